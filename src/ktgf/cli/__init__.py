@@ -1,0 +1,49 @@
+"""The ``ktgf`` command line: a thin layer that parses, validates, calls the library and prints.
+
+Each topic lives in its own module exposing ``register(app, plot_app)``; the modules listed in
+:data:`COMMAND_MODULES` are loaded if present.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+import typer
+
+app = typer.Typer(
+    name="ktgf",
+    help="Continuum models of dense inelastic granular flows (kinetic theory of granular flow).",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    add_completion=False,
+)
+plot_app = typer.Typer(help="Figures (PNG/PDF/SVG by file extension).", no_args_is_help=True)
+app.add_typer(plot_app, name="plot")
+
+COMMAND_MODULES = ("closures", "hcs", "couette", "solver", "report")
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(False, "--version", help="Print the version and exit.", is_eager=True),
+) -> None:
+    if version:
+        from .. import __version__
+
+        typer.echo(f"ktgf {__version__}")
+        raise typer.Exit()
+
+
+for _name in COMMAND_MODULES:
+    try:
+        _mod = importlib.import_module(f"{__name__}.{_name}")
+    except ModuleNotFoundError as _exc:  # that topic is not part of this build
+        if _exc.name != f"{__name__}.{_name}":
+            raise
+        continue
+    _mod.register(app, plot_app)
+
+
+def main() -> None:
+    """Entry point of the ``ktgf`` console script."""
+    app()

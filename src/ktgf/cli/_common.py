@@ -1,0 +1,83 @@
+"""Shared CLI helpers: error reporting, list/range parsing and table/JSON/CSV output."""
+
+from __future__ import annotations
+
+import functools
+import json
+import sys
+from enum import Enum
+from typing import Any, Callable, Sequence
+
+import numpy as np
+import typer
+
+from ..errors import KtgfError
+
+EXIT_USAGE = 2
+
+
+class OutputFormat(str, Enum):
+    table = "table"
+    json = "json"
+    csv = "csv"
+
+
+def handle_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """Turn user mistakes (:class:`~ktgf.errors.KtgfError`) into a one-line message and exit code 2."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return fn(*args, **kwargs)
+        except KtgfError as exc:
+            typer.echo(f"Error: {exc}", err=True)
+            raise typer.Exit(EXIT_USAGE) from None
+
+    return wrapper
+
+
+def parse_values(text: str, name: str) -> np.ndarray:
+    """Parse ``"0.3"``, ``"0.1,0.2,0.3"`` or a range ``"start:stop:num"`` (inclusive, like linspace)."""
+    from ..errors import InputError
+
+    try:
+        if ":" in text:
+            parts = text.split(":")
+            if len(parts) != 3:
+                raise ValueError
+            start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
+            if num < 1:
+                raise ValueError
+            return np.linspace(start, stop, num)
+        return np.array([float(v) for v in text.split(",") if v.strip()], dtype=float)
+    except ValueError:
+        raise InputError(
+            f"--{name} {text!r} is not a number, a comma-separated list or a range start:stop:num"
+        ) from None
+
+
+def emit(rows: Sequence[dict[str, Any]], fmt: OutputFormat, title: str = "") -> None:
+    """Print rows (dicts with the same keys) as a rich table, JSON or CSV on stdout."""
+    if fmt == OutputFormat.json:
+        typer.echo(json.dumps(list(rows), indent=2, default=float))
+        return
+    if not rows:
+        return
+    keys = list(rows[0])
+    if fmt == OutputFormat.csv:
+        import csv
+
+        w = csv.DictWriter(sys.stdout, fieldnames=keys, lineterminator="\n")
+        w.writeheader()
+        for r in rows:
+            w.writerow(r)
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title=title or None)
+    for k in keys:
+        table.add_column(k, justify="right")
+    for r in rows:
+        table.add_row(*(f"{v:.6g}" if isinstance(v, float) else str(v) for v in r.values()))
+    Console(width=max(120, 14 * len(keys))).print(table)

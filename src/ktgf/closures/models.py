@@ -1,0 +1,268 @@
+"""Named closure models: compositions theory × radial distribution × viscosity law, and their registry.
+
+A :class:`Model` is a small frozen (hashable) object, so solvers can take it as a static
+argument of ``jax.jit``.  Solvers never branch on model names: they call
+:meth:`Model.reduced` or :meth:`Model.coefficients`.  The registry (:func:`get_model`,
+:func:`list_models`, :func:`register_model`) also drives the CLI, the docs and the
+parametrised tests.
+
+The four models of the paper (``model.md`` §§3–6):
+
+=========== ===================== ========================== ==========================
+name        theory                RDF                        viscosity law
+=========== ===================== ========================== ==========================
+enskog      Lun et al. (1984)     Carnahan–Starling          theory's own
+ret         Garzó & Dufty (1999)  Carnahan–Starling          theory's own
+visc-div    Lun et al. (1984)     Torquato                   Bocquet et al. divergence
+proposed    Garzó & Dufty (1999)  viscosity-divergence RDF   theory's own
+=========== ===================== ========================== ==========================
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+from .._array import asarray
+from ..errors import InputError, UnknownModelError
+from ..validation import check_positive, check_state
+from .coefficients import Dimensional, Reduced, to_dimensional
+from .garzo_dufty1999 import GarzoDufty1999
+from .lun1984 import Lun1984
+from .rdf import CarnahanStarling, RadialDistribution, Torquato, ViscosityDivergence
+from .viscosity_divergence import NoViscosityCorrection, ViscosityDivergenceLaw
+
+
+class Theory(Protocol):
+    """What a theory provides: reduced coefficients from (φ, e, χ, χ')."""
+
+    key: str
+    label: str
+    reference: str
+
+    def reduced(self, phi: Any, e: Any, chi: Any, dchi: Any) -> Reduced: ...
+
+    def options(self) -> dict[str, Any]: ...
+
+
+class ViscosityLaw(Protocol):
+    """What a viscosity law provides: a multiplier of η* as a function of φ."""
+
+    key: str
+    label: str
+
+    def factor(self, phi: Any) -> Any: ...
+
+    def options(self) -> dict[str, Any]: ...
+
+
+@dataclass(frozen=True)
+class Model:
+    """A closure model: a theory, a radial distribution function and a viscosity law.
+
+    Parameters
+    ----------
+    name : str
+        Registry name (e.g. ``"ret"``).
+    theory : Theory
+        :class:`~ktgf.closures.garzo_dufty1999.GarzoDufty1999` or
+        :class:`~ktgf.closures.lun1984.Lun1984` (or any object with ``reduced``).
+    rdf : RadialDistribution
+        χ(φ) and χ'(φ).
+    viscosity : ViscosityLaw
+        Multiplier of the shear viscosity (default: none).
+    label, description : str
+        Display name and one-line description.
+
+    Examples
+    --------
+    >>> from ktgf import get_model
+    >>> ret = get_model("ret")
+    >>> r = ret.reduced(0.3, 0.9)          # reduced p*, η*, λ_b*, κ*, μ*, ζ0*, ζ_U, g, C
+    >>> c = ret.coefficients(0.3, 0.9, theta=0.01, d=1e-3, rho_s=1500.0)   # SI values
+    """
+
+    name: str
+    theory: Any
+    rdf: RadialDistribution
+    viscosity: Any = field(default_factory=NoViscosityCorrection)
+    label: str = ""
+    description: str = ""
+
+    @property
+    def phi_max(self) -> float:
+        """Packing limit of the model's RDF: valid states have φ < phi_max."""
+        return float(self.rdf.phi_max)
+
+    def check(self, phi: Any, e: Any, theta: Any = None) -> None:
+        """Raise :class:`~ktgf.errors.InputError` if (φ, e, θ) is outside the model's domain."""
+        check_state(phi, e, theta, phi_max=self.phi_max, rdf_name=self.rdf.describe())
+
+    def reduced(self, phi: Any, e: Any, *, check: bool = True) -> Reduced:
+        """Reduced coefficients at solid fraction φ and restitution e (broadcast together).
+
+        Works on NumPy arrays and on JAX arrays (also under ``jit``/``grad``, where the range
+        check is skipped).  Raises :class:`~ktgf.errors.InputError` for φ outside
+        [0, phi_max), e outside (0, 1] or NaN.
+        """
+        phi, e = asarray(phi), asarray(e)
+        if check:
+            self.check(phi, e)
+        chi, dchi = self.rdf.chi(phi), self.rdf.dchi(phi)
+        r = self.theory.reduced(phi, e, chi, dchi)
+        return r._replace(eta=r.eta * self.viscosity.factor(phi))
+
+    def coefficients(
+        self, phi: Any, e: Any, theta: Any, *, d: Any, rho_s: Any, check: bool = True
+    ) -> Dimensional:
+        """SI coefficients (p [Pa], η, λ_b [Pa s], κ, ω, ζ0 [1/s], ζ_U) at (φ, e, θ [m²/s²]).
+
+        ``d`` is the particle diameter [m] and ``rho_s`` the material density [kg/m³].
+        """
+        theta = asarray(theta)
+        if check:
+            self.check(phi, e, theta)
+            check_positive("particle diameter d", d, "m")
+            check_positive("material density rho_s", rho_s, "kg/m^3")
+        return to_dimensional(self.reduced(phi, e, check=False), asarray(phi), theta, d, rho_s)
+
+    def chi(self, phi: Any) -> Any:
+        """The model's radial distribution function χ(φ)."""
+        return self.rdf.chi(asarray(phi))
+
+    def replace(self, **changes: Any) -> Model:
+        """A copy with fields replaced, e.g. ``model.replace(rdf=Torquato())``."""
+        return dataclasses.replace(self, **changes)
+
+    def with_options(self, **options: Any) -> Model:
+        """A copy with options changed, routed to the part that owns them.
+
+        ``zeta11``, ``sonine``, ``omega``, ``alpha`` go to the theory; ``phi_f``, ``phi_c``,
+        ``beta``, ``a`` to the RDF and (where it has them) the viscosity law.
+        """
+        parts = {"theory": self.theory, "rdf": self.rdf, "viscosity": self.viscosity}
+        new = {}
+        used: set[str] = set()
+        for part_name, part in parts.items():
+            names = {f.name for f in dataclasses.fields(part)}
+            mine = {k: v for k, v in options.items() if k in names}
+            used |= set(mine)
+            new[part_name] = dataclasses.replace(part, **mine) if mine else part
+        unknown = set(options) - used
+        if unknown:
+            raise InputError(f"model {self.name!r} has no option(s) {sorted(unknown)}; valid: {sorted(self.options())}")
+        return dataclasses.replace(self, **new)
+
+    def options(self) -> dict[str, Any]:
+        """Every option of the model, flattened (for metadata and display)."""
+        return {
+            **self.theory.options(),
+            **{k: v for k, v in self.rdf.params().items() if not callable(v)},
+            **self.viscosity.options(),
+        }
+
+    def metadata(self) -> dict[str, str]:
+        """Attributes for netCDF files: name, parts, references and options as strings."""
+        import json
+
+        return {
+            "model": self.name,
+            "model_label": self.label or self.name,
+            "theory": self.theory.key,
+            "theory_reference": self.theory.reference,
+            "rdf": self.rdf.describe(),
+            "viscosity_law": self.viscosity.key,
+            "model_options": json.dumps(
+                {
+                    "theory": self.theory.options(),
+                    "rdf": {k: v for k, v in self.rdf.params().items() if not callable(v)},
+                    "viscosity": self.viscosity.options(),
+                }
+            ),
+        }
+
+
+_REGISTRY: dict[str, Model] = {}
+_ALIASES: dict[str, str] = {}
+
+
+def _normalise(name: str) -> str:
+    return name.strip().lower().replace("_", "-").replace(".", "-").replace(" ", "-").strip("-")
+
+
+def register_model(model: Model, *aliases: str, overwrite: bool = False) -> Model:
+    """Add a model to the registry (and so to the CLI, the report and the tests)."""
+    key = _normalise(model.name)
+    if key in _REGISTRY and not overwrite:
+        raise InputError(f"a model named {model.name!r} is already registered")
+    _REGISTRY[key] = model
+    for a in aliases:
+        _ALIASES[_normalise(a)] = key
+    return model
+
+
+def get_model(name: str | Model, **options: Any) -> Model:
+    """Look a model up by name (case and punctuation insensitive), optionally with options.
+
+    >>> get_model("RET", zeta11="ghd").theory.zeta11
+    'ghd'
+    """
+    if isinstance(name, Model):
+        model = name
+    else:
+        key = _normalise(name)
+        key = _ALIASES.get(key, key)
+        if key not in _REGISTRY:
+            raise UnknownModelError(f"unknown model {name!r}; registered models: {', '.join(_REGISTRY)}")
+        model = _REGISTRY[key]
+    return model.with_options(**options) if options else model
+
+
+def list_models() -> list[Model]:
+    """All registered models, in registration order."""
+    return list(_REGISTRY.values())
+
+
+PAPER_MODELS: tuple[str, ...] = ("enskog", "ret", "visc-div", "proposed")
+
+register_model(
+    Model(
+        "enskog",
+        Lun1984(),
+        CarnahanStarling(),
+        label="Enskog",
+        description="Lun et al. (1984) kinetic theory, the classic KTGF benchmark",
+    ),
+    "lun", "lun1984", "lun-1984",
+)
+register_model(
+    Model(
+        "ret",
+        GarzoDufty1999(),
+        CarnahanStarling(),
+        label="RET",
+        description="Garzó & Dufty (1999) revised Enskog theory with density-gradient heat flux and ζ_U",
+    ),
+    "garzo-dufty", "gd99", "garzo-dufty-1999",
+)
+register_model(
+    Model(
+        "visc-div",
+        Lun1984(),
+        Torquato(),
+        ViscosityDivergenceLaw(),
+        label="Visc.div.",
+        description="Lun et al. (1984) with Torquato χ and the Bocquet et al. (2001) faster viscosity divergence",
+    ),
+    "viscdiv", "visc-div", "bocquet",
+)
+register_model(
+    Model(
+        "proposed",
+        GarzoDufty1999(),
+        ViscosityDivergence(),
+        label="Proposed",
+        description="RET with the radial distribution function derived from the viscosity divergence",
+    ),
+)

@@ -1,0 +1,272 @@
+"""Radial distribution functions at contact, χ = g0(φ), each with its analytic derivative.
+
+Every RDF is a small frozen dataclass whose fields are its parameters; ``chi(phi)`` and
+``dchi(phi)`` are pure, vectorised and work on NumPy and JAX arrays alike.  The valid
+domain is ``0 ≤ φ < phi_max`` (the packing limit at which χ diverges); evaluation does
+not check it (so it can run under ``jax.jit``) — :func:`ktgf.validation.check_state`
+does, at the public boundary.
+
+Glossary: ``phi`` solid volume fraction φ, ``phi_f`` freezing point φ_f,
+``phi_c`` random-close-packing (divergence) point φ_c, ``beta`` divergence exponent β.
+Formulas: ``shared/theory/model.md`` §2.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any, Callable, ClassVar
+
+from .._array import namespace
+
+
+@dataclass(frozen=True)
+class RadialDistribution:
+    """Base class: a radial distribution function at contact χ(φ) with its derivative."""
+
+    key: ClassVar[str] = ""
+    label: ClassVar[str] = ""
+    reference: ClassVar[str] = ""
+
+    @property
+    def phi_max(self) -> float:
+        """Packing limit: χ diverges here and states must have φ below it."""
+        raise NotImplementedError
+
+    def chi(self, phi: Any) -> Any:
+        """χ(φ), the pair correlation at contact."""
+        raise NotImplementedError
+
+    def dchi(self, phi: Any) -> Any:
+        """χ'(φ) = dχ/dφ."""
+        raise NotImplementedError
+
+    def params(self) -> dict[str, Any]:
+        """The parameters of this RDF (its dataclass fields)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def describe(self) -> str:
+        """Short text: name and parameters, e.g. ``torquato(phi_f=0.49, phi_c=0.64)``."""
+        p = ", ".join(f"{k}={v}" for k, v in self.params().items() if not callable(v))
+        return f"{self.key}({p})"
+
+
+def _cs_chi(phi: Any) -> Any:
+    return (1.0 - 0.5 * phi) / (1.0 - phi) ** 3
+
+
+def _cs_dchi(phi: Any) -> Any:
+    return (2.5 - phi) / (1.0 - phi) ** 4
+
+
+@dataclass(frozen=True)
+class CarnahanStarling(RadialDistribution):
+    """Carnahan–Starling: χ = (1 − φ/2)/(1 − φ)³, χ' = (5/2 − φ)/(1 − φ)⁴.
+
+    Carnahan & Starling, J. Chem. Phys. 51, 635 (1969); the paper's Table 1 row T11.
+    Diverges only at φ = 1, so it does not stop a dense region from passing random close packing.
+    """
+
+    key: ClassVar[str] = "carnahan-starling"
+    label: ClassVar[str] = "Carnahan–Starling"
+    reference: ClassVar[str] = "Carnahan & Starling, J. Chem. Phys. 51, 635 (1969)"
+
+    @property
+    def phi_max(self) -> float:
+        return 1.0
+
+    def chi(self, phi: Any) -> Any:
+        return _cs_chi(phi)
+
+    def dchi(self, phi: Any) -> Any:
+        return _cs_dchi(phi)
+
+
+@dataclass(frozen=True)
+class Torquato(RadialDistribution):
+    """Torquato (1995): CS for φ ≤ φ_f, χ_CS(φ_f)(φ_c − φ_f)/(φ_c − φ) above.
+
+    Torquato, Phys. Rev. E 51, 3170 (1995), Eq. (13).  Defaults φ_f = 0.49, φ_c = 0.64.
+    """
+
+    phi_f: float = 0.49
+    phi_c: float = 0.64
+    key: ClassVar[str] = "torquato"
+    label: ClassVar[str] = "Torquato"
+    reference: ClassVar[str] = "Torquato, Phys. Rev. E 51, 3170 (1995)"
+
+    @property
+    def phi_max(self) -> float:
+        return self.phi_c
+
+    def chi(self, phi: Any) -> Any:
+        xp = namespace(phi)
+        dense = _cs_chi(self.phi_f) * (self.phi_c - self.phi_f) / (self.phi_c - phi)
+        return xp.where(phi <= self.phi_f, _cs_chi(phi), dense)
+
+    def dchi(self, phi: Any) -> Any:
+        xp = namespace(phi)
+        dense = _cs_chi(self.phi_f) * (self.phi_c - self.phi_f) / (self.phi_c - phi) ** 2
+        return xp.where(phi <= self.phi_f, _cs_dchi(phi), dense)
+
+
+@dataclass(frozen=True)
+class LunSavage(RadialDistribution):
+    """Lun & Savage (1986): χ = (1 − φ/φ_c)^(−2.5 φ_c).
+
+    Lun & Savage, Acta Mech. 63, 15 (1986).  Default φ_c = 0.64.
+    """
+
+    phi_c: float = 0.64
+    key: ClassVar[str] = "lun-savage"
+    label: ClassVar[str] = "Lun–Savage"
+    reference: ClassVar[str] = "Lun & Savage, Acta Mech. 63, 15 (1986)"
+
+    @property
+    def phi_max(self) -> float:
+        return self.phi_c
+
+    def chi(self, phi: Any) -> Any:
+        return (1.0 - phi / self.phi_c) ** (-2.5 * self.phi_c)
+
+    def dchi(self, phi: Any) -> Any:
+        return 2.5 * (1.0 - phi / self.phi_c) ** (-2.5 * self.phi_c - 1.0)
+
+
+@dataclass(frozen=True)
+class MaAhmadi(RadialDistribution):
+    """Ma & Ahmadi (1986): χ = (1 + 2.5φ + 4.5904φ² + 4.515439φ³)/(1 − (φ/φ_c)³)^0.678021.
+
+    Ma & Ahmadi, J. Chem. Phys. 84, 3449 (1986).  Default φ_c = 0.64356.
+    """
+
+    phi_c: float = 0.64356
+    exponent: float = 0.678021
+    key: ClassVar[str] = "ma-ahmadi"
+    label: ClassVar[str] = "Ma–Ahmadi"
+    reference: ClassVar[str] = "Ma & Ahmadi, J. Chem. Phys. 84, 3449 (1986)"
+
+    @property
+    def phi_max(self) -> float:
+        return self.phi_c
+
+    def chi(self, phi: Any) -> Any:
+        num = 1.0 + 2.5 * phi + 4.5904 * phi**2 + 4.515439 * phi**3
+        return num / (1.0 - (phi / self.phi_c) ** 3) ** self.exponent
+
+    def dchi(self, phi: Any) -> Any:
+        num = 1.0 + 2.5 * phi + 4.5904 * phi**2 + 4.515439 * phi**3
+        dnum = 2.5 + 9.1808 * phi + 13.546317 * phi**2
+        den = 1.0 - (phi / self.phi_c) ** 3
+        dden = -3.0 * phi**2 / self.phi_c**3
+        a = self.exponent
+        return dnum / den**a - a * num * dden / den ** (a + 1.0)
+
+
+@dataclass(frozen=True)
+class ChialvoSundaresan(RadialDistribution):
+    """Chialvo & Sundaresan (2013): χ = (2 − φ)/(2(1 − φ)³) + a φ²/(φ_c − φ)^1.5.
+
+    Chialvo & Sundaresan, Phys. Fluids 25, 070603 (2013).  Defaults a = 0.58, φ_c = 0.64.
+    """
+
+    a: float = 0.58
+    phi_c: float = 0.64
+    key: ClassVar[str] = "chialvo-sundaresan"
+    label: ClassVar[str] = "Chialvo–Sundaresan"
+    reference: ClassVar[str] = "Chialvo & Sundaresan, Phys. Fluids 25, 070603 (2013)"
+
+    @property
+    def phi_max(self) -> float:
+        return self.phi_c
+
+    def chi(self, phi: Any) -> Any:
+        # (2 − φ)/(2(1 − φ)³) is the Carnahan–Starling χ written differently.
+        return _cs_chi(phi) + self.a * phi**2 / (self.phi_c - phi) ** 1.5
+
+    def dchi(self, phi: Any) -> Any:
+        gap = self.phi_c - phi
+        return _cs_dchi(phi) + self.a * (2.0 * phi / gap**1.5 + 1.5 * phi**2 / gap**2.5)
+
+
+@dataclass(frozen=True)
+class ViscosityDivergence(RadialDistribution):
+    """The paper's new RDF: CS for φ ≤ φ_f, χ_CS(φ_f) ((φ_c − φ_f)/(φ_c − φ))^β above.
+
+    Reconstructed in ``model.md`` §2 from the Bocquet et al. (2001) viscosity divergence
+    η ∝ (φ_c − φ)^(−β), β = 1.75 (from δV ∝ γ̇^0.4: β = (1/0.4 + 1)/2).  With it the dense
+    RET viscosity (∝ φ²χ) follows the measured law.  Defaults φ_f = 0.49, φ_c = 0.64, β = 1.75.
+    """
+
+    phi_f: float = 0.49
+    phi_c: float = 0.64
+    beta: float = 1.75
+    key: ClassVar[str] = "viscosity-divergence"
+    label: ClassVar[str] = "Viscosity divergence"
+    reference: ClassVar[str] = "model.md §2; Bocquet et al., Phys. Rev. E 65, 011307 (2001)"
+
+    @property
+    def phi_max(self) -> float:
+        return self.phi_c
+
+    def chi(self, phi: Any) -> Any:
+        xp = namespace(phi)
+        dense = _cs_chi(self.phi_f) * ((self.phi_c - self.phi_f) / (self.phi_c - phi)) ** self.beta
+        return xp.where(phi <= self.phi_f, _cs_chi(phi), dense)
+
+    def dchi(self, phi: Any) -> Any:
+        xp = namespace(phi)
+        gap_f = self.phi_c - self.phi_f
+        dense = _cs_chi(self.phi_f) * self.beta * gap_f**self.beta / (self.phi_c - phi) ** (self.beta + 1.0)
+        return xp.where(phi <= self.phi_f, _cs_dchi(phi), dense)
+
+
+@dataclass(frozen=True, eq=False)
+class CustomRDF(RadialDistribution):
+    """A user-supplied RDF: a pair of functions ``chi(phi)``, ``dchi(phi)`` and its packing limit.
+
+    Both functions must be vectorised; to use the RDF inside the JAX solver they must be
+    written with operators (or ``ktgf._array.namespace``) rather than NumPy calls.
+    """
+
+    chi_fn: Callable[[Any], Any] = None  # type: ignore[assignment]
+    dchi_fn: Callable[[Any], Any] = None  # type: ignore[assignment]
+    packing_limit: float = 1.0
+    name: str = "custom"
+    key: ClassVar[str] = "custom"
+    label: ClassVar[str] = "Custom"
+    reference: ClassVar[str] = "user supplied"
+
+    def __post_init__(self) -> None:
+        if not callable(self.chi_fn) or not callable(self.dchi_fn):
+            raise TypeError("CustomRDF needs two callables: chi_fn(phi) and dchi_fn(phi)")
+
+    @property
+    def phi_max(self) -> float:
+        return self.packing_limit
+
+    def chi(self, phi: Any) -> Any:
+        return self.chi_fn(phi)
+
+    def dchi(self, phi: Any) -> Any:
+        return self.dchi_fn(phi)
+
+    def describe(self) -> str:
+        return f"custom({self.name}, phi_max={self.packing_limit})"
+
+
+RDFS: dict[str, type[RadialDistribution]] = {
+    cls.key: cls
+    for cls in (CarnahanStarling, Torquato, LunSavage, MaAhmadi, ChialvoSundaresan, ViscosityDivergence)
+}
+
+
+def get_rdf(name: str, **params: Any) -> RadialDistribution:
+    """Build a registered RDF by key (``"carnahan-starling"``, ``"torquato"``, …) with parameters."""
+    from ..errors import InputError
+
+    key = name.lower().replace("_", "-")
+    if key in ("cs",):
+        key = "carnahan-starling"
+    if key not in RDFS:
+        raise InputError(f"unknown radial distribution function {name!r}; choose one of {sorted(RDFS)}")
+    return RDFS[key](**params)

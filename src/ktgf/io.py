@@ -1,0 +1,59 @@
+"""Run metadata and file output shared by every solver (netCDF via xarray).
+
+Every Dataset ktgf writes carries, in ``attrs``: the package version, the creation time,
+the model (name, parts, options, references) and the run parameters as JSON — enough to
+regenerate a figure from its file and a run from its output.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import platform
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from . import __version__
+from .errors import InputError
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, (np.generic,)):
+        return x.item()
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, Path):
+        return str(x)
+    if hasattr(x, "model_dump"):  # pydantic models
+        return _jsonable(x.model_dump())
+    return x if isinstance(x, (str, int, float, bool)) or x is None else repr(x)
+
+
+def run_metadata(model: Any = None, **parameters: Any) -> dict[str, str]:
+    """netCDF-safe attributes: version, time, platform, model description and parameters (JSON)."""
+    attrs = {
+        "ktgf_version": __version__,
+        "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "python": platform.python_version(),
+        "parameters": json.dumps(_jsonable(parameters), sort_keys=True),
+    }
+    if model is not None:
+        attrs.update(model.metadata())
+    return attrs
+
+
+def write_netcdf(ds: Any, path: str | Path) -> Path:
+    """Write an xarray Dataset to ``path`` (parent folders created), raising a clear error if unwritable."""
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        ds.to_netcdf(path)
+    except (PermissionError, OSError) as exc:
+        raise InputError(f"cannot write output file {str(path)!r}: {exc.strerror or exc}") from exc
+    return path

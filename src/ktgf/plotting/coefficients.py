@@ -1,0 +1,40 @@
+"""Figure: reduced transport coefficients of several models against φ."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from ..closures.models import Model
+from . import save
+
+PANELS = (("p", "$p^*$"), ("eta", r"$\eta^*$"), ("kappa", r"$\kappa^*$"), ("mu", r"$\mu^*$"), ("zeta0", r"$\zeta_0^*$"))
+
+
+def plot_reduced_coefficients(
+    models: Sequence[Model], *, e: float, phi_max: float = 0.6, out: str | Path, n: int = 300
+) -> Path:
+    """Plot p*, η*, κ*, μ*, ζ0* and χ against φ for ``models`` at restitution ``e``; return the file path.
+
+    Each model is drawn up to min(phi_max, 0.995 × its packing limit).
+    """
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 3, figsize=(13, 7.5), constrained_layout=True)
+    for m in models:
+        top = min(phi_max, 0.995 * m.phi_max)
+        phi = np.linspace(1e-3, top, n)
+        r = m.reduced(phi, e)
+        for ax, (key, label) in zip(axes.flat, PANELS):
+            ax.semilogy(phi, np.broadcast_to(getattr(r, key), phi.shape), label=m.label or m.name)
+            ax.set_ylabel(label)
+        axes.flat[5].semilogy(phi, m.chi(phi), label=m.label or m.name)
+    axes.flat[5].set_ylabel(r"$\chi = g_0(\phi)$")
+    for ax in axes.flat:
+        ax.set_xlabel(r"solid fraction $\phi$")
+        ax.grid(True, which="both", alpha=0.3)
+    axes.flat[0].legend()
+    fig.suptitle(f"Reduced transport coefficients, e = {e:g}")
+    return save(fig, out)

@@ -1,0 +1,75 @@
+"""Range checks for physical inputs, applied at public boundaries.
+
+Closures themselves never check (so they can run under ``jax.jit``); public functions call
+:func:`check_state` first.  Abstract JAX values (tracers) are skipped, since their values
+are unknown at trace time.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ._array import is_tracer
+from .errors import InputError
+
+
+def _values(x: Any) -> np.ndarray | None:
+    if x is None or is_tracer(x):
+        return None
+    return np.asarray(x, dtype=float)
+
+
+def _first_bad(v: np.ndarray, ok: np.ndarray) -> str:
+    bad = v[~ok]
+    n = bad.size
+    more = f" (and {n - 1} more)" if n > 1 else ""
+    return f"{bad.flat[0]:g}{more}"
+
+
+def check_range(
+    name: str,
+    x: Any,
+    *,
+    low: float | None = None,
+    high: float | None = None,
+    low_open: bool = False,
+    high_open: bool = False,
+    why: str = "",
+) -> None:
+    """Raise :class:`InputError` if any value of ``x`` is NaN or outside [low, high].
+
+    The message names the quantity, the offending value and the valid range, e.g.
+    ``solid fraction phi = 0.7 is out of range: valid 0 <= phi < 0.64 (packing limit of torquato)``.
+    """
+    v = _values(x)
+    if v is None:
+        return
+    ok = np.isfinite(v)
+    if low is not None:
+        ok &= (v > low) if low_open else (v >= low)
+    if high is not None:
+        ok &= (v < high) if high_open else (v <= high)
+    if ok.all():
+        return
+    lo = "" if low is None else f"{low:g} {'<' if low_open else '<='} "
+    hi = "" if high is None else f" {'<' if high_open else '<='} {high:g}"
+    short = name.split()[-1]
+    rng = f"{lo}{short}{hi}" if (lo or hi) else f"{short} finite"
+    tail = f" ({why})" if why else ""
+    raise InputError(f"{name} = {_first_bad(v, ok)} is out of range: valid {rng}{tail}")
+
+
+def check_state(phi: Any, e: Any, theta: Any = None, *, phi_max: float = 1.0, rdf_name: str = "") -> None:
+    """Check 0 ≤ φ < φ_max, 0 < e ≤ 1 and θ > 0 (if given); raise :class:`InputError` otherwise."""
+    why = f"packing limit of RDF {rdf_name}" if rdf_name else "packing limit"
+    check_range("solid fraction phi", phi, low=0.0, high=phi_max, high_open=True, why=why)
+    check_range("restitution coefficient e", e, low=0.0, high=1.0, low_open=True)
+    if theta is not None:
+        check_range("granular temperature theta", theta, low=0.0, low_open=True, why="m^2/s^2")
+
+
+def check_positive(name: str, x: Any, unit: str = "") -> None:
+    """Check that ``x`` is finite and > 0 (a diameter, a density, a length)."""
+    check_range(name, x, low=0.0, low_open=True, why=unit)
