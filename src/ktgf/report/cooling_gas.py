@@ -1,0 +1,208 @@
+"""Section 4: the 3D homogeneous cooling gas below and above the critical size (model.md §9).
+
+For each model of ``settings.cooling_models`` two periodic cubes are run: one of side
+``cooling_below`` × L⊥ (should stay homogeneous and follow Haff's law) and one of side
+``cooling_above`` × L∥ (should grow vortices and clusters), with L⊥, L∥ from the closed form
+of model.md §8.  The section needs the 3D solver (package :mod:`ktgf.solver`); without it the
+page says "not available in this build".
+
+Contract with the solver (the one thing to wire up)
+---------------------------------------------------
+The section calls :data:`ENTRY_POINT`, ``ktgf.solver.report_cooling_run``, once per run::
+
+    report_cooling_run(model: ktgf.Model, *, phi: float, e: float, box: float, n_cells: int,
+                       t_end: float, seed: int, d: float, rho_s: float, theta0: float) -> xarray.Dataset
+
+(``box`` = side of the cube in the units of ``d``; ``t_end`` in units of the initial collision
+time 1/ν0(θ0); uniform φ, θ0 and a small random velocity perturbation from ``seed``), returning
+
+* coordinate ``time`` (units of 1/ν0(θ0)) with ``theta_mean`` (volume-averaged θ), ``flow_energy``
+  (kinetic energy of the mean flow over the thermal energy (3/2)∫ρθ) and ``phi_std``
+  (standard deviation of φ over the cells divided by the mean φ);
+* coordinates ``x``, ``y`` (units of d) with ``phi_slice``, ``ux_slice``, ``uy_slice``: the
+  fields in the mid-plane z = box/2 at the final time;
+* attrs from :func:`ktgf.io.run_metadata`.
+
+If the solver's API differs, adapt :func:`run_box` (the only call into it).
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from typing import Any, Callable
+
+import numpy as np
+import xarray as xr
+
+from ..closures.models import get_model
+from ..hcs.haff import haff_temperature
+from ..hcs.stability import critical_box_size, critical_wavenumbers
+from .framework import Section, SectionContext, model_inputs, register_section
+from .settings import ReportSettings
+
+ENTRY_POINT = ("ktgf.solver", "report_cooling_run")
+RHO_S_DEM = 6.0 / math.pi
+
+
+def _entry() -> Callable[..., xr.Dataset] | None:
+    try:
+        mod = importlib.import_module(ENTRY_POINT[0])
+    except ModuleNotFoundError as exc:
+        if exc.name and ENTRY_POINT[0].startswith(exc.name):
+            return None
+        raise
+    return getattr(mod, ENTRY_POINT[1], None)
+
+
+def available() -> str | None:
+    """None if the 3D solver and its report entry point are importable, else why not."""
+    try:
+        importlib.import_module(ENTRY_POINT[0])
+    except ModuleNotFoundError:
+        return f"the 3D flow solver (package {ENTRY_POINT[0]}) is not installed in this build."
+    if _entry() is None:
+        return (f"{ENTRY_POINT[0]} has no function {ENTRY_POINT[1]}(model, *, phi, e, box, n_cells, t_end, seed, d, rho_s, theta0) "
+                "that the report calls (see ktgf.report.cooling_gas).")
+    return None
+
+
+def run_box(model: Any, box: float, s: ReportSettings) -> xr.Dataset:
+    """One 3D cooling run (the only call into the solver)."""
+    fn = _entry()
+    if fn is None:
+        raise RuntimeError(available() or "3D solver unavailable")
+    return fn(model, phi=s.cooling_phi, e=s.cooling_e, box=box, n_cells=s.cooling_cells, t_end=s.cooling_t_end,
+              seed=s.cooling_seed, d=1.0, rho_s=RHO_S_DEM, theta0=1.0)
+
+
+def inputs(s: ReportSettings) -> dict[str, Any]:
+    return {"models": model_inputs(s.cooling_models), "phi": s.cooling_phi, "e": s.cooling_e, "below": s.cooling_below,
+            "above": s.cooling_above, "cells": s.cooling_cells, "t_end": s.cooling_t_end, "seed": s.cooling_seed}
+
+
+def boxes(name: str, s: ReportSettings) -> dict[str, float]:
+    """Box sides [d] of the two runs of a model: below L⊥ and above L∥."""
+    kp, kl = critical_wavenumbers(get_model(name).reduced(s.cooling_phi, s.cooling_e))
+    return {"below": s.cooling_below * float(critical_box_size(s.cooling_phi, kp)),
+            "above": s.cooling_above * float(critical_box_size(s.cooling_phi, kl))}
+
+
+def plot_time_series(ds: xr.Dataset, out: Any) -> Any:
+    import matplotlib.pyplot as plt
+
+    from ..plotting import save
+
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4), constrained_layout=True)
+    for r in range(ds.sizes["run"]):
+        lab = str(ds.run.values[r])
+        axes[0].plot(ds.time, ds.theta_over_haff[r], label=lab)
+        axes[1].semilogy(ds.time, ds.flow_energy[r], label=lab)
+        axes[2].semilogy(ds.time, ds.phi_std[r], label=lab)
+    for ax, t in zip(axes, (r"$\theta/\theta_\mathrm{Haff}$", "mean-flow / thermal energy", r"std($\phi$)/mean($\phi$)")):
+        ax.set_xlabel(r"time $t\,\nu_0(\theta_0)$")
+        ax.set_ylabel(t)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle("3D cooling gas: departure from Haff's law, flow energy and density contrast")
+    return save(fig, out)
+
+
+def plot_slices(ds: xr.Dataset, out: Any) -> Any:
+    import matplotlib.pyplot as plt
+
+    from ..plotting import save
+
+    n = ds.sizes["run"]
+    fig, axes = plt.subplots(2, n, figsize=(3.6 * n, 7), constrained_layout=True, squeeze=False)
+    for r in range(n):
+        x, y = ds.x.values[r], ds.y.values[r]
+        im = axes[0, r].pcolormesh(x, y, ds.phi_slice[r].T, shading="auto", cmap="viridis")
+        fig.colorbar(im, ax=axes[0, r], label=r"$\phi$")
+        speed = np.hypot(ds.ux_slice[r], ds.uy_slice[r]).T
+        im = axes[1, r].pcolormesh(x, y, speed, shading="auto", cmap="magma")
+        step = max(1, x.size // 16)
+        axes[1, r].quiver(x[::step], y[::step], ds.ux_slice[r].T[::step, ::step], ds.uy_slice[r].T[::step, ::step], color="w")
+        fig.colorbar(im, ax=axes[1, r], label="|u| in plane")
+        axes[0, r].set_title(str(ds.run.values[r]), fontsize=9)
+        for ax in axes[:, r]:
+            ax.set_aspect("equal")
+            ax.set_xlabel("x / d")
+            ax.set_ylabel("y / d")
+    fig.suptitle("Mid-plane slices at the final time: solid fraction (top), in-plane velocity (bottom)")
+    return save(fig, out)
+
+
+def run(ctx: SectionContext) -> None:
+    s = ctx.settings
+    runs: list[tuple[str, str, float, xr.Dataset]] = []
+    for name in s.cooling_models:
+        m = get_model(name)
+        for kind, side in boxes(name, s).items():
+            runs.append((name, kind, side, run_box(m, side, s)))
+    # Runs share neither grids nor time samples: put them on the first run's time axis and pad slices.
+    t = np.asarray(runs[0][3].time, dtype=float)
+    nx = max(r[3].sizes["x"] for r in runs)
+    series: dict[str, list[np.ndarray]] = {k: [] for k in ("theta_over_haff", "flow_energy", "phi_std")}
+    slices: dict[str, list[np.ndarray]] = {k: [] for k in ("phi_slice", "ux_slice", "uy_slice", "x", "y")}
+    rows, numbers = [], {}
+    for name, kind, side, ds in runs:
+        ti = np.asarray(ds.time, dtype=float)
+        zeta = float(get_model(name).reduced(s.cooling_phi, s.cooling_e).zeta0)  # ζ0/ν0(θ0): Haff time t0 = 2/ζ0*
+        ratio = np.asarray(ds.theta_mean, dtype=float) / (float(ds.theta_mean[0]) * haff_temperature(ti, 1.0, 2.0 / zeta))
+        series["theta_over_haff"].append(np.interp(t, ti, ratio, right=np.nan))
+        series["flow_energy"].append(np.interp(t, ti, np.asarray(ds.flow_energy, dtype=float), right=np.nan))
+        series["phi_std"].append(np.interp(t, ti, np.asarray(ds.phi_std, dtype=float), right=np.nan))
+        for k in ("phi_slice", "ux_slice", "uy_slice"):
+            a = np.full((nx, nx), np.nan)
+            v = np.asarray(ds[k], dtype=float)
+            a[: v.shape[0], : v.shape[1]] = v
+            slices[k].append(a)
+        for k in ("x", "y"):
+            a = np.full(nx, np.nan)
+            a[: ds.sizes[k]] = np.asarray(ds[k], dtype=float)
+            slices[k].append(a)
+        label = f"{get_model(name).label}, L = {side:.1f} d ({kind} critical)"
+        haff_dev = float(np.max(np.abs(ratio - 1.0)))
+        rows.append([label, side, float(ds.phi_std[-1]), float(ds.flow_energy[-1]), 100 * haff_dev])
+        numbers[f"{name}/{kind}"] = {"box": side, "phi_std_end": float(ds.phi_std[-1]), "flow_energy_end": float(ds.flow_energy[-1]),
+                                      "haff_max_dev": haff_dev}
+    labels = [r[0] for r in rows]
+    ts = xr.Dataset(
+        {k: (("run", "time"), np.array(v)) for k, v in series.items()},
+        coords={"run": labels, "time": t},
+        attrs={k: str(v) for k, v in runs[0][3].attrs.items()},
+    )
+    sl = xr.Dataset(
+        {k: (("run", "i", "j"), np.array(v)) for k, v in slices.items() if k.endswith("slice")}
+        | {"x": (("run", "i"), np.array(slices["x"])), "y": (("run", "j"), np.array(slices["y"]))},
+        coords={"run": labels}, attrs=ts.attrs,
+    )
+    plot_time_series(ts, ctx.figure_path("cooling_time_series"))
+    ctx.add_figure("cooling_time_series", f"3D cooling gas at φ = {s.cooling_phi:g}, e = {s.cooling_e:g}: temperature relative to Haff's law, "
+                   "energy of the mean flow and density contrast against time.", ts)
+    plot_slices(sl, ctx.figure_path("cooling_slices"))
+    ctx.add_figure("cooling_slices", "Mid-plane slices at the end of each run: clusters show in φ, vortices in the velocity.", sl)
+    ctx.table("3D cooling runs", ["run", "L/d", "final std(φ)/φ", "final flow/thermal energy", "max |θ/θ_Haff − 1| %"], rows)
+    ctx.number("cooling_runs", numbers)
+
+
+def discuss(nb: dict[str, Any]) -> list[str]:
+    out = []
+    for key, v in nb.get("cooling_runs", {}).items():
+        name, kind = key.split("/")
+        lab = get_model(name).label
+        if kind == "below":
+            out.append(f"{lab}, L = {v['box']:.1f} d (below L⊥): θ stays within {100 * v['haff_max_dev']:.1f} % of Haff's law; "
+                       f"final density contrast {v['phi_std_end']:.2g}.")
+        else:
+            out.append(f"{lab}, L = {v['box']:.1f} d (above L∥): final density contrast {v['phi_std_end']:.2g}, "
+                       f"mean-flow energy {v['flow_energy_end']:.2g} of the thermal energy, θ departs from Haff's law by up to "
+                       f"{100 * v['haff_max_dev']:.0f} %.")
+    return out
+
+
+SECTION = register_section(Section(
+    "cooling_gas", "4. 3D homogeneous cooling gas", run, inputs, order=40,
+    modules=(ENTRY_POINT[0],), available=available, discuss=discuss,
+))

@@ -1,0 +1,333 @@
+"""The report's building blocks: sections, what they produce, the on-disk cache and the build loop.
+
+A *section* is a function ``run(ctx)`` that turns inputs into figures (PNG, each with the
+netCDF file of the data behind it), tables, paragraphs and named numbers, all recorded in
+the :class:`SectionContext` it is given.  Its result is cached in ``<out>/.cache/<key>.json``
+under a hash of everything it depends on: the section's declared inputs (settings, model
+options), the ktgf version, the source code of the section's modules and the content of the
+data files it reads.  A rerun therefore recomputes only sections whose inputs changed or that
+were never finished (an interrupted run continues where it stopped).
+
+Layout of the output folder::
+
+    index.html                the page (figures referenced by relative path)
+    figures/<section>/*.png   figures
+    data/<section>/*.nc       the data behind every figure (ktgf.io.run_metadata attrs)
+    .cache/<section>.json     cached results; .cache/log.jsonl one line per section per run
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import importlib
+import json
+import os
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+from .. import __version__
+from ..errors import InputError
+from .settings import ReportSettings
+
+CACHE_DIR = ".cache"
+FIGURE_DIR = "figures"
+DATA_DIR = "data"
+#: Bump to invalidate every cache entry when the result format changes.
+CACHE_FORMAT = 1
+
+
+@dataclass
+class FigureRef:
+    """A figure file (path relative to the output folder), its caption and its data file."""
+
+    file: str
+    caption: str
+    data: str | None = None
+
+
+@dataclass
+class TableData:
+    """A small table: column titles and rows of plain values (numbers are formatted on the page)."""
+
+    title: str
+    columns: list[str]
+    rows: list[list[Any]]
+    note: str = ""
+
+
+@dataclass
+class SectionResult:
+    """Everything a section produced, in a JSON-serialisable form (what the cache stores).
+
+    ``status`` is ``computed`` (this run), ``cached`` (read back), ``unavailable`` (its package
+    is not part of this build; ``reason`` says why) or ``failed`` (``reason`` holds the error).
+    """
+
+    key: str
+    title: str
+    status: str = "computed"
+    reason: str = ""
+    paragraphs: list[str] = field(default_factory=list)
+    figures: list[FigureRef] = field(default_factory=list)
+    tables: list[TableData] = field(default_factory=list)
+    numbers: dict[str, Any] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+    datasets: list[str] = field(default_factory=list)
+    inputs: dict[str, Any] = field(default_factory=dict)
+
+    def to_json(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_json(cls, d: dict[str, Any]) -> SectionResult:
+        d = dict(d)
+        d["figures"] = [FigureRef(**f) for f in d.get("figures", [])]
+        d["tables"] = [TableData(**t) for t in d.get("tables", [])]
+        return cls(**d)
+
+    def files(self) -> list[str]:
+        """Every file the section wrote (relative paths)."""
+        return [f.file for f in self.figures] + list(self.datasets)
+
+
+class SectionContext:
+    """What a section's ``run`` gets: its settings, the DEM data folder and places to put its outputs."""
+
+    def __init__(self, section: Section, settings: ReportSettings, out: Path, data_dir: Path | None,
+                 inputs: dict[str, Any]) -> None:
+        self.section = section
+        self.settings = settings
+        self.out = out
+        self.data_dir = data_dir
+        self.inputs = inputs
+        self.result = SectionResult(section.key, section.title, inputs=inputs)
+
+    # -- inputs ---------------------------------------------------------------------------
+    def data_file(self, name: str) -> Path | None:
+        """Path of the optional DEM file ``name``, or None after adding a note saying it is absent."""
+        if self.data_dir is not None and (self.data_dir / name).is_file():
+            return self.data_dir / name
+        where = f"in {self.data_dir}" if self.data_dir is not None else "(no DEM data folder)"
+        self.note(f"Optional DEM reference file {name} not found {where}: the comparison with it is left out.")
+        return None
+
+    # -- outputs --------------------------------------------------------------------------
+    def figure(self, fig: Any, name: str, caption: str, data: Any = None) -> str:
+        """Save a matplotlib figure as ``figures/<section>/<name>.png`` and ``data`` (its Dataset) as netCDF."""
+        from ..plotting import save
+
+        save(fig, self.figure_path(name))
+        return self.add_figure(name, caption, data)
+
+    def figure_path(self, name: str) -> Path:
+        """Where figure ``name`` goes, for plotting functions that save the file themselves."""
+        return self.out / FIGURE_DIR / self.section.key / f"{name}.png"
+
+    def add_figure(self, name: str, caption: str, data: Any = None) -> str:
+        """Record figure ``name`` (already saved at :meth:`figure_path`) with its data."""
+        rel = self.figure_path(name).relative_to(self.out).as_posix()
+        nc = self.dataset(data, name) if data is not None else None
+        self.result.figures.append(FigureRef(rel, caption, nc))
+        return rel
+
+    def dataset(self, ds: Any, name: str) -> str:
+        """Write an xarray Dataset to ``data/<section>/<name>.nc``; return its relative path."""
+        from ..io import write_netcdf
+
+        rel = f"{DATA_DIR}/{self.section.key}/{name}.nc"
+        write_netcdf(ds, self.out / rel)
+        self.result.datasets.append(rel)
+        return rel
+
+    def table(self, title: str, columns: list[str], rows: list[list[Any]], note: str = "") -> None:
+        self.result.tables.append(TableData(title, list(columns), [list(r) for r in rows], note))
+
+    def paragraph(self, text: str) -> None:
+        self.result.paragraphs.append(text)
+
+    def note(self, text: str) -> None:
+        self.result.notes.append(text)
+
+    def number(self, key: str, value: Any) -> None:
+        """A named number for the discussion (plain JSON values: float, int, str, lists, dicts)."""
+        self.result.numbers[key] = _plain(value)
+
+
+def _plain(x: Any) -> Any:
+    """Convert NumPy scalars/arrays inside ``x`` to JSON values (NaN/inf kept as floats)."""
+    import numpy as np
+
+    if isinstance(x, dict):
+        return {str(k): _plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_plain(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return _plain(x.tolist())
+    if isinstance(x, np.generic):
+        return x.item()
+    return x
+
+
+@dataclass(frozen=True)
+class Section:
+    """One section of the report.
+
+    Parameters
+    ----------
+    key, title : str
+        Identifier (folder and HTML id) and heading.
+    run : callable
+        ``run(ctx: SectionContext) -> None``; records its outputs in ``ctx``.
+    inputs : callable
+        ``inputs(settings) -> dict`` of every setting and model option the section uses (cache key).
+    order : int
+        Position on the page.
+    data_files : tuple of str
+        Optional DEM files it reads (their content enters the cache key).
+    modules : tuple of str
+        Modules whose source code enters the cache key besides the one defining ``run``.
+    available : callable
+        ``available() -> str | None``: None if the section can run, else the reason it cannot.
+    discuss : callable
+        ``discuss(numbers) -> list of str``: sentences for the discussion, from the section's
+        numbers (run at page time, so cached results are discussed too).
+    """
+
+    key: str
+    title: str
+    run: Callable[[SectionContext], None]
+    inputs: Callable[[ReportSettings], dict[str, Any]]
+    order: int
+    data_files: tuple[str, ...] = ()
+    modules: tuple[str, ...] = ()
+    available: Callable[[], str | None] = lambda: None
+    discuss: Callable[[dict[str, Any]], list[str]] = lambda numbers: []
+
+
+_SECTIONS: dict[str, Section] = {}
+
+
+def register_section(section: Section) -> Section:
+    """Add (or replace) a section of the report."""
+    _SECTIONS[section.key] = section
+    return section
+
+
+def sections() -> list[Section]:
+    """Registered sections in page order."""
+    return sorted(_SECTIONS.values(), key=lambda s: s.order)
+
+
+def model_inputs(names: tuple[str, ...] | list[str]) -> dict[str, Any]:
+    """Model names with their full metadata (parts, options, references), for a section's inputs."""
+    from ..closures.models import get_model
+
+    return {n: get_model(n).metadata() for n in names}
+
+
+# -- cache ------------------------------------------------------------------------------
+#: Packages/modules every section depends on (their source enters every cache key).
+CORE_CODE = ("ktgf.closures", "ktgf.hcs", "ktgf.io", "ktgf.plotting")
+
+
+def _package_hash(name: str) -> str:
+    """Hash of a module's source, or of every .py file of a package."""
+    try:
+        mod = importlib.import_module(name)
+    except ModuleNotFoundError:
+        return "absent"
+    if getattr(mod, "__file__", None) is None:  # no source available (frozen install): the version decides
+        return __version__
+    base = Path(mod.__file__).parent
+    files = sorted(base.rglob("*.py")) if hasattr(mod, "__path__") else [Path(mod.__file__)]
+    h = hashlib.sha256()
+    for f in files:
+        h.update(f.relative_to(base).as_posix().encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _file_hash(path: Path | None) -> str:
+    if path is None or not path.is_file():
+        return "absent"
+    return hashlib.sha256(path.read_bytes()).hexdigest()[:16]
+
+
+def cache_record(section: Section, settings: ReportSettings, data_dir: Path | None) -> dict[str, Any]:
+    """Everything a section's result depends on (hashed into its cache key)."""
+    mods = (section.run.__module__, *section.modules)
+    return {
+        "format": CACHE_FORMAT,
+        "section": section.key,
+        "ktgf_version": __version__,
+        "inputs": _plain(json.loads(json.dumps(section.inputs(settings), default=str))),
+        "code": {**{m: _package_hash(m) for m in CORE_CODE}, **{m: _package_hash(m) for m in mods}},
+        "data": {f: _file_hash(data_dir / f if data_dir else None) for f in section.data_files},
+    }
+
+
+def record_hash(record: dict[str, Any]) -> str:
+    return hashlib.sha256(json.dumps(record, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def load_cached(out: Path, key: str, digest: str) -> SectionResult | None:
+    """The cached result of section ``key`` if its hash matches and all its files still exist."""
+    path = out / CACHE_DIR / f"{key}.json"
+    try:
+        entry = json.loads(path.read_text(encoding="utf-8"))
+        if entry.get("hash") != digest:
+            return None
+        result = SectionResult.from_json(entry["result"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if not all((out / f).is_file() for f in result.files()):
+        return None
+    result.status = "cached"
+    return result
+
+
+def store_cached(out: Path, result: SectionResult, digest: str, record: dict[str, Any]) -> None:
+    entry = {"hash": digest, "record": record, "result": result.to_json()}
+    _atomic_write(out / CACHE_DIR / f"{result.key}.json", json.dumps(entry, indent=1, default=str))
+
+
+def log_event(out: Path, key: str, status: str, digest: str = "") -> None:
+    """Append one line to ``.cache/log.jsonl`` (how tests and users see what was recomputed)."""
+    with open(out / CACHE_DIR / "log.jsonl", "a", encoding="utf-8") as fh:
+        fh.write(json.dumps({"section": key, "status": status, "hash": digest[:16]}) + "\n")
+
+
+def clear_section_outputs(out: Path, key: str) -> None:
+    for sub in (FIGURE_DIR, DATA_DIR):
+        shutil.rmtree(out / sub / key, ignore_errors=True)
+
+
+def prepare_out_dir(out: Path) -> Path:
+    """Create the output folder and check it is writable; InputError (one line) otherwise."""
+    out = Path(out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        (out / CACHE_DIR).mkdir(exist_ok=True)
+        probe = out / CACHE_DIR / ".write-test"
+        probe.write_text("ok")
+        probe.unlink()
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        raise InputError(f"cannot write the report to {str(out)!r}: {reason} (choose another folder with --out)") from None
+    return out

@@ -1,0 +1,144 @@
+"""Inputs of the reproduction report: one validated, frozen settings object per run.
+
+``ReportSettings.preset(quick=...)`` gives the two standard runs: the full report and the
+``--quick`` one (coarser grids, fewer points; what CI runs, < 5 min on 2 cores).  Every
+field ends up in the page's "rerun" table and, through each section's ``inputs``, in the
+cache key of the sections that use it.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from ..closures.models import PAPER_MODELS, get_model
+from ..errors import InputError
+
+#: Environment variable naming the DEM reference-data folder (overridden by ``--data``).
+DATA_ENV = "KTGF_DATA"
+
+Restitution = Field(gt=0.0, le=1.0)
+
+
+class ReportSettings(BaseModel):
+    """Every input of one report run.
+
+    Units for the Couette and 3D cases follow the DEM data: d = 1, m = 1 (ρ_s = 6/π).
+    """
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    out: Path = Field(Path("ktgf-report"), description="Output folder of the report")
+    quick: bool = Field(False, description="Coarse grids and fewer points (CI run)")
+    data_dir: Path | None = Field(None, description=f"DEM reference data folder (default: ${DATA_ENV} or ../shared/data)")
+    models: tuple[str, ...] = Field(PAPER_MODELS, min_length=1, description="Models compared (registry names)")
+
+    # (1) transport coefficients
+    coefficient_e: tuple[float, ...] = Field((0.9, 0.7), min_length=1, description="Restitution values of the coefficient figures")
+    coefficient_points: int = Field(300, ge=10, le=20000, description="Points in φ per curve")
+    coefficient_phi_max: float = Field(0.6, gt=0.0, lt=1.0, description="Largest φ plotted")
+
+    # (2) homogeneous cooling state
+    stability_e: tuple[float, ...] = Field((0.5, 0.7, 0.8, 0.9, 0.95), min_length=1, description="Restitution values of the stability map")
+    stability_points: int = Field(300, ge=10, le=20000, description="Points in φ of the stability map")
+    stability_phi: tuple[float, float] = Field((0.02, 0.6), description="φ range of the stability map")
+    dispersion_phi: float = Field(0.3, gt=0.0, lt=0.64, description="Solid fraction of the dispersion-relation state")
+    dispersion_e: float = Field(0.9, gt=0.0, le=1.0, description="Restitution of the dispersion-relation state")
+    dispersion_points: int = Field(400, ge=20, le=100000, description="Wavenumbers of the dispersion relations")
+    haff_states: tuple[tuple[float, float], ...] = Field(
+        ((0.1, 0.9), (0.4, 0.7)), min_length=1, description="(φ, e) states of the Haff's-law figure"
+    )
+
+    # (3) Couette cell (the DEM case of dem_couette_e0.9_phi0.50.csv)
+    couette_phi_mean: float = Field(0.5, gt=0.0, lt=0.64, description="Mean solid fraction of the Couette cell")
+    couette_e: float = Field(0.9, gt=0.0, le=1.0, description="Restitution (particle-particle and particle-wall)")
+    couette_height: float = Field(20.0, gt=0.0, description="Wall-to-wall distance H [d]")
+    couette_wall_speed: float = Field(10.0, gt=0.0, description="Relative wall speed U [√(m/…) units of the DEM]")
+    couette_cells: int = Field(200, ge=8, le=100000, description="Grid cells across the Couette gap")
+
+    # (4) 3D homogeneous cooling gas
+    cooling_models: tuple[str, ...] = Field(("ret", "proposed"), min_length=1, description="Models run in 3D")
+    cooling_phi: float = Field(0.1, gt=0.0, lt=0.64, description="Solid fraction of the 3D cooling runs")
+    cooling_e: float = Field(0.7, gt=0.0, le=1.0, description="Restitution of the 3D cooling runs")
+    cooling_below: float = Field(0.7, gt=0.0, lt=1.0, description="Side of the small box as a fraction of L⊥ (stays homogeneous)")
+    cooling_above: float = Field(1.4, gt=1.0, le=10.0, description="Side of the large box as a multiple of L∥ (vortices and clusters)")
+    cooling_cells: int = Field(64, ge=8, le=1024, description="Grid cells per side of the 3D box")
+    cooling_t_end: float = Field(400.0, gt=0.0, description="End time in units of the initial collision time 1/ν0(θ0)")
+    cooling_seed: int = Field(0, ge=0, description="Seed of the initial velocity perturbation")
+
+    @field_validator("models", "cooling_models")
+    @classmethod
+    def _known_models(cls, names: tuple[str, ...]) -> tuple[str, ...]:
+        return tuple(get_model(n).name for n in names)  # raises UnknownModelError with the valid names
+
+    @field_validator("coefficient_e", "stability_e")
+    @classmethod
+    def _restitution(cls, values: tuple[float, ...]) -> tuple[float, ...]:
+        for v in values:
+            if not 0.0 < v <= 1.0:
+                raise ValueError(f"restitution {v:g} is outside (0, 1]")
+        return values
+
+    @classmethod
+    def preset(cls, *, quick: bool = False, **overrides: Any) -> ReportSettings:
+        """The full report, or with ``quick=True`` the coarse one; ``overrides`` replace single fields.
+
+        Raises :class:`~ktgf.errors.InputError` naming the field and its valid range.
+        """
+        values: dict[str, Any] = {"quick": quick}
+        if quick:
+            values.update(
+                coefficient_e=(0.9,), coefficient_points=80, stability_e=(0.7, 0.9), stability_points=60,
+                dispersion_points=120, couette_cells=40, cooling_cells=16, cooling_t_end=150.0,
+            )
+        values.update({k: v for k, v in overrides.items() if v is not None})
+        try:
+            return cls(**values)
+        except ValidationError as exc:
+            err = exc.errors()[0]
+            field = ".".join(str(p) for p in err["loc"])
+            desc = cls.model_fields[str(err["loc"][0])].description if err["loc"] else ""
+            raise InputError(
+                f"report setting {field} = {err.get('input')!r}: {err['msg']}" + (f" ({desc})" if desc else "")
+            ) from None
+
+    def rerun_options(self) -> str:
+        """The CLI options that reproduce this run."""
+        opts = ["--quick"] if self.quick else []
+        opts.append(f"--out {self.out}")
+        if self.data_dir is not None:
+            opts.append(f"--data {self.data_dir}")
+        return " ".join(["ktgf reproduce", *opts])
+
+
+def default_data_dirs() -> list[Path]:
+    """Where the DEM data is looked for by default: ``../shared/data`` beside the source tree and the cwd."""
+    repo = Path(__file__).resolve().parents[3]
+    return [repo.parent / "shared" / "data", Path.cwd().parent / "shared" / "data"]
+
+
+def locate_data_dir(explicit: Path | None) -> tuple[Path | None, str]:
+    """The DEM data folder to use, and a sentence saying where it came from (or why there is none).
+
+    Order: the explicit option, ``$KTGF_DATA``, then :func:`default_data_dirs`.  A folder named
+    explicitly (option or variable) that does not exist is reported, not an error: the data are optional.
+    """
+    if explicit is not None:
+        src, path = "--data", Path(explicit)
+    elif os.environ.get(DATA_ENV):
+        src, path = f"${DATA_ENV}", Path(os.environ[DATA_ENV])
+    else:
+        for cand in default_data_dirs():
+            if cand.is_dir():
+                return cand.resolve(), f"DEM reference data from {cand.resolve()} (found beside the source tree)"
+        return None, (
+            "DEM reference data folder not found (looked in "
+            + ", ".join(str(p) for p in default_data_dirs())
+            + f"; set --data or ${DATA_ENV}): comparisons with particle simulations are left out"
+        )
+    if path.is_dir():
+        return path.resolve(), f"DEM reference data from {path.resolve()} (given by {src})"
+    return None, f"DEM reference data folder {path} (given by {src}) does not exist: comparisons with particle simulations are left out"
