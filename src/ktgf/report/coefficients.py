@@ -17,7 +17,7 @@ import xarray as xr
 from ..closures.models import get_model
 from ..io import run_metadata
 from .dem import HCS_COOLING, UNIFORM_SHEAR, read_table
-from .framework import Section, SectionContext, model_inputs, register_section
+from .framework import Section, SectionContext, closest, join_labels, model_inputs, register_section
 from .settings import ReportSettings
 
 FIELDS = ("p", "eta", "lambda_b", "kappa", "mu", "zeta0", "zeta_u")
@@ -141,23 +141,25 @@ def discuss(nb: dict[str, Any]) -> list[str]:
         )
     pe = nb.get("pstar_mean_abs_error")
     if pe:
-        best = min(pe, key=pe.get)
+        best = closest(pe)
         pd = nb.get("pstar_dense_mean_abs_error", {})
+        verdict = (f"{join_labels(best)} is closest" if len(best) < len(pe) else
+                   "all models give the same p* at these states (φ ≤ 0.4, where their χ coincide), so these data cannot rank them")
         out.append(
             "Against the DEM equation of state measured in homogeneous cooling, the mean |error| of p* is "
             + ", ".join(f"{labels.get(n, get_model(n).label)} {100 * v:.1f} %" for n, v in pe.items())
-            + f"; {get_model(best).label} is closest"
+            + f"; {verdict}"
             + (f" (for φ ≥ 0.3: " + ", ".join(f"{get_model(n).label} {100 * v:.1f} %" for n, v in pd.items()) + ")." if pd else ".")
         )
     es = nb.get("eta_shear_error")
     if es:
         phis = sorted(next(iter(es.values())))
         for p in phis:
-            best = min(es, key=lambda n: abs(es[n][p]))
+            best = join_labels(closest({n: abs(es[n][p]) for n in es}))
             out.append(
                 f"Uniform-shear DEM at φ = {p}: η* errors "
                 + ", ".join(f"{get_model(n).label} {100 * es[n][p]:+.0f} %" for n in es)
-                + f"; closest: {get_model(best).label} (indicative only: a* ≈ 0.2–0.3 is beyond Navier–Stokes order)."
+                + f"; closest: {best} (indicative only: a* ≈ 0.2–0.3 is beyond Navier–Stokes order)."
             )
     return out
 

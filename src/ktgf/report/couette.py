@@ -35,7 +35,7 @@ import xarray as xr
 from ..closures.models import get_model
 from ..io import run_metadata
 from .dem import COUETTE, read_table
-from .framework import Section, SectionContext, model_inputs, register_section
+from .framework import Section, SectionContext, closest, join_labels, model_inputs, register_section
 from .settings import ReportSettings
 
 #: module, function: the agreed entry point of the Couette solver.
@@ -168,8 +168,8 @@ def discuss(nb: dict[str, Any]) -> list[str]:
         return []
     out = []
     for key, name in (("u_rms_over_U", "velocity"), ("phi_rms", "solid fraction"), ("theta_rms_rel", "temperature")):
-        best = min(errs, key=lambda n: errs[n][key])
-        out.append(f"Couette {name}: closest to the DEM is {get_model(best).label} ("
+        best = closest({n: errs[n][key] for n in errs})
+        out.append(f"Couette {name}: closest to the DEM: {join_labels(best)} ("
                    + ", ".join(f"{get_model(n).label} {errs[n][key]:.3g}" for n in errs) + f"; metric {key}).")
     return out
 

@@ -57,6 +57,7 @@ class TableData:
     columns: list[str]
     rows: list[list[Any]]
     note: str = ""
+    figure: str | None = None  # file of the figure it is shown beside (None: end of the section)
 
 
 @dataclass
@@ -143,8 +144,10 @@ class SectionContext:
         self.result.datasets.append(rel)
         return rel
 
-    def table(self, title: str, columns: list[str], rows: list[list[Any]], note: str = "") -> None:
-        self.result.tables.append(TableData(title, list(columns), [list(r) for r in rows], note))
+    def table(self, title: str, columns: list[str], rows: list[list[Any]], note: str = "", *, with_figure: bool = True) -> None:
+        """Add a table, shown right after the last figure added (``with_figure=False``: at the section's end)."""
+        fig = self.result.figures[-1].file if with_figure and self.result.figures else None
+        self.result.tables.append(TableData(title, list(columns), [list(r) for r in rows], note, fig))
 
     def paragraph(self, text: str) -> None:
         self.result.paragraphs.append(text)
@@ -231,7 +234,7 @@ def model_inputs(names: tuple[str, ...] | list[str]) -> dict[str, Any]:
 
 # -- cache ------------------------------------------------------------------------------
 #: Packages/modules every section depends on (their source enters every cache key).
-CORE_CODE = ("ktgf.closures", "ktgf.hcs", "ktgf.io", "ktgf.plotting")
+CORE_CODE = ("ktgf.closures", "ktgf.hcs", "ktgf.io", "ktgf.plotting", "ktgf.report.framework")
 
 
 def _package_hash(name: str) -> str:
@@ -331,3 +334,17 @@ def prepare_out_dir(out: Path) -> Path:
         reason = exc.strerror or str(exc)
         raise InputError(f"cannot write the report to {str(out)!r}: {reason} (choose another folder with --out)") from None
     return out
+
+
+def closest(values: dict[str, float], tol: float = 1e-4) -> list[str]:
+    """Names whose value (an error magnitude) is within ``tol`` of the smallest: ties are reported as ties."""
+    best = min(values.values())
+    return [n for n, v in values.items() if v <= best + tol]
+
+
+def join_labels(names: list[str]) -> str:
+    """'Enskog', 'Enskog and RET', 'Enskog, RET and Proposed' from registry names."""
+    from ..closures.models import get_model
+
+    labels = [get_model(n).label or n for n in names]
+    return labels[0] if len(labels) == 1 else ", ".join(labels[:-1]) + " and " + labels[-1]

@@ -26,7 +26,7 @@ from ..hcs.stability import (
 )
 from ..io import run_metadata
 from .dem import HCS_COOLING, read_table
-from .framework import Section, SectionContext, model_inputs, register_section
+from .framework import Section, SectionContext, closest, join_labels, model_inputs, register_section
 from .hcs_plots import plot_cooling_errors, plot_dispersion, plot_haff, plot_stability_map
 from .settings import ReportSettings
 
@@ -221,9 +221,9 @@ def run(ctx: SectionContext) -> None:
         ctx.table(f"Cooling-rate error against DEM ({HCS_COOLING}), {cmp.sizes['state']} states",
                   ["model", "mean |err| % (T0→T0/2)", "max |err| % (T0→T0/2)", "mean |err| % (T0→T0/4)", "max |err| % (T0→T0/4)"],
                   rows, note="Error = A_model/A_DEM − 1. Nothing was fitted to these data. DEM uncertainty ±0.5–1 %.")
-        best = [names[int(np.argmin(np.abs(cmp.error_early.values[:, j])))] for j in range(cmp.sizes["state"])]
+        best = [closest({n: abs(float(cmp.error_early[i, j])) for i, n in enumerate(names)}) for j in range(cmp.sizes["state"])]
         state_rows = [[f"φ={float(cmp.phi[j]):g}, e={float(cmp.e[j]):g}", *(100 * float(cmp.error_early[i, j]) for i in range(len(names))),
-                       get_model(best[j]).label] for j in range(cmp.sizes["state"])]
+                       join_labels(best[j])] for j in range(cmp.sizes["state"])]
         ctx.table("Cooling-rate error per state (T0 → T0/2), %", ["state", *labels, "closest"], state_rows)
         ctx.number("cooling_mean_abs_error", {n: float(np.mean(np.abs(cmp.error_early.values[i]))) for i, n in enumerate(names)})
         ctx.number("cooling_best", {f"{float(cmp.phi[j]):g},{float(cmp.e[j]):g}": best[j] for j in range(len(best))})
@@ -301,16 +301,16 @@ def discuss(nb: dict[str, Any]) -> list[str]:
                    f"to {nb['eigen_vs_closed_form_max_rel']:.1e} (relative) for every model.")
     ce = nb.get("cooling_mean_abs_error")
     if ce:
-        best = min(ce, key=ce.get)
+        best = closest(ce)
         signed = nb.get("cooling_signed_mean", {})
         wins: dict[str, list[str]] = {}
-        for state, m in nb.get("cooling_best", {}).items():
-            wins.setdefault(m, []).append(state)
+        for state, ms in nb.get("cooling_best", {}).items():
+            wins.setdefault(join_labels(ms), []).append(state)
         out.append(
             "Cooling rate against DEM (early window): mean |error| "
             + ", ".join(f"{get_model(n).label} {100 * v:.1f} %" for n, v in ce.items())
-            + f". {get_model(best).label} is closest overall; per state the closest is "
-            + "; ".join(f"{get_model(m).label} at (φ, e) = " + ", ".join(f"({s})" for s in st) for m, st in wins.items())
+            + f". {join_labels(best)} {'is' if len(best) == 1 else 'are'} closest overall; per state the closest is "
+            + "; ".join(f"{who} at (φ, e) = " + ", ".join(f"({s})" for s in st) for who, st in wins.items())
             + ". "
             + ("All models cool faster than the DEM on average (" + ", ".join(f"{get_model(n).label} {100 * v:+.1f} %" for n, v in signed.items())
                + "), as the data's README expects from velocity correlations that Enskog-type theories neglect." if signed and all(v > 0 for v in signed.values()) else "")

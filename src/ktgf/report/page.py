@@ -41,7 +41,7 @@ td.l,th.l{text-align:left} caption{font-weight:600;text-align:left;padding:.3em 
 .fail{background:#fde8e8;border-left:4px solid #c33;padding:.5em .8em;margin:.6em 0}
 .status{color:#777;font-size:.85em} code,pre{background:#f6f6f6;padding:.1em .3em;border-radius:3px}
 pre{padding:.6em;overflow-x:auto}
-nav ol{columns:2}
+nav ul{columns:2;list-style:none;padding-left:1em}
 """
 
 
@@ -85,13 +85,15 @@ def _section(r: SectionResult) -> str:
         parts.append(f'<p class="status">Results {when}.</p>')
     parts += [f'<p class="note">{html.escape(n)}</p>' for n in r.notes]
     parts += [f"<p>{html.escape(p)}</p>" for p in r.paragraphs]
+    figs = {f.file for f in r.figures}
     for f in r.figures:
         data = f' <a href="{html.escape(f.data)}">data (netCDF)</a>' if f.data else ""
         parts.append(
             f'<figure><img src="{html.escape(f.file)}" alt="{html.escape(f.caption)}" loading="lazy">'
             f"<figcaption>{html.escape(f.caption)}{data}</figcaption></figure>"
         )
-    parts += [_table(t) for t in r.tables]
+        parts += [_table(t) for t in r.tables if t.figure == f.file]
+    parts += [_table(t) for t in r.tables if t.figure not in figs]
     extra = [d for d in r.datasets if d not in {f.data for f in r.figures}]
     if extra:
         links = ", ".join(f'<a href="{html.escape(d)}">{html.escape(Path(d).name)}</a>' for d in extra)
@@ -102,7 +104,7 @@ def _section(r: SectionResult) -> str:
 
 def _discussion(results: list[SectionResult]) -> str:
     by_key = {s.key: s for s in sections()}
-    parts = [f'<section id="{section_id("discussion")}"><h2>Discussion</h2>',
+    parts = [f'<section id="{section_id("discussion")}"><h2>5. Discussion</h2>',
              "<p class=\"status\">Generated from the numbers of the sections above.</p>"]
     for r in results:
         sec = by_key.get(r.key)
@@ -131,7 +133,7 @@ def _rerun(results: list[SectionResult], settings: ReportSettings, data_dir: Pat
     from ..closures.models import get_model
 
     command = " ".join(argv) if argv else settings.rerun_options()
-    parts = [f'<section id="{section_id("rerun")}"><h2>How to rerun</h2>',
+    parts = [f'<section id="{section_id("rerun")}"><h2>6. How to rerun</h2>',
              f"<p>Command: <code>{html.escape(command)}</code> (a rerun reuses cached sections whose inputs are unchanged; "
              "delete the <code>.cache</code> folder to recompute everything).</p>"]
     versions = [["ktgf", __version__], ["python", platform.python_version()], ["platform", platform.platform()]]
@@ -170,7 +172,7 @@ def write_page(out: Path, results: list[SectionResult], settings: ReportSettings
     now = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
     kind = "quick (coarse) run" if settings.quick else "full run"
     toc = "".join(f'<li><a href="#{section_id(r.key)}">{html.escape(r.title)}</a></li>' for r in results)
-    toc += f'<li><a href="#{section_id("discussion")}">Discussion</a></li><li><a href="#{section_id("rerun")}">How to rerun</a></li>'
+    toc += f'<li><a href="#{section_id("discussion")}">5. Discussion</a></li><li><a href="#{section_id("rerun")}">6. How to rerun</a></li>'
     body = "\n".join(_section(r) for r in results)
     doc = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
@@ -182,7 +184,8 @@ def write_page(out: Path, results: list[SectionResult], settings: ReportSettings
 Enskog theory of Garzó &amp; Dufty (1999, "RET"), Lun's theory with a viscosity that diverges faster at random
 close packing ("Visc.div.", Bocquet et al. 2001) and RET with a radial distribution function derived from that
 viscosity divergence ("Proposed"). Each figure links the netCDF file with the numbers behind it.</p>
-<nav><ol>{toc}</ol></nav>
+{"" if data_dir is not None else f'<p class="note">{html.escape(data_note)}.</p>'}
+<nav><ul>{toc}</ul></nav>
 {body}
 {_discussion(results)}
 {_rerun(results, settings, data_dir, data_note, argv)}

@@ -115,9 +115,13 @@ class ReportSettings(BaseModel):
 
 
 def default_data_dirs() -> list[Path]:
-    """Where the DEM data is looked for by default: ``../shared/data`` beside the source tree and the cwd."""
+    """Where the DEM data is looked for by default: ``shared/data`` beside the source tree or one of its parents.
+
+    The project keeps it at ``../shared/data`` relative to the repository; a git worktree one
+    level deeper (``wt/<topic>``) finds it one level further up.
+    """
     repo = Path(__file__).resolve().parents[3]
-    return [repo.parent / "shared" / "data", Path.cwd().parent / "shared" / "data"]
+    return [p / "shared" / "data" for p in list(repo.parents)[:2]]
 
 
 def locate_data_dir(explicit: Path | None) -> tuple[Path | None, str]:
