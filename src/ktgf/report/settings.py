@@ -15,7 +15,7 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from ..closures.models import PAPER_MODELS, get_model
-from ..errors import InputError
+from ..errors import InputError, UnknownModelError
 
 #: Environment variable naming the DEM reference-data folder (overridden by ``--data``).
 DATA_ENV = "KTGF_DATA"
@@ -72,7 +72,10 @@ class ReportSettings(BaseModel):
     @field_validator("models", "cooling_models")
     @classmethod
     def _known_models(cls, names: tuple[str, ...]) -> tuple[str, ...]:
-        return tuple(get_model(n).name for n in names)  # raises UnknownModelError with the valid names
+        try:
+            return tuple(get_model(n).name for n in names)
+        except UnknownModelError as exc:  # a KeyError, which pydantic would not attribute to the field
+            raise ValueError(str(exc)) from None
 
     @field_validator("coefficient_e", "stability_e")
     @classmethod
