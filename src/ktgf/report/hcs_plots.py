@@ -86,18 +86,26 @@ def plot_dispersion(ds: xr.Dataset, out: Any) -> Any:
 
 
 def plot_stability_map(ds: xr.Dataset, out: Any) -> Any:
-    """Critical box sides L⊥/d (vortices) and L∥/d (clusters) against φ: rows are the two modes, columns e."""
+    """Critical box sides against φ, one panel per e: colour = model, solid = L⊥/d (vortices), dashed = L∥/d (clusters)."""
+    from matplotlib.lines import Line2D
+
     es = ds.e.values
-    fig, axes = _fig(2, len(es), w=4.0, h=3.4)
+    ncols = min(3, len(es))
+    nrows = -(-len(es) // ncols)
+    fig, axes = _fig(nrows, ncols, w=4.4, h=3.5)
     for j, e in enumerate(es):
-        for row, (var, name) in enumerate((("L_perp", r"$L_\perp/d$ (vortices)"), ("L_par", r"$L_\parallel/d$ (clusters)"))):
-            ax = axes[row, j]
-            for i in range(ds.sizes["model"]):
-                ax.semilogy(ds.phi, ds[var][i, j], ls=LINESTYLES[i % 4], label=str(ds.label[i].values))
-            ax.set_title(f"e = {e:g}")
-            ax.set_xlabel(r"solid fraction $\phi$")
-            ax.set_ylabel(name)
-            ax.grid(True, which="both", alpha=0.3)
-    axes[0, 0].legend(fontsize=8)
+        ax = axes.flat[j]
+        for i in range(ds.sizes["model"]):
+            ax.semilogy(ds.phi, ds.L_perp[i, j], color=f"C{i}", ls="-", lw=1.4)
+            ax.semilogy(ds.phi, ds.L_par[i, j], color=f"C{i}", ls="--", lw=1.4)
+        ax.set_title(f"e = {e:g}")
+        ax.set_xlabel(r"solid fraction $\phi$")
+        ax.set_ylabel("critical side L/d")
+        ax.grid(True, which="both", alpha=0.3)
+    for ax in axes.flat[len(es):]:
+        ax.set_visible(False)
+    handles = [Line2D([], [], color=f"C{i}", label=str(ds.label[i].values)) for i in range(ds.sizes["model"])]
+    handles += [Line2D([], [], color="k", ls="-", label=r"$L_\perp$ (vortices)"), Line2D([], [], color="k", ls="--", label=r"$L_\parallel$ (clusters)")]
+    axes.flat[0].legend(handles=handles, fontsize=8)
     fig.suptitle("Critical size of a periodic cube: homogeneous below L⊥, vortices between, clusters above L∥")
     return save(fig, out)
