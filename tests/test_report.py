@@ -129,6 +129,29 @@ def test_unwritable_out_dir_is_one_clear_error(tmp_path) -> None:
         build_report(small(blocker / "report"))
 
 
+def test_foreign_index_html_is_not_overwritten(tmp_path) -> None:
+    (tmp_path / PAGE_NAME).write_text("<html>my own page</html>")
+    with pytest.raises(InputError, match="index.html that ktgf did not write"):
+        build_report(small(tmp_path))
+    assert (tmp_path / PAGE_NAME).read_text() == "<html>my own page</html>"
+
+
+def test_cli_ctrl_c_message_and_exit_code(built, tmp_path, monkeypatch) -> None:
+    from typer.testing import CliRunner
+
+    from ktgf.cli import app
+
+    out = tmp_path / "r"
+    shutil.copytree(built.out, out)
+    shutil.rmtree(out / "figures" / "hcs")  # hcs must run again, and is interrupted
+    counting(monkeypatch, "hcs", effect=KeyboardInterrupt())
+    res = CliRunner().invoke(app, ["reproduce", "--quick", "--out", str(out)])
+    text = " ".join(res.output.split())
+    assert res.exit_code == 130
+    assert "Interrupted: interrupted during section 'hcs'" in text and "Run the same command again" in text
+    assert (out / ".cache" / "coefficients.json").is_file()
+
+
 def test_missing_data_dir_gives_notes_not_failure(built, tmp_path) -> None:
     shutil.copytree(built.out, tmp_path / "r")
     rep = build_report(small(tmp_path / "r", data_dir=tmp_path / "no-such-folder"))

@@ -81,6 +81,7 @@ def build_report(settings: ReportSettings, *, progress: Progress | None = None, 
         tell(sec.key, sec.title, "start")
         reason = sec.available()
         if reason:
+            clear_section_outputs(out, sec.key)  # outputs of an earlier build with that package would be orphans
             results.append(SectionResult(sec.key, sec.title, status="unavailable", reason=reason))
             log_event(out, sec.key, "unavailable")
             tell(sec.key, sec.title, "unavailable")

@@ -323,7 +323,15 @@ def clear_section_outputs(out: Path, key: str) -> None:
 
 def prepare_out_dir(out: Path) -> Path:
     """Create the output folder and check it is writable; InputError (one line) otherwise."""
+    from .page import GENERATOR, PAGE_NAME
+
     out = Path(out)
+    page = out / PAGE_NAME
+    try:
+        if page.is_file() and f'content="{GENERATOR}"' not in page.read_text(encoding="utf-8", errors="replace")[:2000]:
+            raise InputError(f"{str(out)!r} already holds an index.html that ktgf did not write; choose another folder with --out")
+    except OSError:
+        pass  # unreadable: the write test below reports it
     try:
         out.mkdir(parents=True, exist_ok=True)
         (out / CACHE_DIR).mkdir(exist_ok=True)

@@ -23,6 +23,8 @@ from .framework import SectionResult, TableData, _atomic_write, sections
 from .settings import ReportSettings
 
 PAGE_NAME = "index.html"
+#: Marks pages written by ktgf, so that a report never overwrites someone else's index.html.
+GENERATOR = "ktgf reproduce"
 #: Sections every page has besides the registered ones (generated at page time, never cached).
 FIXED_SECTIONS = ("discussion", "rerun")
 PACKAGES = ("numpy", "scipy", "xarray", "netCDF4", "h5netcdf", "matplotlib", "jax", "pydantic", "typer")
@@ -176,6 +178,7 @@ def write_page(out: Path, results: list[SectionResult], settings: ReportSettings
     body = "\n".join(_section(r) for r in results)
     doc = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
+<meta name="generator" content="{GENERATOR}">
 <title>ktgf model comparison report</title><style>{_CSS}</style></head>
 <body>
 <h1>Continuum models of dense inelastic granular flow: model comparison</h1>
