@@ -102,8 +102,10 @@ def run(ctx: SectionContext) -> None:
     labels = ", ".join(get_model(n).label for n in s.models)
     ctx.paragraph(
         f"Reduced coefficients (model.md §1: p* = p/(ρθ), η* = η/η0, κ* = κ/κ0, μ* = φω/(θκ0), ζ0* = ζ0/ν0) of {labels}, "
-        "and the radial distribution function χ each model uses. All four coincide in the dilute limit; they part "
-        "where χ departs from Carnahan–Starling (above φ ≈ 0.49) and where the viscosity law diverges."
+        "and the radial distribution function χ each model uses. Models sharing a theory (Enskog and Visc.div.: "
+        "Lun et al. 1984; RET and Proposed: Garzó & Dufty 1999) differ only through χ and the viscosity law, which "
+        "depart from Carnahan–Starling above their freezing point φ_f; the two theories differ at every φ (Lun's has "
+        "no density-gradient heat flux, μ* = 0, and a different dependence of κ*, η*, ζ0* on e)."
     )
     for e in s.coefficient_e:
         ds = coefficient_curves(s.models, e, s.coefficient_phi_max, s.coefficient_points)
@@ -137,8 +139,13 @@ def discuss(nb: dict[str, Any]) -> list[str]:
             f"At φ = 0.5 (e = {nb['table_e']:g}) the Proposed model's shear viscosity is "
             f"{eta['proposed']['0.5'] / eta['ret']['0.5']:.2f} times RET's"
             + (f", and Visc.div.'s is {eta['visc-div']['0.5'] / eta['enskog']['0.5']:.2f} times Enskog's" if "0.5" in eta.get("visc-div", {}) and "0.5" in eta.get("enskog", {}) else "")
-            + "; at φ = 0.1 and 0.3 the models with the same theory agree, since their χ coincide below φ ≈ 0.49."
+            + "."
         )
+    pairs = [("ret", "proposed"), ("enskog", "visc-div")]
+    same = [p for p in ("0.1", "0.3") if all(a in eta and b in eta and p in eta[a] and p in eta[b]
+                                             and abs(eta[b][p] / eta[a][p] - 1) < 1e-12 for a, b in pairs)]
+    if same:
+        out.append(f"At φ = {' and '.join(same)} the models sharing a theory give identical η* (their χ and viscosity laws coincide there).")
     pe = nb.get("pstar_mean_abs_error")
     if pe:
         best = closest(pe)

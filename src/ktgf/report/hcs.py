@@ -30,7 +30,7 @@ from .framework import Section, SectionContext, closest, join_labels, model_inpu
 from .hcs_plots import plot_cooling_errors, plot_dispersion, plot_haff, plot_stability_map
 from .settings import ReportSettings
 
-#: The Proposed model's RDF equals Carnahan–Starling below this φ (its φ_f), where it must match RET.
+#: Solid fractions of the critical-size table.
 TABLE_PHI = (0.1, 0.3, 0.5)
 #: Relative difference below which two critical sizes count as the same (well under DEM/MD resolution).
 SAME = 0.01
