@@ -43,11 +43,16 @@ def reproduce(
                   TimeElapsedColumn(), console=console, transient=False) as bar:
         task = bar.add_task("sections", total=len(secs))
         started: dict[str, float] = {}
+        titles: dict[str, str] = {}
 
         def progress(key: str, title: str, event: str) -> None:
             if event == "start":
                 started[key] = time.perf_counter()
+                titles[key] = title
                 bar.update(task, description=f"{title} …")
+                return
+            if event == "step":
+                bar.update(task, description=f"{titles.get(key, key)}: {title} …")
                 return
             dt = time.perf_counter() - started.get(key, time.perf_counter())
             bar.console.print(f"  {title}: {words.get(event, event)}[/] ({dt:.1f} s)")

@@ -23,7 +23,8 @@ from .framework import (
 from .page import PAGE_NAME, write_page
 from .settings import ReportSettings, locate_data_dir
 
-#: progress(section_key, section_title, event) with event "start", "computed", "cached", "unavailable" or "failed".
+#: progress(section_key, text, event): event "start" (text = section title), "step" (text = what runs now, from
+#: SectionContext.step), then one of "computed", "cached", "unavailable" or "failed" (text = title).
 Progress = Callable[[str, str, str], None]
 
 
@@ -96,7 +97,7 @@ def build_report(settings: ReportSettings, *, progress: Progress | None = None, 
             tell(sec.key, sec.title, "cached")
             continue
         clear_section_outputs(out, sec.key)
-        ctx = SectionContext(sec, settings, out, data_dir, record["inputs"])
+        ctx = SectionContext(sec, settings, out, data_dir, record["inputs"], progress=tell)
         try:
             sec.run(ctx)
         except KeyboardInterrupt:

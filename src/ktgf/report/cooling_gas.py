@@ -114,16 +114,16 @@ def plot_slices(ds: xr.Dataset, out: Any) -> Any:
     from ..plotting import save
 
     n = ds.sizes["run"]
-    fig, axes = plt.subplots(2, n, figsize=(3.6 * n, 7), constrained_layout=True, squeeze=False)
+    fig, axes = plt.subplots(2, n, figsize=(3.4 * n, 6.4), constrained_layout=True, squeeze=False)
     for r in range(n):
         x, y = ds.x.values[r], ds.y.values[r]
         im = axes[0, r].pcolormesh(x, y, ds.phi_slice[r].T, shading="auto", cmap="viridis")
-        fig.colorbar(im, ax=axes[0, r], label=r"$\phi$")
+        fig.colorbar(im, ax=axes[0, r], label=r"$\phi$", shrink=0.8)
         speed = np.hypot(ds.ux_slice[r], ds.uy_slice[r]).T
         im = axes[1, r].pcolormesh(x, y, speed, shading="auto", cmap="magma")
         step = max(1, x.size // 16)
         axes[1, r].quiver(x[::step], y[::step], ds.ux_slice[r].T[::step, ::step], ds.uy_slice[r].T[::step, ::step], color="w")
-        fig.colorbar(im, ax=axes[1, r], label="|u| in plane")
+        fig.colorbar(im, ax=axes[1, r], label="|u| in plane", shrink=0.8)
         axes[0, r].set_title(str(ds.run.values[r]), fontsize=9)
         for ax in axes[:, r]:
             ax.set_aspect("equal")
@@ -139,6 +139,7 @@ def run(ctx: SectionContext) -> None:
     for name in s.cooling_models:
         m = get_model(name)
         for kind, side in boxes(name, s).items():
+            ctx.step(f"3D run {m.label}, L = {side:.1f} d")
             runs.append((name, kind, side, run_box(m, side, s)))
     # Runs share neither grids nor time samples: put them on the first run's time axis and pad slices.
     t = np.asarray(runs[0][3].time, dtype=float)
@@ -162,7 +163,7 @@ def run(ctx: SectionContext) -> None:
             a = np.full(nx, np.nan)
             a[: ds.sizes[k]] = np.asarray(ds[k], dtype=float)
             slices[k].append(a)
-        label = f"{get_model(name).label}, L = {side:.1f} d ({kind} critical)"
+        label = f"{get_model(name).label}, L = {side:.1f} d " + ("(< L⊥)" if kind == "below" else "(> L∥)")
         haff_dev = float(np.max(np.abs(ratio - 1.0)))
         rows.append([label, side, float(ds.phi_std[-1]), float(ds.flow_energy[-1]), 100 * haff_dev])
         numbers[f"{name}/{kind}"] = {"box": side, "phi_std_end": float(ds.phi_std[-1]), "flow_energy_end": float(ds.flow_energy[-1]),

@@ -99,13 +99,19 @@ class SectionContext:
     """What a section's ``run`` gets: its settings, the DEM data folder and places to put its outputs."""
 
     def __init__(self, section: Section, settings: ReportSettings, out: Path, data_dir: Path | None,
-                 inputs: dict[str, Any]) -> None:
+                 inputs: dict[str, Any], progress: Callable[[str, str, str], None] | None = None) -> None:
+        self._progress = progress
         self.section = section
         self.settings = settings
         self.out = out
         self.data_dir = data_dir
         self.inputs = inputs
         self.result = SectionResult(section.key, section.title, inputs=inputs)
+
+    def step(self, text: str) -> None:
+        """Report progress inside a long section (shown by ``ktgf reproduce`` next to the section's title)."""
+        if self._progress is not None:
+            self._progress(self.section.key, text, "step")
 
     # -- inputs ---------------------------------------------------------------------------
     def data_file(self, name: str) -> Path | None:

@@ -202,6 +202,7 @@ def run(ctx: SectionContext) -> None:
         "A uniform granular gas at rest cools by inelastic collisions as θ(t) = θ0/(1 + ζ0(θ0)t/2)² (Haff 1983). "
         "The models differ only through their cooling rate ζ0* (Enskog/Lun: no Sonine correction; RET: with it) and χ."
     )
+    ctx.step("Haff's law")
     ds = haff_curves(names, s.haff_states, dem)
     plot_haff(ds, ctx.figure_path("haff"))
     ctx.add_figure("haff", "Haff's law for each model (units d = m = θ0 = 1)"
@@ -229,6 +230,7 @@ def run(ctx: SectionContext) -> None:
         ctx.number("cooling_best", {f"{float(cmp.phi[j]):g},{float(cmp.e[j]):g}": best[j] for j in range(len(best))})
         ctx.number("cooling_signed_mean", {n: float(np.mean(cmp.error_early.values[i])) for i, n in enumerate(names)})
 
+    ctx.step("dispersion relations")
     disp = dispersion(names, s.dispersion_phi, s.dispersion_e, s.dispersion_points)
     plot_dispersion(disp, ctx.figure_path("dispersion"))
     ctx.add_figure("dispersion", f"Growth rates of perturbations of the HCS against k* = kℓ at φ = {s.dispersion_phi:g}, "
@@ -242,6 +244,7 @@ def run(ctx: SectionContext) -> None:
                 float(critical_box_size(s.dispersion_phi, float(disp.k_par[i])))] for i in range(len(names))],
               note="k∥* (eigenvalues): last wavenumber at which an eigenvalue of −M has a positive real part (scan + root refinement).")
 
+    ctx.step("stability map")
     smap = stability_map(names, s.stability_e, s.stability_phi, s.stability_points)
     plot_stability_map(smap, ctx.figure_path("stability_map"))
     ctx.add_figure("stability_map", "Critical sizes of a periodic cube against φ for each e and model (model.md §8, closed form). "
