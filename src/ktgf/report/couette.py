@@ -58,7 +58,9 @@ def available() -> str | None:
     """None if the Couette solver and its report entry point are importable, else why not."""
     try:
         importlib.import_module(ENTRY_POINT[0])
-    except ModuleNotFoundError:
+    except ModuleNotFoundError as exc:
+        if exc.name and not ENTRY_POINT[0].startswith(exc.name):  # the package is there, one of its imports is not
+            return f"{ENTRY_POINT[0]} is present but cannot be imported: {exc}."
         return f"the Couette solver (package {ENTRY_POINT[0]}) is not installed in this build."
     if _entry() is None:
         return (f"{ENTRY_POINT[0]} has no function {ENTRY_POINT[1]}(model, *, phi_mean, e, height, wall_speed, d, rho_s, n_cells) "
