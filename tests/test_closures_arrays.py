@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ktgf import get_model, list_models
+from ktgf import PAPER_MODELS, get_model, list_models
 from ktgf.closures import RDFS, CustomRDF, get_rdf
 
 jax = pytest.importorskip("jax")
