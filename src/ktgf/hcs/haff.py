@@ -13,7 +13,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._array import asarray
+from .._array import asarray, namespace
 from ..closures.coefficients import nu0
 from ..closures.models import Model, get_model
 from ..errors import ConvergenceError, InputError
@@ -30,8 +30,10 @@ def cooling_rate(model: Model | str, phi: Any, e: Any, theta0: Any, *, d: float)
 
 
 def cooling_time(model: Model | str, phi: Any, e: Any, theta0: Any, *, d: float) -> Any:
-    """Haff time t0 = 2/ζ0(θ0) [s]; θ halves its square root after t0."""
-    return 2.0 / cooling_rate(model, phi, e, theta0, d=d)
+    """Haff time t0 = 2/ζ0(θ0) [s]; θ halves its square root after t0 (``inf`` for an elastic gas, e = 1)."""
+    zeta = cooling_rate(model, phi, e, theta0, d=d)
+    xp = namespace(zeta)
+    return xp.where(zeta > 0, 2.0 / xp.where(zeta > 0, zeta, 1.0), xp.inf)
 
 
 def haff_temperature(t: Any, theta0: Any, t0: Any) -> Any:
@@ -107,8 +109,9 @@ def haff_history(
     """Cooling histories of several models as an xarray Dataset (dims ``model``, ``t``).
 
     Variables: ``theta_haff`` (closed form), ``theta_numeric`` (:func:`integrate_cooling`), and per
-    model ``zeta0`` [1/s] and ``t0`` [s].  The time axis runs to ``t_end`` (default: 10 × the
-    longest t0) on a uniform grid of ``n`` points; attrs from :func:`ktgf.io.run_metadata`.
+    model ``zeta0`` [1/s] and ``t0`` [s].  The time axis is t = 0 followed by ``n − 1`` points
+    spaced geometrically from 10⁻³ t_end to ``t_end`` (default: 10 × the longest t0), which suits the
+    log–log plot of the t⁻² tail; attrs from :func:`ktgf.io.run_metadata`.
     """
     import json
 
@@ -120,11 +123,12 @@ def haff_history(
     if not models:
         raise InputError("at least one model is needed")
     zeta = np.array([float(cooling_rate(m, phi, e, theta0, d=d)) for m in models])
-    t0 = 2.0 / zeta
+    t0 = np.array([float(cooling_time(m, phi, e, theta0, d=d)) for m in models])
     if t_end is None:
         t_end = 10.0 * float(np.max(t0[np.isfinite(t0)], initial=1.0))
     check_positive("end time t_end", t_end, "s")
-    t = np.linspace(0.0, t_end, n)
+    check_range("number of output times n", n, low=2)
+    t = np.concatenate([[0.0], np.geomspace(1e-3 * t_end, t_end, n - 1)])
     theta_haff = np.stack([haff_temperature(t, theta0, t0_m) for t0_m in t0])
     theta_num = np.stack([integrate_cooling(m, phi, e, theta0, t, d=d) for m in models])
     ds = xr.Dataset(
