@@ -66,16 +66,16 @@ def longitudinal_growth_rates(r: Reduced, kstar: Any) -> Any:
 def critical_wavenumbers(r: Reduced) -> tuple[Any, Any]:
     """Closed-form critical reduced wavenumbers (k⊥*, k∥*) (model.md §8).
 
-    Modes with k* below k⊥* (vortex) or k∥* (cluster) grow.  det M ∝ k*² D (k∥*² − k*²) with
-    D = κ*C − μ*p*, so the sign of D decides what the heat mode does at large k*:
+    Modes with k* below k⊥* (vortex) or k∥* (cluster) grow.  With N = 2gp* − C and
+    D = κ*C − μ*p*, det M = (5/8) k*² (D k*² − (2/5) ζ0* N): a longitudinal eigenvalue is zero
+    only at k∥*² = (2/5)ζ0* N/D.  At k* → 0 the rates are (ζ0*/2, 0⁻, −ζ0*/2), so
 
-    - D > 0 (every paper model except RET/Proposed at e ≲ 0.18): one real eigenvalue crosses
-      zero at k∥*, stable beyond;
-    - D ≤ 0 with 2gp* − C > 0: det M never vanishes for k* > 0, the heat mode stays unstable at
-      every wavenumber and k∥* is ``inf`` (every box clusters: L∥ = 0);
-    - 2gp* − C ≤ 0 (no paper model; possible for a user model): the instability cannot end
-      through a zero eigenvalue, the closed form does not apply and k∥* is NaN — use
-      :func:`ktgf.hcs.critical.critical_wavenumbers_eig`.
+    - N > 0, D > 0 (every paper model except RET/Proposed at e ≲ 0.18): one real eigenvalue
+      crosses zero at k∥*, and the modes are stable beyond;
+    - N > 0, D ≤ 0: det M never vanishes for k* > 0, the heat mode stays unstable at every
+      wavenumber (its rate tends to a positive constant) and k∥* is ``inf`` (L∥ = 0);
+    - N ≤ 0 (no paper model: N = 1 + 2φχ'/χ + 2(1 + e)φ²χ' for their p*; possible for a user
+      model): not covered here, k∥* is NaN — use :func:`ktgf.hcs.critical.critical_wavenumbers_eig`.
 
     In the elastic limit ζ0* = 0 both are 0 (every box is stable).
     """
