@@ -127,3 +127,16 @@ def test_unknown_model_is_named():
 
     with pytest.raises(UnknownModelError, match="'nope'"):
         stability_map(["nope"], PHI, E)
+
+
+def test_user_model_objects_run_on_a_process_pool():
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from ktgf.closures import Lun1984, MaAhmadi, Model
+
+    mine = Model("lun-omega-ma", Lun1984(omega="lun"), MaAhmadi())
+    local = stability_map([mine, "ret"], PHI[:10], E)
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as ex:
+        _assert_same(local, stability_map([mine, "ret"], PHI[:10], E, executor=ex))
+    assert "ma-ahmadi" in json.loads(local.attrs["models"])["lun-omega-ma"]["rdf"]

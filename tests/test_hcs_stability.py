@@ -209,3 +209,25 @@ def test_dispersion_shapes_and_box_mode():
     assert (np.diff(d.longitudinal.real, axis=-1) <= 0).all()  # sorted by decreasing real part
     # the box mode is the inverse of the critical size
     assert box_wavenumber(0.2, critical_box_size(0.2, 0.37)) == pytest.approx(0.37, rel=1e-14)
+
+
+def _user_models():
+    from ktgf.closures import Lun1984, MaAhmadi, Model, Torquato
+
+    return [
+        Model("lun-omega-ma", Lun1984(omega="lun"), MaAhmadi(), label="Lun (with omega) + Ma-Ahmadi"),
+        get_model("ret", zeta11="ghd", sonine=False),
+        Model("enskog-torquato", Lun1984(alpha=1.6), Torquato()),
+    ]
+
+
+@pytest.mark.parametrize("model", _user_models(), ids=lambda m: m.name + str(m.options()))
+def test_user_defined_models_closed_form_agrees_with_eigenvalues(model):
+    """Any model, not only the registered four: compositions with other RDFs and options."""
+    phi, e = _grid(model, n_phi=8, n_e=6, e_min=0.2)
+    r = model.reduced(phi, e)
+    k_perp, k_par = critical_wavenumbers(r)
+    assert np.isfinite(k_par).all()
+    n_perp, n_par = critical_wavenumbers_eig(r)
+    np.testing.assert_allclose(n_perp, k_perp, rtol=1e-10)
+    np.testing.assert_allclose(n_par, k_par, rtol=1e-10)
