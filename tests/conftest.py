@@ -6,8 +6,14 @@ from pathlib import Path
 
 import pytest
 
+import os
+
 ROOT = Path(__file__).resolve().parents[1]
-SHARED = ROOT.parent / "shared"
+# The shared folder sits next to the main checkout (/work/main -> /work/shared) and two levels up
+# from a helper worktree (/work/wt/<topic> -> /work/shared); KTGF_SHARED overrides both.
+_CANDIDATES = [Path(os.environ["KTGF_SHARED"])] if os.environ.get("KTGF_SHARED") else []
+_CANDIDATES += [ROOT.parent / "shared", ROOT.parent.parent / "shared"]
+SHARED = next((c for c in _CANDIDATES if c.is_dir()), _CANDIDATES[0])
 DATA = SHARED / "data"
 
 

@@ -23,15 +23,21 @@ app.add_typer(plot_app, name="plot")
 COMMAND_MODULES = ("closures", "hcs", "couette", "solver", "report")
 
 
-@app.callback()
-def _root(
-    version: bool = typer.Option(False, "--version", help="Print the version and exit.", is_eager=True),
-) -> None:
-    if version:
+def _print_version(value: bool) -> None:
+    if value:
         from .. import __version__
 
         typer.echo(f"ktgf {__version__}")
         raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(
+        False, "--version", help="Print the version and exit.", is_eager=True, callback=_print_version
+    ),
+) -> None:
+    """Continuum models of dense inelastic granular flows (kinetic theory of granular flow)."""
 
 
 for _name in COMMAND_MODULES:

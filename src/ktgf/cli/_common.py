@@ -20,6 +20,15 @@ class OutputFormat(str, Enum):
     table = "table"
     json = "json"
     csv = "csv"
+    markdown = "markdown"
+
+
+def markdown_table(rows: Sequence[dict[str, Any]]) -> str:
+    """Rows as a GitHub-flavoured Markdown table (used for the generated docs)."""
+    keys = list(rows[0])
+    lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
+    lines += ["| " + " | ".join(f"{v:.6g}" if isinstance(v, float) else str(v) for v in r.values()) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
 
 
 def handle_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
@@ -57,13 +66,16 @@ def parse_values(text: str, name: str) -> np.ndarray:
 
 
 def emit(rows: Sequence[dict[str, Any]], fmt: OutputFormat, title: str = "") -> None:
-    """Print rows (dicts with the same keys) as a rich table, JSON or CSV on stdout."""
+    """Print rows (dicts with the same keys) as a rich table, JSON, CSV or Markdown on stdout."""
     if fmt == OutputFormat.json:
         typer.echo(json.dumps(list(rows), indent=2, default=float))
         return
     if not rows:
         return
     keys = list(rows[0])
+    if fmt == OutputFormat.markdown:
+        typer.echo(markdown_table(rows), nl=False)
+        return
     if fmt == OutputFormat.csv:
         import csv
 

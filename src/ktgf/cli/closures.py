@@ -20,9 +20,9 @@ SI_NAMES = {
 }
 
 
-def models(fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv.")) -> None:
-    """List the registered closure models with their parts, references and options."""
-    rows = [
+def model_rows() -> list[dict[str, str]]:
+    """One row per registered model: parts, options and references (feeds the CLI and docs/models.md)."""
+    return [
         {
             "name": m.name,
             "label": m.label,
@@ -31,10 +31,15 @@ def models(fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help
             "viscosity": m.viscosity.label,
             "options": ", ".join(f"{k}={v}" for k, v in m.options().items()),
             "reference": m.theory.reference,
+            "description": m.description,
         }
         for m in list_models()
     ]
-    emit(rows, fmt, title="ktgf closure models")
+
+
+def models(fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown.")) -> None:
+    """List the registered closure models with their parts, references and options."""
+    emit(model_rows(), fmt, title="ktgf closure models")
 
 
 @handle_errors

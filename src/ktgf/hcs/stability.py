@@ -66,22 +66,47 @@ def longitudinal_growth_rates(r: Reduced, kstar: Any) -> Any:
 def critical_wavenumbers(r: Reduced) -> tuple[Any, Any]:
     """Closed-form critical reduced wavenumbers (k⊥*, k∥*) (model.md §8).
 
-    Modes with k* below k⊥* (vortex) or k∥* (cluster) grow.  Where the numerator
-    2gp* − C or the denominator κ*C − μ*p* is not positive, no longitudinal mode is
-    unstable at finite k* and k∥* is returned as NaN-free 0 (every box is stable to it).
+    Modes with k* below k⊥* (vortex) or k∥* (cluster) grow.  With N = 2gp* − C and
+    D = κ*C − μ*p*, det M = (5/8) k*² (D k*² − (2/5) ζ0* N): a longitudinal eigenvalue is zero
+    only at k∥*² = (2/5)ζ0* N/D.  At k* → 0 the rates are (ζ0*/2, 0⁻, −ζ0*/2), so
+
+    - N > 0, D > 0 (every paper model except RET/Proposed at e ≲ 0.18): one real eigenvalue
+      crosses zero at k∥*, and the modes are stable beyond;
+    - N > 0, D ≤ 0: det M never vanishes for k* > 0, the heat mode stays unstable at every
+      wavenumber (its rate tends to a positive constant) and k∥* is ``inf`` (L∥ = 0);
+    - N ≤ 0 (no paper model: N = 1 + 2φχ'/χ + 2(1 + e)φ²χ' for their p*; possible for a user
+      model): not covered here, k∥* is NaN — use :func:`ktgf.hcs.critical.critical_wavenumbers_eig`.
+
+    In the elastic limit ζ0* = 0 both are 0 (every box is stable).
     """
     xp = namespace(r.p)
     k_perp = xp.sqrt(r.zeta0 / r.eta)
-    k2 = 0.4 * r.zeta0 * (2.0 * r.g * r.p - r.C) / (r.kappa * r.C - r.mu * r.p)
-    k_par = xp.sqrt(xp.where(k2 > 0, k2, 0.0))
+    num = 2.0 * r.g * r.p - r.C
+    den = r.kappa * r.C - r.mu * r.p
+    safe_den = xp.where(den > 0, den, 1.0)
+    k2 = 0.4 * r.zeta0 * num / safe_den
+    k_par = xp.where(
+        num > 0,
+        xp.where(den > 0, xp.sqrt(xp.maximum(k2, 0.0)), xp.where(r.zeta0 > 0, xp.inf, 0.0)),
+        xp.nan,
+    )
     return k_perp, k_par
 
 
 def critical_box_size(phi: Any, kstar: Any) -> Any:
     """Side of the periodic cube, in particle diameters, whose lowest mode 2π/L is k*: L/d = 0.8202922/(φk*).
 
-    ``inf`` where k* = 0 (no instability at any size).
+    ``inf`` where k* = 0 (no instability at any size), 0 where k* = inf (unstable at every
+    size), NaN where k* is NaN.
     """
     xp = namespace(phi, kstar)
     safe = xp.where(kstar > 0, kstar, 1.0)
-    return xp.where(kstar > 0, BOX_CONSTANT / (phi * safe), xp.inf)
+    return xp.where(kstar > 0, BOX_CONSTANT / (phi * safe), xp.where(kstar == 0, xp.inf, xp.nan))
+
+
+def box_wavenumber(phi: Any, box: Any) -> Any:
+    """Reduced wavenumber k* = 2πℓ/L of the lowest mode of a periodic cube of side ``box`` = L/d.
+
+    The inverse of :func:`critical_box_size`: k* = 0.8202922/(φ L/d).
+    """
+    return BOX_CONSTANT / (phi * box)

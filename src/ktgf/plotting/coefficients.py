@@ -32,6 +32,10 @@ def plot_reduced_coefficients(
             ax.set_ylabel(label)
         axes.flat[5].semilogy(phi, m.chi(phi), label=m.label or m.name)
     axes.flat[5].set_ylabel(r"$\chi = g_0(\phi)$")
+    # μ* = 0 for Lun-based models by default (no ∇φ heat flux): say so rather than leave a blank.
+    zero_mu = [m.label or m.name for m in models if not np.any(np.asarray(m.reduced(0.3, e).mu))]
+    if zero_mu:
+        axes.flat[3].set_title(f"$\\mu^* = 0$: {', '.join(zero_mu)}", fontsize=9)
     for ax in axes.flat:
         ax.set_xlabel(r"solid fraction $\phi$")
         ax.grid(True, which="both", alpha=0.3)

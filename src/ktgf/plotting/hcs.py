@@ -1,0 +1,133 @@
+"""Figures of the homogeneous cooling state: cooling curves, stability maps and dispersion relations."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..closures.models import Model
+from . import save
+
+#: Same colour for a model in every figure (paper order: Enskog, RET, Visc.div., Proposed).
+MODEL_COLOURS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000")
+
+
+def _style() -> dict[str, Any]:
+    return {"font.size": 9, "axes.labelsize": 9, "legend.fontsize": 8, "xtick.labelsize": 8, "ytick.labelsize": 8}
+
+
+def plot_haff(ds: Any, out: str | Path) -> Path:
+    """θ(t)/θ0 of each model: Haff's law (line) and the integrated ODE (markers), log–log axes."""
+    import matplotlib.pyplot as plt
+
+    with plt.rc_context(_style()):
+        fig, ax = plt.subplots(figsize=(4.2, 3.2), constrained_layout=True)
+        t = ds["t"].values
+        theta0 = ds["theta_haff"].values[:, 0]
+        every = max(1, t.size // 20)
+        for i, name in enumerate(ds["model"].values):
+            c = MODEL_COLOURS[i % len(MODEL_COLOURS)]
+            label = f"{ds['model_label'].values[i]} ($t_0$ = {float(ds['t0'].values[i]):.3g} s)"
+            ax.loglog(t[1:], ds["theta_haff"].values[i, 1:] / theta0[i], color=c, label=label)
+            ax.loglog(t[1::every], ds["theta_numeric"].values[i, 1::every] / theta0[i], "o", color=c, ms=3, mfc="none")
+        ax.set_xlabel("time $t$ [s]")
+        ax.set_ylabel(r"$\theta/\theta_0$")
+        ax.plot([], [], "k-", label="Haff's law")
+        ax.plot([], [], "ko", ms=3, mfc="none", label=r"$d\theta/dt=-\zeta_0(\theta)\theta$ (numerical)")
+        ax.legend(frameon=False)
+        ax.grid(True, which="both", alpha=0.25)
+        ax.set_title(f"Homogeneous cooling, $\\phi$ = {_param(ds, 'phi')}, e = {_param(ds, 'e')}")
+        return save(fig, out)
+
+
+def _param(ds: Any, key: str) -> str:
+    import json
+
+    return f"{json.loads(ds.attrs['parameters'])[key]:g}"
+
+
+def plot_stability_map(ds: Any, e_values: Sequence[float], out: str | Path) -> Path:
+    """L⊥/d (solid) and L∥/d (dashed) against φ for every model in ``ds``, one panel per e (log y).
+
+    ``ds`` is a :func:`ktgf.hcs.stability_map` Dataset; each requested e is taken at the nearest
+    grid value (shown in the panel title).  Boxes below a curve stay homogeneous for that mode.
+    """
+    import matplotlib.pyplot as plt
+
+    e_values = list(e_values)
+    n = len(e_values)
+    with plt.rc_context(_style()):
+        fig, axes = plt.subplots(1, n, figsize=(3.4 * n, 3.0), sharey=True, constrained_layout=True, squeeze=False)
+        phi = ds["phi"].values
+        for ax, e in zip(axes[0], e_values):
+            sel = ds.sel(e=e, method="nearest")
+            for i, name in enumerate(ds["model"].values):
+                c = MODEL_COLOURS[i % len(MODEL_COLOURS)]
+                for var, ls in (("L_perp", "-"), ("L_par", "--")):
+                    y = sel[var].values[i]
+                    y = np.where(np.isfinite(y) & (y > 0), y, np.nan)  # L = 0 or inf cannot be drawn on log axes
+                    ax.semilogy(phi, y, ls, color=c, lw=1.3, label=str(ds["model_label"].values[i]) if var == "L_perp" else None)
+            ax.set_title(f"e = {float(sel['e']):.3g}")
+            ax.set_xlabel(r"solid fraction $\phi$")
+            ax.grid(True, which="both", alpha=0.25)
+        axes[0, 0].set_ylabel("critical box side $L/d$")
+        axes[0, 0].plot([], [], "k-", label=r"$L_\perp$ (vortices)")
+        axes[0, 0].plot([], [], "k--", label=r"$L_\parallel$ (clusters)")
+        axes[0, 0].legend(frameon=False)
+        return save(fig, out)
+
+
+def plot_dispersion(
+    model: Model,
+    phi: float,
+    e: float,
+    out: str | Path,
+    *,
+    k_max: float | None = None,
+    box: float | None = None,
+    n: int = 600,
+) -> Path:
+    """Growth rates s(k*) of the shear mode and the three longitudinal modes, unstable bands shaded.
+
+    The bands where s⊥ > 0 (vortices) and max Re s∥ > 0 (clusters) are shaded from the computed
+    curves; ``box`` (L/d) marks the lowest wavenumber of that periodic cube.
+    """
+    import matplotlib.pyplot as plt
+
+    from ..hcs.dispersion import dispersion_relation
+    from ..hcs.stability import box_wavenumber, critical_wavenumbers
+
+    r = model.reduced(phi, e)
+    kc = [float(k) for k in critical_wavenumbers(r) if np.isfinite(k) and k > 0]
+    if k_max is None:
+        k_max = 2.0 * max(kc) if kc else 1.0
+    k = np.linspace(0.0, k_max, n)
+    disp = dispersion_relation(r, k)
+    with plt.rc_context(_style()):
+        fig, ax = plt.subplots(figsize=(5.6, 3.3), constrained_layout=True)
+        trans = ax.get_xaxis_transform()
+        ax.fill_between(k, 0, 1, where=disp.transverse > 0, transform=trans, color="#0072B2", alpha=0.12, lw=0,
+                        label="vortex band")
+        ax.fill_between(k, 0, 1, where=disp.largest_longitudinal > 0, transform=trans, color="#D55E00", alpha=0.22,
+                        lw=0, label="cluster band")
+        ax.plot(k, disp.transverse, color="#0072B2", lw=1.5, label=r"$s_\perp$ (2 shear modes)")
+        styles = ("-", "--", ":")
+        for j in range(3):
+            ax.plot(k, disp.longitudinal[:, j].real, styles[j], color="#D55E00", lw=1.2,
+                    label=rf"Re $s_{{\parallel,{j + 1}}}$")
+        ax.axhline(0.0, color="k", lw=0.6)
+        if box is not None:
+            kb = float(box_wavenumber(phi, box))
+            ax.axvline(kb, color="0.3", lw=0.8, ls="-.", label=f"box L/d = {box:g}")
+        ax.set_xlim(0.0, k_max)
+        top = float(max(disp.transverse.max(), disp.largest_longitudinal.max()))
+        if top > 0:  # the stable branches fall like -k*²; keep the unstable band readable
+            ax.set_ylim(-2.0 * top, 1.4 * top)
+        ax.set_xlabel(r"reduced wavenumber $k^* = k\ell$")
+        ax.set_ylabel(r"growth rate $s/\nu_0$")
+        ax.set_title(f"{model.label or model.name}: $\\phi$ = {phi:g}, e = {e:g}")
+        ax.legend(frameon=False, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+        ax.grid(True, alpha=0.25)
+        return save(fig, out)

@@ -1,0 +1,116 @@
+"""The closures on NumPy and JAX arrays: broadcasting, jit, and analytic derivatives vs autodiff."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ktgf import PAPER_MODELS, get_model, list_models
+from ktgf.closures import RDFS, CustomRDF, get_rdf
+
+jax = pytest.importorskip("jax")
+jnp = jax.numpy
+
+# Sample points inside every RDF's domain, on both sides of φ_f = 0.49.
+MODEL_NAMES = [m.name for m in list_models()]  # every registered model, not only the paper's four
+PHI = np.array([0.02, 0.1, 0.25, 0.4, 0.48, 0.5, 0.55, 0.6, 0.63])
+
+
+@pytest.mark.parametrize("key", sorted(RDFS))
+def test_rdf_derivative_matches_autodiff(key):
+    rdf = get_rdf(key)
+    auto = np.array([jax.grad(rdf.chi)(float(p)) for p in PHI])
+    assert np.allclose(rdf.dchi(PHI), auto, rtol=1e-12)
+
+
+@pytest.mark.parametrize("key", sorted(RDFS))
+def test_rdf_derivative_matches_finite_difference(key):
+    rdf = get_rdf(key)
+    h = 1e-7
+    fd = (rdf.chi(PHI + h) - rdf.chi(PHI - h)) / (2 * h)
+    assert np.allclose(rdf.dchi(PHI), fd, rtol=1e-6)
+
+
+@pytest.mark.parametrize("key", sorted(RDFS))
+def test_rdf_dilute_limit_and_monotone(key):
+    rdf = get_rdf(key)
+    assert rdf.chi(0.0) == pytest.approx(1.0, abs=1e-12)
+    phi = np.linspace(0, 0.999 * rdf.phi_max, 400)
+    assert np.all(np.diff(rdf.chi(phi)) > 0)
+
+
+@pytest.mark.parametrize("name", MODEL_NAMES)
+def test_stability_derivatives_match_autodiff(name):
+    """g = ∂ln ζ0/∂ln n and C = ∂(φp*)/∂φ from each model's own ζ0 and p* (model.md §8)."""
+    m = get_model(name)
+    e = 0.8
+
+    def log_zeta0(log_phi):  # ζ0 = ν0 ζ0*, ν0 ∝ φ at fixed θ
+        phi = jnp.exp(log_phi)
+        return jnp.log(phi * m.reduced(phi, e, check=False).zeta0)
+
+    def phi_p(phi):
+        return phi * m.reduced(phi, e, check=False).p
+
+    r = m.reduced(PHI, e)
+    g = np.array([jax.grad(log_zeta0)(np.log(p)) for p in PHI])
+    c = np.array([jax.grad(phi_p)(float(p)) for p in PHI])
+    assert np.allclose(r.g, g, rtol=1e-12)
+    assert np.allclose(r.C, c, rtol=1e-12)
+
+
+@pytest.mark.parametrize("name", MODEL_NAMES)
+def test_jit_equals_numpy(name):
+    m = get_model(name)
+    phi = PHI[:, None]
+    e = np.array([0.5, 0.8, 1.0])[None, :]
+    ref = m.reduced(phi, e)
+    fn = jax.jit(lambda p, q: m.reduced(p, q, check=False))
+    got = fn(jnp.asarray(phi), jnp.asarray(e))
+    for k in ref._fields:
+        assert np.allclose(np.broadcast_to(getattr(ref, k), (PHI.size, 3)), getattr(got, k), rtol=1e-13), k
+
+
+def test_jax_concrete_arrays_are_still_checked():
+    from ktgf import InputError
+
+    with pytest.raises(InputError):
+        get_model("ret").reduced(jnp.asarray([0.2, 1.2]), 0.9)
+
+
+def test_broadcasting_over_phi_e_theta():
+    m = get_model("proposed")
+    phi = np.linspace(0.1, 0.6, 6)[:, None, None]
+    e = np.linspace(0.6, 1.0, 5)[None, :, None]
+    theta = np.array([1e-3, 1e-2])[None, None, :]
+    c = m.coefficients(phi, e, theta, d=1e-3, rho_s=1500.0)
+    for k in ("p", "eta", "kappa", "omega", "zeta0"):
+        assert np.shape(getattr(c, k)) == (6, 5, 2), k
+    # coefficients ∝ √θ and p ∝ θ (model.md §1)
+    assert np.allclose(c.eta[..., 1] / c.eta[..., 0], np.sqrt(10))
+    assert np.allclose(c.p[..., 1] / c.p[..., 0], 10)
+
+
+def test_custom_rdf_reproduces_carnahan_starling():
+    custom = CustomRDF(chi_fn=lambda p: (1 - p / 2) / (1 - p) ** 3, dchi_fn=lambda p: (2.5 - p) / (1 - p) ** 4,
+                       packing_limit=1.0, name="my-cs")
+    a = get_model("ret").replace(rdf=custom).reduced(PHI, 0.85)
+    b = get_model("ret").reduced(PHI, 0.85)
+    for k in a._fields:
+        assert np.allclose(getattr(a, k), getattr(b, k), rtol=1e-14), k
+
+
+def test_registry_has_the_paper_models_and_aliases():
+    names = [m.name for m in list_models()]
+    assert set(PAPER_MODELS) <= set(names)
+    assert get_model("Visc.Div.").name == "visc-div"
+    assert get_model("GD99") is get_model("ret")
+    assert get_model("ret", zeta11="ghd").theory.zeta11 == "ghd"
+    assert get_model("proposed", beta=2.0).rdf.beta == 2.0
+
+
+def test_every_registered_model_is_hashable_and_documented():
+    for m in list_models():
+        hash(m)
+        assert m.label and m.description and m.theory.reference
+        assert m.metadata()["model"] == m.name
