@@ -19,7 +19,8 @@ from ktgf.hcs.haff import haff_temperature
 from ktgf.report import ReportSettings, build_report, check_report, framework, locate_data_dir
 from ktgf.report import cooling_gas, couette
 from ktgf.report.dem import COUETTE, HCS_COOLING, read_table
-from ktgf.report.hcs import compare_pair, cooling_comparison, dispersion, ret_proposed_sentence, stability_map
+from ktgf.hcs import stability_map
+from ktgf.report.hcs import compare_pair, cooling_comparison, dispersion, ret_proposed_sentence
 
 
 @pytest.fixture(scope="module")
@@ -36,24 +37,37 @@ ORACLE_RET = {(0.9, 0.1): (28.499, 51.216), (0.9, 0.2): (15.485, 30.262), (0.9, 
               (0.7, 0.5): (5.741, 9.853)}
 
 
-def test_stability_map_reproduces_oracle_box_sizes() -> None:
-    ds = stability_map(("enskog", "ret"), (0.7, 0.9), (0.1, 0.5), 5)
-    for (e, phi), (lp, ll) in ORACLE_RET.items():
-        got = ds.sel(model="ret", e=e).sel(phi=phi, method="nearest")
-        assert float(got.phi) == pytest.approx(phi)
-        assert float(got.L_perp) == pytest.approx(lp, abs=1.5e-3)
-        assert float(got.L_par) == pytest.approx(ll, abs=1.5e-3)
+@pytest.fixture(scope="module")
+def quick_report(tmp_path_factory):
+    """One ``--quick`` report (Couette/3D as this build has them), copied by tests that add to it."""
+    return build_report(ReportSettings.preset(quick=True, out=tmp_path_factory.mktemp("quick") / "r"))
 
 
-def test_stability_map_masks_states_beyond_packing() -> None:
-    ds = stability_map(("visc-div",), (0.9,), (0.1, 0.7), 7)
-    assert np.isnan(ds.L_perp.sel(model="visc-div", e=0.9, phi=0.7, method="nearest"))  # φ_c = 0.64
-    assert np.isfinite(ds.L_perp.sel(model="visc-div", e=0.9, phi=0.6, method="nearest"))
+def copy_of(report, tmp_path):
+    import shutil
+
+    shutil.copytree(report.out, tmp_path / "r")
+    return tmp_path / "r"
+
+
+def test_report_stability_data_reproduce_oracle_box_sizes(quick_report) -> None:
+    """The netCDF behind the report's stability map holds the oracle critical sizes (grid step 0.01 hits them)."""
+    rep = quick_report
+    assert rep.results and ReportSettings.preset(quick=True).stability_e == (0.7, 0.9)
+    hcs = next(r for r in rep.results if r.key == "hcs")
+    nc = next(f.data for f in hcs.figures if f.file.endswith("stability_map.png"))
+    with xr.open_dataset(rep.out / nc) as ds:
+        for (e, phi), (lp, ll) in ORACLE_RET.items():
+            got = ds.sel(model="ret", e=e).sel(phi=phi, method="nearest")
+            assert float(got.phi) == pytest.approx(phi, abs=1e-12)
+            assert float(got.L_perp) == pytest.approx(lp, abs=1.5e-3)
+            assert float(got.L_par) == pytest.approx(ll, abs=1.5e-3)
 
 
 def test_eigenvalue_threshold_matches_closed_form() -> None:
     ds = dispersion(("enskog", "ret", "visc-div", "proposed"), 0.3, 0.9, 60)
     np.testing.assert_allclose(ds.k_par_eigen, ds.k_par, rtol=1e-9)
+    np.testing.assert_allclose(ds.k_perp_eigen, ds.k_perp, rtol=1e-9)
     # transverse rate at k = 0 is ζ0*/2 (model.md §8)
     for i, n in enumerate(ds.model.values):
         assert float(ds.s_perp[i, 0]) == pytest.approx(0.5 * float(get_model(str(n)).reduced(0.3, 0.9).zeta0))
@@ -67,7 +81,7 @@ def test_ret_cooling_rate_matches_the_dem_files_enskog_column(dem_dir) -> None:
 
 
 def test_ret_and_proposed_critical_sizes_agree_where_their_rdfs_do() -> None:
-    ds = stability_map(("ret", "proposed"), (0.7, 0.9), (0.02, 0.6), 59)  # φ step 0.01
+    ds = stability_map(("ret", "proposed"), np.linspace(0.02, 0.6, 59), [0.7, 0.9])  # φ step 0.01
     c = compare_pair(ds, "ret", "proposed")
     phi_f = get_model("proposed").rdf.phi_f  # χ_vd equals Carnahan–Starling below φ_f (model.md §2)
     assert c["L_perp"]["first_phi_differing"] >= phi_f - 0.011
@@ -86,7 +100,7 @@ def _enable(monkeypatch, key: str, module, fake) -> None:
     monkeypatch.setitem(framework._SECTIONS, key, dataclasses.replace(sec, available=lambda: None))
 
 
-def test_couette_section_errors_of_a_known_solution(monkeypatch, tmp_path, dem_dir) -> None:
+def test_couette_section_errors_of_a_known_solution(monkeypatch, tmp_path, dem_dir, quick_report) -> None:
     dem = read_table(dem_dir / COUETTE)
     calls = []
     shift = 0.05  # the manufactured velocity is the DEM's plus 5 % of U: RMS(u − u_DEM)/U = 0.05 exactly
@@ -97,18 +111,19 @@ def test_couette_section_errors_of_a_known_solution(monkeypatch, tmp_path, dem_d
                           coords={"y": dem["y"]}, attrs={"wall": "manufactured", "valid": 1})
 
     _enable(monkeypatch, "couette", couette, fake)
-    rep = build_report(ReportSettings.preset(quick=True, out=tmp_path / "r", models=("ret", "proposed")))
+    rep = build_report(ReportSettings.preset(quick=True, out=copy_of(quick_report, tmp_path)))
     assert rep.statuses["couette"] == "computed" and rep.problems == []
+    assert rep.statuses["hcs"] == "cached"
     assert calls[0] == dict(phi_mean=0.5, e=0.9, height=20.0, wall_speed=10.0, d=1.0, rho_s=6 / math.pi, n_cells=40)
     errs = next(r for r in rep.results if r.key == "couette").numbers["couette_errors"]
-    for n in ("ret", "proposed"):
+    for n in ("enskog", "ret", "visc-div", "proposed"):
         assert errs[n]["u_rms_over_U"] == pytest.approx(shift, rel=1e-12)
         assert errs[n]["phi_rms"] == pytest.approx(0.0, abs=1e-15)
         assert errs[n]["theta_rms_rel"] == pytest.approx(0.0, abs=1e-15)
     assert "couette_profiles.png" in (rep.out / "index.html").read_text()
 
 
-def test_cooling_gas_section_through_its_contract(monkeypatch, tmp_path) -> None:
+def test_cooling_gas_section_through_its_contract(monkeypatch, tmp_path, quick_report) -> None:
     calls = []
 
     def fake(model, *, phi, e, box, n_cells, t_end, seed, d, rho_s, theta0):
@@ -124,7 +139,7 @@ def test_cooling_gas_section_through_its_contract(monkeypatch, tmp_path) -> None
         )
 
     _enable(monkeypatch, "cooling_gas", cooling_gas, fake)
-    s = ReportSettings.preset(quick=True, out=tmp_path / "r")
+    s = ReportSettings.preset(quick=True, out=copy_of(quick_report, tmp_path))
     rep = build_report(s)
     assert rep.statuses["cooling_gas"] == "computed" and rep.problems == [], rep.problems
     assert check_report(rep.out) == []

@@ -105,11 +105,12 @@ def plot_profiles(ds: xr.Dataset, out: Any) -> Any:
     import matplotlib.pyplot as plt
 
     from ..plotting import save
+    from ..plotting.hcs import MODEL_COLOURS
 
     fig, axes = plt.subplots(1, 3, figsize=(14, 4.4), constrained_layout=True)
     for ax, var, lab in zip(axes, ("u", "phi", "theta"), ("velocity $u$", r"solid fraction $\phi$", r"temperature $\theta$")):
         for i in range(ds.sizes["model"]):
-            ax.plot(ds[var][i], ds.y, label=str(ds.label[i].values))
+            ax.plot(ds[var][i], ds.y, color=MODEL_COLOURS[i % len(MODEL_COLOURS)], label=str(ds.label[i].values))
         if f"{var}_dem" in ds:
             occupied = ds.phi_dem.values > 0.05  # bins inside the wall layers hold no flowing particles
             ax.errorbar(ds[f"{var}_dem"].values[occupied], ds.y_dem.values[occupied], xerr=ds[f"{var}_dem_sem"].values[occupied],

@@ -9,25 +9,22 @@ unstable wavenumber found from them matches the closed form.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 import xarray as xr
-from scipy.optimize import brentq
 
 from ..closures.models import get_model
-from ..hcs.haff import cooling_rate, haff_temperature
-from ..hcs.stability import (
-    critical_box_size,
-    critical_wavenumbers,
-    longitudinal_growth_rates,
-    transverse_growth_rate,
-)
+from ..hcs.critical import critical_wavenumbers_eig
+from ..hcs.dispersion import dispersion_relation
+from ..hcs.haff import cooling_rate, haff_history
+from ..hcs.stability import critical_box_size, critical_wavenumbers
+from ..hcs.stability_map import stability_map
 from ..io import run_metadata
+from ..plotting.hcs import plot_haff, plot_stability_map
 from .dem import HCS_COOLING, read_table
 from .framework import Section, SectionContext, closest, join_labels, model_inputs, register_section
-from .hcs_plots import plot_cooling_errors, plot_dispersion, plot_haff, plot_stability_map
+from .hcs_plots import plot_cooling_errors, plot_dispersion
 from .settings import ReportSettings
 
 #: Solid fractions of the critical-size table.
@@ -49,40 +46,6 @@ def _labels(names: tuple[str, ...]) -> list[str]:
 
 
 # -- Haff's law and DEM cooling rates ---------------------------------------------------------
-def _dem_row(dem: dict[str, np.ndarray] | None, phi: float, e: float) -> int | None:
-    if dem is None:
-        return None
-    hit = np.flatnonzero(np.isclose(dem["phi"], phi) & np.isclose(dem["e"], e))
-    return int(hit[0]) if hit.size else None
-
-
-def haff_curves(names: tuple[str, ...], states: tuple[tuple[float, float], ...], dem: dict[str, np.ndarray] | None,
-                n: int = 200) -> xr.Dataset:
-    """θ(t)/θ0 for each model and state (d = m = θ0 = 1), with the DEM's fitted Haff curve where available."""
-    ns = len(states)
-    time = np.empty((ns, n))
-    theta = np.empty((len(names), ns, n))
-    theta_dem = np.full((ns, n), np.nan)
-    for j, (phi, e) in enumerate(states):
-        rates = [float(cooling_rate(m, phi, e, 1.0, d=1.0)) for m in names]
-        time[j] = np.linspace(0.0, 8.0 / min(rates), n)  # down to θ/θ0 ≈ 1/25 for the slowest model
-        for i, z in enumerate(rates):
-            theta[i, j] = haff_temperature(time[j], 1.0, 2.0 / z)
-        row = _dem_row(dem, phi, e)
-        if row is not None:
-            theta_dem[j] = haff_temperature(time[j], 1.0, 2.0 / dem["A_early"][row])
-    return xr.Dataset(
-        {
-            "theta": (("model", "state", "t"), theta, {"long_name": "theta/theta0", "units": "1"}),
-            "theta_dem": (("state", "t"), theta_dem, {"long_name": "DEM Haff fit over T0 -> T0/2 (A_early)", "source": HCS_COOLING}),
-            "time": (("state", "t"), time, {"long_name": "t sqrt(theta0)/d", "units": "1"}),
-        },
-        coords={"model": list(names), "label": ("model", _labels(names)),
-                "phi": ("state", [s[0] for s in states]), "e": ("state", [s[1] for s in states])},
-        attrs=run_metadata(None, models=list(names), states=[list(s) for s in states], units="d = m = theta0 = 1"),
-    )
-
-
 def cooling_comparison(names: tuple[str, ...], dem: dict[str, np.ndarray]) -> xr.Dataset:
     """Each model's cooling rate A = ζ0/√θ at the DEM states, and its relative error against both DEM fits."""
     a = np.array([np.asarray(cooling_rate(m, dem["phi"], dem["e"], 1.0, d=1.0), dtype=float) for m in names])
@@ -100,42 +63,28 @@ def cooling_comparison(names: tuple[str, ...], dem: dict[str, np.ndarray]) -> xr
     )
 
 
-# -- dispersion relations and stability map ----------------------------------------------------
-def _last_unstable_k(model: Any, phi: float, e: float, kmax: float, n: int) -> float:
-    """Largest k* at which a longitudinal mode grows, from the eigenvalues (grid scan, then root refinement)."""
-    r = model.reduced(phi, e)
-
-    def lead(k: float) -> float:
-        return float(np.max(longitudinal_growth_rates(r, np.asarray(k)).real))
-
-    k = np.linspace(kmax / n, kmax, n)
-    s = np.max(longitudinal_growth_rates(r, k).real, axis=-1)
-    pos = np.flatnonzero(s > 0)
-    if pos.size == 0:
-        return 0.0
-    i = pos[-1]
-    if i == k.size - 1:
-        return math.inf
-    return brentq(lead, k[i], k[i + 1], xtol=1e-14, rtol=1e-12)
-
-
+# -- dispersion relations and the RET/Proposed comparison --------------------------------------
 def dispersion(names: tuple[str, ...], phi: float, e: float, n: int) -> xr.Dataset:
-    """s⊥(k*) and the three longitudinal growth rates for each model at one state, with the closed-form k⊥*, k∥*."""
+    """s⊥(k*) and the three longitudinal growth rates of each model at one state, with k⊥*, k∥*
+    from the closed form and from the eigenvalues (:func:`ktgf.hcs.critical_wavenumbers_eig`)."""
     models = [get_model(m) for m in names]
-    crit = [critical_wavenumbers(m.reduced(phi, e)) for m in models]
+    red = [m.reduced(phi, e) for m in models]
+    crit = [critical_wavenumbers(r) for r in red]
     kmax = 1.6 * max(float(max(kp, kl)) for kp, kl in crit)
     k = np.linspace(0.0, kmax, n)
-    s_perp = np.array([np.asarray(transverse_growth_rate(m.reduced(phi, e), k), dtype=float) for m in models])
-    s_par = np.array([np.asarray(longitudinal_growth_rates(m.reduced(phi, e), k)) for m in models])
-    k_scan = np.array([_last_unstable_k(m, phi, e, kmax, n) for m in models])
+    rel = [dispersion_relation(r, k) for r in red]
+    eig = [critical_wavenumbers_eig(r) for r in red]
     return xr.Dataset(
         {
-            "s_perp": (("model", "kstar"), s_perp, {"long_name": "transverse growth rate / nu0"}),
-            "s_par_real": (("model", "kstar", "branch"), s_par.real, {"long_name": "Re longitudinal growth rates / nu0"}),
-            "s_par_imag": (("model", "kstar", "branch"), s_par.imag, {"long_name": "Im longitudinal growth rates / nu0"}),
+            "s_perp": (("model", "kstar"), np.array([d.transverse for d in rel]), {"long_name": "transverse growth rate / nu0"}),
+            "s_par_real": (("model", "kstar", "branch"), np.array([d.longitudinal.real for d in rel]),
+                           {"long_name": "Re longitudinal growth rates / nu0"}),
+            "s_par_imag": (("model", "kstar", "branch"), np.array([d.longitudinal.imag for d in rel]),
+                           {"long_name": "Im longitudinal growth rates / nu0"}),
             "k_perp": (("model",), [float(c[0]) for c in crit], {"long_name": "closed-form critical k* (vortex)"}),
             "k_par": (("model",), [float(c[1]) for c in crit], {"long_name": "closed-form critical k* (cluster)"}),
-            "k_par_eigen": (("model",), k_scan, {"long_name": "last unstable k* of the eigenvalues of -M"}),
+            "k_perp_eigen": (("model",), [float(c[0]) for c in eig], {"long_name": "critical k* from the eigenvalues (vortex)"}),
+            "k_par_eigen": (("model",), [float(c[1]) for c in eig], {"long_name": "critical k* from the eigenvalues (cluster)"}),
         },
         coords={"model": list(names), "label": ("model", _labels(names)), "kstar": k, "branch": [0, 1, 2],
                 "phi": phi, "e": e},
@@ -143,32 +92,10 @@ def dispersion(names: tuple[str, ...], phi: float, e: float, n: int) -> xr.Datas
     )
 
 
-def stability_map(names: tuple[str, ...], es: tuple[float, ...], phi_range: tuple[float, float], n: int) -> xr.Dataset:
-    """L⊥/d and L∥/d on a (model, e, φ) grid; NaN where φ is at or above a model's packing limit."""
-    phi = np.linspace(phi_range[0], phi_range[1], n)
-    shape = (len(names), len(es), n)
-    out = {k: np.full(shape, np.nan) for k in ("L_perp", "L_par", "k_perp", "k_par")}
-    for i, name in enumerate(names):
-        m = get_model(name)
-        ok = phi < 0.995 * m.phi_max
-        ph, ee = np.meshgrid(phi[ok], np.asarray(es, dtype=float), indexing="xy")
-        kp, kl = critical_wavenumbers(m.reduced(ph, ee))
-        out["k_perp"][i][:, ok], out["k_par"][i][:, ok] = kp, kl
-        out["L_perp"][i][:, ok], out["L_par"][i][:, ok] = critical_box_size(ph, kp), critical_box_size(ph, kl)
-    attrs = {"L_perp": "critical side L/d of a periodic cube, vortex (shear) mode",
-             "L_par": "critical side L/d of a periodic cube, cluster (heat) mode",
-             "k_perp": "critical k* = k l, vortex mode", "k_par": "critical k* = k l, cluster mode"}
-    return xr.Dataset(
-        {k: (("model", "e", "phi"), v, {"long_name": attrs[k]}) for k, v in out.items()},
-        coords={"model": list(names), "label": ("model", _labels(names)), "e": list(es), "phi": phi},
-        attrs=run_metadata(None, models=list(names), e=list(es), phi_range=list(phi_range), points=n,
-                           equation="model.md section 8, closed form"),
-    )
-
-
 def compare_pair(ds: xr.Dataset, a: str, b: str) -> dict[str, Any]:
     """How model ``b``'s critical sizes differ from model ``a``'s over the map (for the RET/Proposed sentence)."""
     out: dict[str, Any] = {}
+    ds = ds.transpose("model", "e", "phi")
     both = np.isfinite(ds.L_perp.sel(model=a)) & np.isfinite(ds.L_perp.sel(model=b))
     phi = ds.phi.values
     for var in ("L_perp", "L_par"):
@@ -182,11 +109,11 @@ def compare_pair(ds: xr.Dataset, a: str, b: str) -> dict[str, Any]:
             "at_phi": float(phi[k[1]]), "at_e": float(ds.e.values[k[0]]), "signed": float(rel[k]),
             "first_phi_differing": min((f for f in first if f is not None), default=None),
         }
-    # "Predicts the instabilities": finite critical sizes, vortex threshold below the cluster one.
+    # "Predicts the instabilities": finite, positive critical sizes, vortex threshold below the cluster one.
     for name in (a, b):
         lp, ll = ds.L_perp.sel(model=name).values, ds.L_par.sel(model=name).values
         valid = np.isfinite(ds.k_perp.sel(model=name).values)
-        out[f"{name}_all_finite"] = bool(np.all(np.isfinite(lp[valid]) & np.isfinite(ll[valid])))
+        out[f"{name}_all_finite"] = bool(np.all(np.isfinite(lp[valid]) & np.isfinite(ll[valid]) & (lp[valid] > 0) & (ll[valid] > 0)))
         out[f"{name}_vortex_first"] = bool(np.all(lp[valid] < ll[valid]))
         out[f"{name}_phi_top"] = float(phi[valid.any(axis=0)].max())
     return out
@@ -202,11 +129,13 @@ def run(ctx: SectionContext) -> None:
         "A uniform granular gas at rest cools by inelastic collisions as θ(t) = θ0/(1 + ζ0(θ0)t/2)² (Haff 1983). "
         "The models differ only through their cooling rate ζ0* (Enskog/Lun: no Sonine correction; RET: with it) and χ."
     )
-    ctx.step("Haff's law")
-    ds = haff_curves(names, s.haff_states, dem)
-    plot_haff(ds, ctx.figure_path("haff"))
-    ctx.add_figure("haff", "Haff's law for each model (units d = m = θ0 = 1)"
-                   + (", with the DEM's fitted Haff curve (dem_hcs_cooling.csv, early window) where the state was simulated." if dem is not None else "."), ds)
+    for phi, e in s.haff_states:
+        ctx.step(f"Haff's law at φ = {phi:g}, e = {e:g}")
+        ds = haff_history(names, phi, e, 1.0, d=1.0)
+        name = f"haff_phi{phi:g}_e{e:g}"
+        plot_haff(ds, ctx.figure_path(name))
+        ctx.add_figure(name, f"Haff's law (lines) and the integrated cooling equation (markers) at φ = {phi:g}, e = {e:g}, "
+                       "in units d = 1, θ0 = 1 (time in units of d/√θ0).", ds)
 
     if dem is not None:
         cmp = cooling_comparison(names, dem)
@@ -235,18 +164,18 @@ def run(ctx: SectionContext) -> None:
     plot_dispersion(disp, ctx.figure_path("dispersion"))
     ctx.add_figure("dispersion", f"Growth rates of perturbations of the HCS against k* = kℓ at φ = {s.dispersion_phi:g}, "
                    f"e = {s.dispersion_e:g} (model.md §8): modes with positive rate grow.", disp)
-    check = np.abs(disp.k_par_eigen.values / disp.k_par.values - 1.0)
+    check = np.abs(np.concatenate([disp.k_par_eigen.values / disp.k_par.values, disp.k_perp_eigen.values / disp.k_perp.values]) - 1.0)
     ctx.number("eigen_vs_closed_form_max_rel", float(np.nanmax(check)))
     ctx.table(f"Critical wavenumbers at φ = {s.dispersion_phi:g}, e = {s.dispersion_e:g}",
-              ["model", "k⊥* (closed form)", "k∥* (closed form)", "k∥* (eigenvalues)", "L⊥/d", "L∥/d"],
-              [[str(disp.label[i].values), float(disp.k_perp[i]), float(disp.k_par[i]), float(disp.k_par_eigen[i]),
+              ["model", "k⊥* (closed form)", "k⊥* (eigenvalues)", "k∥* (closed form)", "k∥* (eigenvalues)", "L⊥/d", "L∥/d"],
+              [[str(disp.label[i].values), float(disp.k_perp[i]), float(disp.k_perp_eigen[i]), float(disp.k_par[i]), float(disp.k_par_eigen[i]),
                 float(critical_box_size(s.dispersion_phi, float(disp.k_perp[i]))),
                 float(critical_box_size(s.dispersion_phi, float(disp.k_par[i])))] for i in range(len(names))],
-              note="k∥* (eigenvalues): last wavenumber at which an eigenvalue of −M has a positive real part (scan + root refinement).")
+              note="Eigenvalues: last wavenumber at which the mode's growth rate is positive (scan + root refinement, ktgf.hcs.critical).")
 
     ctx.step("stability map")
-    smap = stability_map(names, s.stability_e, s.stability_phi, s.stability_points)
-    plot_stability_map(smap, ctx.figure_path("stability_map"))
+    smap = stability_map(names, np.linspace(*s.stability_phi, s.stability_points), np.asarray(s.stability_e))
+    plot_stability_map(smap, s.stability_e, ctx.figure_path("stability_map"))
     ctx.add_figure("stability_map", "Critical sizes of a periodic cube against φ for each e and model (model.md §8, closed form). "
                    "A cube smaller than L⊥ stays homogeneous, between L⊥ and L∥ it grows vortices, above L∥ also clusters.", smap)
     rows = []
@@ -300,7 +229,7 @@ def discuss(nb: dict[str, Any]) -> list[str]:
         out.append(f"Visc.div.'s faster viscosity divergence moves its vortex threshold L⊥ by up to {100 * d['max_rel_diff']:.0f} % "
                    f"from Enskog's (at φ = {d['at_phi']:.2f}), since L⊥ ∝ √(η*/ζ0*).")
     if "eigen_vs_closed_form_max_rel" in nb:
-        out.append(f"The closed-form cluster threshold k∥* agrees with the last unstable wavenumber of the full eigenvalue problem "
+        out.append(f"The closed-form thresholds k⊥*, k∥* agree with the last unstable wavenumbers of the full eigenvalue problem "
                    f"to {nb['eigen_vs_closed_form_max_rel']:.1e} (relative) for every model.")
     ce = nb.get("cooling_mean_abs_error")
     if ce:

@@ -1,4 +1,4 @@
-"""Figures of the report's homogeneous-cooling section, each drawn from the Dataset written beside it."""
+"""Multi-model figures of the report's HCS section (single-model HCS figures are in :mod:`ktgf.plotting.hcs`)."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import numpy as np
 import xarray as xr
 
 from ..plotting import save
+from ..plotting.hcs import MODEL_COLOURS
 
 LINESTYLES = ("-", "--", "-.", ":")
 
@@ -17,25 +18,6 @@ def _fig(nrows: int, ncols: int, w: float = 4.6, h: float = 3.6) -> tuple[Any, n
 
     fig, axes = plt.subplots(nrows, ncols, figsize=(w * ncols, h * nrows), constrained_layout=True, squeeze=False)
     return fig, axes
-
-
-def plot_haff(ds: xr.Dataset, out: Any) -> Any:
-    """θ/θ0 against t√θ0/d per state: one curve per model, the DEM fit (if present) in black."""
-    states = ds.sizes["state"]
-    fig, axes = _fig(1, states)
-    for j in range(states):
-        ax = axes[0, j]
-        for i, m in enumerate(ds.model.values):
-            ax.semilogy(ds.time[j], ds.theta[i, j], label=str(ds.label[i].values))
-        if "theta_dem" in ds and np.isfinite(ds.theta_dem[j]).any():
-            ax.semilogy(ds.time[j], ds.theta_dem[j], "k--", lw=1.5, label="DEM fit (early window)")
-        ax.set_title(f"φ = {float(ds.phi[j]):g}, e = {float(ds.e[j]):g}")
-        ax.set_xlabel(r"time $t\,\sqrt{\theta_0}/d$")
-        ax.set_ylabel(r"$\theta/\theta_0$")
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0, 0].legend()
-    fig.suptitle("Haff's law θ = θ0/(1 + ζ0(θ0)t/2)²")
-    return save(fig, out)
 
 
 def plot_cooling_errors(ds: xr.Dataset, out: Any) -> Any:
@@ -49,7 +31,8 @@ def plot_cooling_errors(ds: xr.Dataset, out: Any) -> Any:
         unc = 100 * ds.dem_rel_sem.values[sel]
         ax.fill_between(phi, -np.maximum(unc, 0.5), np.maximum(unc, 0.5), color="0.85", label="DEM ±0.5 % (or s.e.m.)")
         for i, m in enumerate(ds.model.values):
-            ax.plot(phi, 100 * ds.error_early.values[i, sel], marker="o", ls=LINESTYLES[i % 4], label=str(ds.label[i].values))
+            ax.plot(phi, 100 * ds.error_early.values[i, sel], marker="o", ls=LINESTYLES[i % 4], color=MODEL_COLOURS[i % len(MODEL_COLOURS)],
+                    label=str(ds.label[i].values))
         ax.axhline(0, color="k", lw=0.8)
         ax.set_title(f"e = {e:g}")
         ax.set_xlabel(r"solid fraction $\phi$")
@@ -64,7 +47,7 @@ def plot_dispersion(ds: xr.Dataset, out: Any) -> Any:
     """Growth rates of the transverse mode and real parts of the three longitudinal modes against k*."""
     fig, axes = _fig(1, 2, w=5.6)
     k = ds.kstar.values
-    colors = [f"C{i}" for i in range(ds.sizes["model"])]
+    colors = [MODEL_COLOURS[i % len(MODEL_COLOURS)] for i in range(ds.sizes["model"])]
     for i in range(ds.sizes["model"]):
         lab = str(ds.label[i].values)
         axes[0, 0].plot(k, ds.s_perp[i], color=colors[i], ls=LINESTYLES[i % 4], label=lab)
@@ -85,27 +68,3 @@ def plot_dispersion(ds: xr.Dataset, out: Any) -> Any:
     return save(fig, out)
 
 
-def plot_stability_map(ds: xr.Dataset, out: Any) -> Any:
-    """Critical box sides against φ, one panel per e: colour = model, solid = L⊥/d (vortices), dashed = L∥/d (clusters)."""
-    from matplotlib.lines import Line2D
-
-    es = ds.e.values
-    ncols = min(3, len(es))
-    nrows = -(-len(es) // ncols)
-    fig, axes = _fig(nrows, ncols, w=4.4, h=3.5)
-    for j, e in enumerate(es):
-        ax = axes.flat[j]
-        for i in range(ds.sizes["model"]):
-            ax.semilogy(ds.phi, ds.L_perp[i, j], color=f"C{i}", ls="-", lw=1.4)
-            ax.semilogy(ds.phi, ds.L_par[i, j], color=f"C{i}", ls="--", lw=1.4)
-        ax.set_title(f"e = {e:g}")
-        ax.set_xlabel(r"solid fraction $\phi$")
-        ax.set_ylabel("critical side L/d")
-        ax.grid(True, which="both", alpha=0.3)
-    for ax in axes.flat[len(es):]:
-        ax.set_visible(False)
-    handles = [Line2D([], [], color=f"C{i}", label=str(ds.label[i].values)) for i in range(ds.sizes["model"])]
-    handles += [Line2D([], [], color="k", ls="-", label=r"$L_\perp$ (vortices)"), Line2D([], [], color="k", ls="--", label=r"$L_\parallel$ (clusters)")]
-    axes.flat[0].legend(handles=handles, fontsize=8)
-    fig.suptitle("Critical size of a periodic cube: homogeneous below L⊥, vortices between, clusters above L∥")
-    return save(fig, out)

@@ -43,7 +43,7 @@ class ReportSettings(BaseModel):
 
     # (2) homogeneous cooling state
     stability_e: tuple[float, ...] = Field((0.5, 0.7, 0.8, 0.9, 0.95), min_length=1, description="Restitution values of the stability map")
-    stability_points: int = Field(300, ge=10, le=20000, description="Points in φ of the stability map")
+    stability_points: int = Field(291, ge=10, le=20000, description="Points in φ of the stability map (291: step 0.002)")
     stability_phi: tuple[float, float] = Field((0.02, 0.6), description="φ range of the stability map")
     dispersion_phi: float = Field(0.3, gt=0.0, lt=0.64, description="Solid fraction of the dispersion-relation state")
     dispersion_e: float = Field(0.9, gt=0.0, le=1.0, description="Restitution of the dispersion-relation state")
@@ -94,7 +94,7 @@ class ReportSettings(BaseModel):
         values: dict[str, Any] = {"quick": quick}
         if quick:
             values.update(
-                coefficient_e=(0.9,), coefficient_points=80, stability_e=(0.7, 0.9), stability_points=60,
+                coefficient_e=(0.9,), coefficient_points=80, stability_e=(0.7, 0.9), stability_points=59,
                 dispersion_points=120, couette_cells=40, cooling_cells=16, cooling_t_end=150.0,
             )
         values.update({k: v for k, v in overrides.items() if v is not None})
