@@ -75,6 +75,7 @@ class Problem:
     e: float
     x: np.ndarray
     v_scale: float = 1.0
+    centrifugal: float = 1.0  # multiplier of the centripetal term (1 = physics; <1 only inside a homotopy)
 
     def __post_init__(self) -> None:
         x = self.x
@@ -138,7 +139,7 @@ class Problem:
         return {
             "u": u, "theta": theta, "phi": phi, "p": c.p[node], "eta": c.eta[node],
             "F": F, "E": E, "P": P, "gamma": gamma, "F_wall": F_wall, "E_wall": E_wall, "slip": slip,
-            "K": self.geometry.centripetal(u, self.x, phi, c.p[node]),
+            "K": self.centrifugal * self.geometry.centripetal(u, self.x, phi, c.p[node]),
         }
 
     def residual(self, X: np.ndarray, t: dict[str, np.ndarray] | None = None) -> np.ndarray:

@@ -9,7 +9,7 @@ a single step cannot change θ or φ/(φ_max − φ) by more than a factor e^3. 
 
 When Newton fails from the naive start (uniform φ̄, linear velocity, θ of uniform shear), the
 solver first tries pseudo-transient continuation, then follows a homotopy from an easy problem
-(mean φ ≤ 0.3, e ≥ 0.9, specularity ≥ 0.1) to the target
+(mean φ ≤ 0.3, e ≥ 0.9, specularity ≥ 0.1, no centripetal term in the annular cell) to the target
 with adaptive steps.  If that fails too it raises :class:`~ktgf.errors.ConvergenceError`
 carrying the residual history and the last iterate.
 """
@@ -95,6 +95,8 @@ def newton(
                 return X, rep
             logs = np.abs(dX.reshape(-1, N_VARS)[:, 1:]).max()
             lam = min(1.0, 4.0 * lam, MAX_LOG_STEP / max(logs, 1e-300))
+            scales = problem.residual_scales(t)
+            res_norm = float(np.sqrt(np.mean((R / scales) ** 2)))
             while True:
                 Xt = X + lam * dX
                 Rt = problem.residual(Xt)
@@ -102,6 +104,10 @@ def newton(
                     dXbar = -lu.solve(Rt)
                     nbar = float(np.sqrt(np.mean(dXbar**2)))
                     if nbar <= (1.0 - 0.25 * lam) * norm or norm < tol:
+                        break
+                    # second acceptance rule (helps at kinks of piecewise closures, e.g. Torquato's χ at φ_f):
+                    # sufficient decrease of the scaled residual
+                    if float(np.sqrt(np.mean((Rt / scales) ** 2))) <= (1.0 - 0.25 * lam) * res_norm:
                         break
                 lam *= 0.5
                 if lam < lambda_min:
@@ -211,7 +217,7 @@ def _homotopy_problem(target: Problem, s: float, easy: dict[str, float]) -> Prob
     for k, w in enumerate(target.walls):
         spec = math.exp(math.log(easy["specularity"][k]) + s * (math.log(w.specularity) - math.log(easy["specularity"][k])))
         walls.append(dataclasses.replace(w, specularity=spec))
-    return dataclasses.replace(target, mean_phi=mean_phi, e=e, bottom=walls[0], top=walls[1])
+    return dataclasses.replace(target, mean_phi=mean_phi, e=e, bottom=walls[0], top=walls[1], centrifugal=s)
 
 
 def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10, max_iter: int = 60) -> tuple[np.ndarray, dict[str, Any]]:
@@ -254,6 +260,9 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
         sub = _homotopy_problem(problem, s_try, easy)
         Xt, rep = newton(sub, X, tol=tol, max_iter=30)
         history += rep.history
+        if not rep.converged:
+            Xt, rep = pseudo_transient(sub, X)
+            history += rep.history
         total_it += rep.iterations
         steps += 1
         if rep.converged:
