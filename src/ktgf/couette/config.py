@@ -167,6 +167,12 @@ class CouetteConfig(_Strict):
                 f"mean_solid_fraction = {self.mean_solid_fraction:g} is out of range: valid 0 < mean_solid_fraction "
                 f"< {m.phi_max:g} (packing limit of model {self.model!r})"
             )
+        if self.mean_solid_fraction >= self.output.phi_rcp:
+            # the whole inventory would be above random close packing: every solution is invalid (model.md §9)
+            raise ValueError(
+                f"mean_solid_fraction = {self.mean_solid_fraction:g} is out of range: valid 0 < mean_solid_fraction "
+                f"< output.phi_rcp = {self.output.phi_rcp:g} (random close packing)"
+            )
         gap = self.geometry.gap if isinstance(self.geometry, PlanarConfig) else self.geometry.outer_radius - self.geometry.inner_radius
         if gap < self.particle_diameter:
             raise ValueError(f"the gap ({gap:g} m) must be at least one particle diameter ({self.particle_diameter:g} m)")
@@ -185,7 +191,9 @@ class CouetteConfig(_Strict):
 def _format(exc: ValidationError) -> str:
     parts = []
     for err in exc.errors():
-        loc = ".".join(str(p) for p in err["loc"] if not str(p).startswith(("PlanarConfig", "AnnularConfig")))
+        parts_loc = [str(p) for p in err["loc"]]
+        # drop the discriminator tag pydantic inserts (geometry.planar.gap -> geometry.gap)
+        loc = ".".join(p for i, p in enumerate(parts_loc) if not (i and parts_loc[i - 1] == "geometry" and p in ("planar", "annular")))
         msg = err["msg"].removeprefix("Value error, ")
         if err.get("input") is not None and err["type"] not in ("value_error", "missing", "extra_forbidden"):
             msg += f" (got {err['input']!r})"

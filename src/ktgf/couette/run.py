@@ -146,7 +146,8 @@ def to_dataset(problem: Problem, X: np.ndarray, material: Material, *, phi_rcp: 
 
 def run(model, geometry, bottom: Wall, top: Wall, mean_phi: float, material: Material, *,
         n_cells: int = 200, stretch: float = 1.5, phi_rcp: float = 0.64, tol: float = 1e-10,
-        failed_path: str | Path | None = None, start: np.ndarray | None = None) -> xr.Dataset:
+        failed_path: str | Path | None = None, start: np.ndarray | None = None,
+        max_iter: int = 60, ptc_max_iter: int = 400) -> xr.Dataset:
     """Solve one Couette cell and return the Dataset.
 
     Raises :class:`~ktgf.errors.ConvergenceError` (a one-line message) if the solver fails; the
@@ -156,7 +157,7 @@ def run(model, geometry, bottom: Wall, top: Wall, mean_phi: float, material: Mat
     check_range("random close packing phi_rcp", phi_rcp, low=0.0, high=1.0, low_open=True)
     problem = build_problem(model, geometry, bottom, top, mean_phi, material, n_cells, stretch)
     try:
-        X, info = solve(problem, start, tol=tol)
+        X, info = solve(problem, start, tol=tol, max_iter=max_iter, ptc_max_iter=ptc_max_iter)
     except CouetteConvergenceError as exc:
         ds = to_dataset(exc.problem, exc.last_iterate, material, phi_rcp=phi_rcp,
                         info={"history": exc.history, "iterations": len(exc.history)}, converged=False)

@@ -220,8 +220,11 @@ def _homotopy_problem(target: Problem, s: float, easy: dict[str, float]) -> Prob
     return dataclasses.replace(target, mean_phi=mean_phi, e=e, bottom=walls[0], top=walls[1], centrifugal=s)
 
 
-def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10, max_iter: int = 60) -> tuple[np.ndarray, dict[str, Any]]:
+def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10, max_iter: int = 60,
+          ptc_max_iter: int = 400) -> tuple[np.ndarray, dict[str, Any]]:
     """Solve the steady problem; returns the unknowns and a dict of solver diagnostics.
+
+    ``max_iter`` bounds each Newton solve, ``ptc_max_iter`` each pseudo-transient run.
 
     Raises
     ------
@@ -234,7 +237,7 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
     history = list(rep.history)
     if rep.converged:
         return X, {"iterations": rep.iterations, "continuation_steps": 0, "residual": rep.residual, "history": history}
-    X, rep2 = pseudo_transient(problem, start)
+    X, rep2 = pseudo_transient(problem, start, max_iter=ptc_max_iter)
     history += rep2.history
     if rep2.converged:
         return X, {"iterations": rep.iterations + rep2.iterations, "continuation_steps": 0,
@@ -258,10 +261,10 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
     while s < 1.0:
         s_try = min(1.0, s + ds)
         sub = _homotopy_problem(problem, s_try, easy)
-        Xt, rep = newton(sub, X, tol=tol, max_iter=30)
+        Xt, rep = newton(sub, X, tol=tol, max_iter=min(30, max_iter))
         history += rep.history
         if not rep.converged:
-            Xt, rep = pseudo_transient(sub, X)
+            Xt, rep = pseudo_transient(sub, X, max_iter=ptc_max_iter)
             history += rep.history
         total_it += rep.iterations
         steps += 1
