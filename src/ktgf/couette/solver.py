@@ -8,9 +8,11 @@ a single step cannot change θ or φ/(φ_max − φ) by more than a factor e^3. 
 φ < φ_max hold by construction of the unknowns.
 
 When Newton fails from the naive start (uniform φ̄, linear velocity, θ of uniform shear), the
-solver first tries pseudo-transient continuation, then follows a homotopy from an easy problem
-(mean φ ≤ 0.3, e ≥ 0.9, specularity ≥ 0.1, no centripetal term in the annular cell) to the target
-with adaptive steps.  If that fails too it raises :class:`~ktgf.errors.ConvergenceError`
+solver first tries pseudo-transient continuation, then follows homotopies from an easy problem
+(mean φ ≤ 0.3, e ≥ 0.9, specularity ≥ 0.1, no centripetal term in the annular cell) to the
+target with adaptive steps: one parameter group per stage, then all at once
+(:func:`homotopy_paths`).  Near-jammed plug states (φ within ~1e-4 of φ_c, θ ~ 1e-8 U²) have
+Jacobian condition numbers of 1e12–1e13 and are where the solver can stop.  If it fails it raises :class:`~ktgf.errors.ConvergenceError`
 carrying the residual history and the last iterate.
 """
 
@@ -189,6 +191,7 @@ def pseudo_transient(
                 dt0 *= 0.25
             else:
                 rep.message = "pseudo-time step collapsed"
+                rep.residual = rel
                 return X, rep
             X = X + dX
         rep.residual = rel
@@ -209,15 +212,79 @@ def naive_start(problem: Problem) -> np.ndarray:
     return problem.pack(u, theta, np.full(x.size, phi))
 
 
-def _homotopy_problem(target: Problem, s: float, easy: dict[str, float]) -> Problem:
-    """The problem at homotopy parameter s ∈ [0, 1] (0 easy, 1 target)."""
-    mean_phi = easy["mean_phi"] + s * (target.mean_phi - easy["mean_phi"])
-    e = easy["e"] + s * (target.e - easy["e"])
-    walls = []
-    for k, w in enumerate(target.walls):
-        spec = math.exp(math.log(easy["specularity"][k]) + s * (math.log(w.specularity) - math.log(easy["specularity"][k])))
-        walls.append(dataclasses.replace(w, specularity=spec))
-    return dataclasses.replace(target, mean_phi=mean_phi, e=e, bottom=walls[0], top=walls[1], centrifugal=s)
+def _staged_problem(target: Problem, values: dict[str, Any]) -> Problem:
+    walls = [dataclasses.replace(w, specularity=values["specularity"][k]) for k, w in enumerate(target.walls)]
+    return dataclasses.replace(target, mean_phi=values["mean_phi"], e=values["e"], bottom=walls[0], top=walls[1],
+                               centrifugal=values["centrifugal"])
+
+
+def _interpolate(a: dict[str, Any], b: dict[str, Any], s: float) -> dict[str, Any]:
+    """Parameters a fraction s of the way from a to b (specularity geometrically)."""
+    return {
+        "mean_phi": a["mean_phi"] + s * (b["mean_phi"] - a["mean_phi"]),
+        "e": a["e"] + s * (b["e"] - a["e"]),
+        "centrifugal": a["centrifugal"] + s * (b["centrifugal"] - a["centrifugal"]),
+        "specularity": [math.exp(math.log(x) + s * (math.log(y) - math.log(x))) for x, y in zip(a["specularity"], b["specularity"])],
+    }
+
+
+def homotopy_stages(problem: Problem) -> list[dict[str, Any]]:
+    """Parameter states from an easy problem to the target, one parameter group changed per stage.
+
+    Easy: mean φ ≤ 0.3, e ≥ 0.9, specularity ≥ 0.1, no centripetal term.  Stages: restitution and
+    centripetal term, then specularity, then inventory.
+    """
+    target = {"mean_phi": problem.mean_phi, "e": problem.e, "centrifugal": problem.centrifugal,
+              "specularity": [w.specularity for w in problem.walls]}
+    easy = {"mean_phi": min(problem.mean_phi, 0.3), "e": max(problem.e, 0.9), "centrifugal": 0.0,
+            "specularity": [max(w.specularity, 0.1) for w in problem.walls]}
+    s1 = {**easy, "e": target["e"], "centrifugal": target["centrifugal"]}
+    s2 = {**s1, "specularity": target["specularity"]}
+    return [easy, s1, s2, target]
+
+
+def homotopy_paths(problem: Problem) -> list[list[dict[str, Any]]]:
+    """Two paths from the easy state: one parameter group per stage, then all parameters at once."""
+    staged = homotopy_stages(problem)
+    return [staged, [staged[0], staged[-1]]]
+
+
+def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: float, max_iter: int,
+            ptc_max_iter: int):
+    """Natural-parameter continuation through ``stages`` with adaptive steps; returns (X, iterations, steps)."""
+    sub = _staged_problem(problem, stages[0])
+    X, rep = newton(sub, naive_start(sub), tol=tol, max_iter=max_iter)
+    history += rep.history
+    total_it = rep.iterations
+    if not rep.converged:
+        raise CouetteConvergenceError(
+            f"Couette solver did not converge from the naive start nor from the easy state ({rep.message}); "
+            f"last relative residual {rep.residual:.3g}", history, X, sub)
+    steps = 0
+    for a, b in zip(stages[:-1], stages[1:]):
+        s, ds = 0.0, 1.0
+        while s < 1.0:
+            s_try = min(1.0, s + ds)
+            sub = _staged_problem(problem, _interpolate(a, b, s_try))
+            Xt, rep = newton(sub, X, tol=tol, max_iter=min(30, max_iter))
+            history += rep.history
+            total_it += rep.iterations
+            if not rep.converged:
+                Xt, rep = pseudo_transient(sub, X, max_iter=min(100, ptc_max_iter))
+                history += rep.history
+                total_it += rep.iterations
+            steps += 1
+            if rep.converged:
+                s, X = s_try, Xt
+                ds = min(1.0, 2.0 * ds)
+            else:
+                ds *= 0.5
+                if ds < 1e-3:
+                    raise CouetteConvergenceError(
+                        f"Couette continuation stalled (mean phi {sub.mean_phi:.4f}, e {sub.e:.4f}, "
+                        f"specularity {[round(w.specularity, 5) for w in sub.walls]}): {rep.message}; "
+                        f"last relative residual {rep.residual:.3g}", history, Xt, sub)
+    return X, total_it, steps
 
 
 def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10, max_iter: int = 60,
@@ -243,39 +310,19 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
         return X, {"iterations": rep.iterations + rep2.iterations, "continuation_steps": 0,
                    "residual": rep2.residual, "history": history, "method": "pseudo-transient"}
 
-    easy = {
-        "mean_phi": min(problem.mean_phi, 0.3),
-        "e": max(problem.e, 0.9),
-        "specularity": [max(w.specularity, 0.1) for w in problem.walls],
-    }
-    s, ds, steps = 0.0, 0.25, 0
-    X = None
-    sub = _homotopy_problem(problem, 0.0, easy)
-    X, rep = newton(sub, naive_start(sub), tol=tol, max_iter=max_iter)
-    history += rep.history
-    total_it = rep.iterations
-    if not rep.converged:
-        raise CouetteConvergenceError(
-            f"Couette solver did not converge from the naive start nor from the easy state ({rep.message}); "
-            f"last relative residual {rep.residual:.3g}", history, X, sub)
-    while s < 1.0:
-        s_try = min(1.0, s + ds)
-        sub = _homotopy_problem(problem, s_try, easy)
-        Xt, rep = newton(sub, X, tol=tol, max_iter=min(30, max_iter))
-        history += rep.history
-        if not rep.converged:
-            Xt, rep = pseudo_transient(sub, X, max_iter=ptc_max_iter)
-            history += rep.history
-        total_it += rep.iterations
-        steps += 1
-        if rep.converged:
-            s, X = s_try, Xt
-            ds = min(1.0, 1.5 * ds)
-        else:
-            ds *= 0.5
-            if ds < 1e-3:
-                raise CouetteConvergenceError(
-                    f"Couette continuation stalled at s = {s:.4f} of 1 (mean phi {sub.mean_phi:.4f}, "
-                    f"specularity {[w.specularity for w in sub.walls]}): {rep.message}; "
-                    f"last relative residual {rep.residual:.3g}", history, Xt, sub)
-    return X, {"iterations": total_it, "continuation_steps": steps, "residual": rep.residual, "history": history}
+    failure: CouetteConvergenceError | None = None
+    total_it = rep.iterations + rep2.iterations
+    steps = 0
+    for stages in homotopy_paths(problem):
+        try:
+            X, it, st = _follow(problem, stages, history, tol, max_iter, ptc_max_iter)
+        except CouetteConvergenceError as exc:
+            failure = failure or exc
+            continue
+        total_it, steps = total_it + it, steps + st
+        break
+    else:
+        assert failure is not None
+        raise failure
+    return X, {"iterations": total_it, "continuation_steps": steps, "residual": relative_residual(problem, X),
+               "history": history, "method": "continuation"}
