@@ -74,11 +74,18 @@ def compare_cmd(
         from ..couette.config import load_config, run_config
 
         cfg = load_config(config)
-        datasets = {}
+        from ..errors import ConvergenceError
+
+        datasets, rows = {}, []
         for n in names:
             c = cfg.model_copy(update={"model": n, "model_options": {}})
-            datasets[get_model(n).label] = run_config(c)
-        emit([_summary(ds) for ds in datasets.values()], fmt, title=f"Couette comparison ({config})")
+            try:
+                datasets[get_model(n).label] = ds = run_config(c)
+                rows.append(_summary(ds))
+            except ConvergenceError as exc:  # report it and go on with the other models
+                rows.append({"model": n, "converged": False, "valid": str(exc)[:100]})
+        rows = [{**{k: "" for k in rows[0] if k not in r}, **r} for r in rows] if rows else rows
+        emit(rows, fmt, title=f"Couette comparison ({config})")
         dem_data = load_dem_couette(dem) if dem.exists() and _is_dem_case(cfg) else None
         path = plot_profiles(datasets, out, dem=dem_data)
     typer.echo(f"wrote {path}")
