@@ -76,6 +76,8 @@ class Problem:
     x: np.ndarray
     v_scale: float = 1.0
     centrifugal: float = 1.0  # multiplier of the centripetal term (1 = physics; <1 only inside a homotopy)
+    central_differences: bool = True  # O(h²) Jacobian: the near-jammed states have condition numbers ~1e13
+    fd_step: float = 1e-5
 
     def __post_init__(self) -> None:
         x = self.x
@@ -187,10 +189,15 @@ class Problem:
         for k in range(N_VARS):
             for colour in range(3):
                 j = np.arange(colour, n, 3)
-                h = 1e-7 * (1.0 + np.abs(Xm[j, k]))
+                h = self.fd_step * (1.0 + np.abs(Xm[j, k]))
                 Xp = Xm.copy()
                 Xp[j, k] += h
-                dR = (self.residual(Xp.ravel()).reshape(n, N_VARS) - R0m)
+                if self.central_differences:
+                    Xn = Xm.copy()
+                    Xn[j, k] -= h
+                    dR = 0.5 * (self.residual(Xp.ravel()) - self.residual(Xn.ravel())).reshape(n, N_VARS)
+                else:
+                    dR = self.residual(Xp.ravel()).reshape(n, N_VARS) - R0m
                 for off in (-1, 0, 1):
                     i = j + off
                     ok = (i >= 0) & (i < n)

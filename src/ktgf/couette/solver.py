@@ -262,21 +262,17 @@ def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: 
             f"last relative residual {rep.residual:.3g}", history, X, sub)
     steps = 0
     for a, b in zip(stages[:-1], stages[1:]):
-        s, ds = 0.0, 1.0
+        s, ds = 0.0, 0.25
         while s < 1.0:
             s_try = min(1.0, s + ds)
             sub = _staged_problem(problem, _interpolate(a, b, s_try))
             Xt, rep = newton(sub, X, tol=tol, max_iter=min(30, max_iter))
             history += rep.history
             total_it += rep.iterations
-            if not rep.converged:
-                Xt, rep = pseudo_transient(sub, X, max_iter=min(100, ptc_max_iter))
-                history += rep.history
-                total_it += rep.iterations
             steps += 1
             if rep.converged:
                 s, X = s_try, Xt
-                ds = min(1.0, 2.0 * ds)
+                ds = min(1.0, 1.5 * ds)
             else:
                 ds *= 0.5
                 if ds < 1e-3:
