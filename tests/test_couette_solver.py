@@ -84,3 +84,20 @@ def test_converges_over_the_practical_range(name, e):
             except Exception as exc:  # noqa: BLE001 - collect every failure for the message
                 failures.append((mean_phi, spec, str(exc)[:80]))
     assert not failures, failures
+
+
+# Strongly inelastic (e = 0.5) Visc.div. cells whose cores approach jamming (φ_c − φ ~ 1e-4, θ ~ 1e-8 U²,
+# Jacobian condition ~1e13): known limits of the current solver, kept visible here.
+KNOWN_FAILURES_E05 = {("visc-div", 0.5, 1e-3), ("visc-div", 0.62, 1e-3), ("visc-div", 0.62, 0.1)}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", PAPER_MODELS)
+@pytest.mark.parametrize("mean_phi", [0.1, 0.3, 0.5, 0.62])
+@pytest.mark.parametrize("spec", [1e-3, 0.1, 1.0])
+def test_converges_at_strong_inelasticity(name, mean_phi, spec, request):
+    if (name, mean_phi, spec) in KNOWN_FAILURES_E05:
+        request.applymarker(pytest.mark.xfail(strict=True, reason="near-jammed core, known solver limit"))
+    pr = _problem(name, mean_phi, 0.5, spec, n=200)
+    X, info = solve(pr)
+    assert info["residual"] < 1e-8
