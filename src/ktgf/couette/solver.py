@@ -70,9 +70,14 @@ def relative_residual(problem: Problem, X: np.ndarray) -> float:
 
 
 def newton(
-    problem: Problem, X0: np.ndarray, *, tol: float = 1e-10, max_iter: int = 60, lambda_min: float = 1e-4
+    problem: Problem, X0: np.ndarray, *, tol: float = 1e-10, max_iter: int = 60, lambda_min: float = 1e-4,
+    residual_tol: float = 1e-8,
 ) -> tuple[np.ndarray, NewtonReport]:
-    """Damped Newton iteration; returns the last iterate and a report (never raises on non-convergence)."""
+    """Damped Newton iteration; returns the last iterate and a report (never raises on non-convergence).
+
+    Converged when a full step is shorter than ``tol`` (RMS over the unknowns u/V, ln θ, logit φ),
+    or, if the line search stalls, when the relative residual is already below ``residual_tol``.
+    """
     X = X0.copy()
     rep = NewtonReport(False, 0)
     lam = 1.0
@@ -116,7 +121,13 @@ def newton(
                     rep.history.append((rel, norm, lam))
                     rep.iterations = it + 1
                     rep.residual = rel
-                    rep.message = f"damping factor fell below {lambda_min:g} (no descent direction)"
+                    if rel < residual_tol:
+                        # every balance already holds to residual_tol of its largest term; the step
+                        # cannot shrink further because of round-off in an ill-conditioned system
+                        rep.converged = True
+                        rep.message = f"stopped at round-off level (relative residual {rel:.2g})"
+                    else:
+                        rep.message = f"damping factor fell below {lambda_min:g} (no descent direction)"
                     return X, rep
             X = Xt
             rep.history.append((rel, norm, lam))
