@@ -141,7 +141,7 @@ def test_cli_sweep_through_executor(tmp_path):
     cfg = tmp_path / "c.toml"
     cfg.write_text(EXAMPLE.read_text().replace("n_cells = 200", "n_cells = 60"))
     r = runner.invoke(app, ["couette", "sweep", str(cfg), "--specularity", "0.05,0.5", "--wall-restitution", "0.8,0.95",
-                            "--format", "json", "--out", str(tmp_path / "s.png")])
+                            "--format", "json", "--out", str(tmp_path / "s.png"), "--workers", "2"])
     assert r.exit_code == 0, r.output
     import json
 

@@ -60,10 +60,11 @@ def _jj_case(name="ret", n_cells=200, stretch=1.5, mean_phi=0.4, geometry=None, 
     return run(name, geometry, wall, wall, mean_phi, Material(D, RHO, 0.9), n_cells=n_cells, stretch=stretch)
 
 
-def test_mesh_refinement_second_order():
+@pytest.mark.parametrize("geometry", [PlanarCell(0.02, 1.0), AnnularCell(0.2, 0.22, 5.0)], ids=["planar", "annular"])
+def test_mesh_refinement_second_order(geometry):
     """Nested grids (25 … 400 cells, clustered): observed order of u, θ, φ at shared nodes and of τ_w."""
     ns = [25, 50, 100, 200, 400]
-    sols = [_jj_case(n_cells=n) for n in ns]
+    sols = [_jj_case(n_cells=n, geometry=geometry) for n in ns]
     orders = {}
     for var in ("u", "theta", "phi"):
         coarse = [ds[var].values[:: n // ns[0]] for ds, n in zip(sols, ns)]
