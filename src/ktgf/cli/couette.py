@@ -9,7 +9,17 @@ import typer
 
 from ._common import OutputFormat, emit, handle_errors, parse_values
 
-DEFAULT_DEM = Path("/work/shared/data/dem_couette_e0.9_phi0.50.csv")
+def _default_dem() -> Path:
+    """The DEM Couette file: $KTGF_DATA, then ../shared/data and shared/data from the working directory."""
+    import os
+
+    name = "dem_couette_e0.9_phi0.50.csv"
+    candidates = [Path(os.environ["KTGF_DATA"]) / name] if "KTGF_DATA" in os.environ else []
+    candidates += [Path("../shared/data") / name, Path("shared/data") / name, Path("/work/shared/data") / name]
+    return next((c for c in candidates if c.exists()), candidates[0])
+
+
+DEFAULT_DEM = _default_dem()
 
 
 def _summary(ds: Any) -> dict[str, Any]:

@@ -95,7 +95,8 @@ def calibrate_specularity(model: Any, target_u: float, *, n_cells: int = 200, bo
         best = lo if abs(flo) < abs(fhi) else hi
         return math.exp(best), cache[best]
     root = brentq(f, lo, hi, xtol=1e-4)
-    return math.exp(root), cache.get(root) or dem_cell(math.exp(root), model, n_cells=n_cells)
+    ds = cache.get(root)
+    return math.exp(root), ds if ds is not None else dem_cell(math.exp(root), model, n_cells=n_cells)
 
 
 def profile_errors(ds, dem: DemProfile) -> dict[str, float]:
