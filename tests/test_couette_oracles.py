@@ -54,17 +54,21 @@ def test_uniform_shear_every_model(name):
     np.testing.assert_allclose(ds["theta"].values / (U / H * D) ** 2, expect, rtol=1e-8)
 
 
-def _jj_case(name="ret", n_cells=200, stretch=1.5, mean_phi=0.4, geometry=None, spec=0.3):
-    wall = Wall(specularity=spec, restitution=0.85)
+def _jj_case(name="ret", n_cells=200, stretch=1.5, mean_phi=0.4, geometry=None, spec=0.3, heat_flux="total"):
+    wall = Wall(specularity=spec, restitution=0.85, heat_flux=heat_flux)
     geometry = geometry or PlanarCell(0.02, 1.0)
     return run(name, geometry, wall, wall, mean_phi, Material(D, RHO, 0.9), n_cells=n_cells, stretch=stretch)
 
 
-@pytest.mark.parametrize("geometry", [PlanarCell(0.02, 1.0), AnnularCell(0.2, 0.22, 5.0)], ids=["planar", "annular"])
-def test_mesh_refinement_second_order(geometry):
+@pytest.mark.parametrize(
+    "geometry,heat_flux",
+    [(PlanarCell(0.02, 1.0), "total"), (AnnularCell(0.2, 0.22, 5.0), "total"), (PlanarCell(0.02, 1.0), "conductive")],
+    ids=["planar", "annular", "planar-literal-JJ"],
+)
+def test_mesh_refinement_second_order(geometry, heat_flux):
     """Nested grids (25 … 400 cells, clustered): observed order of u, θ, φ at shared nodes and of τ_w."""
     ns = [25, 50, 100, 200, 400]
-    sols = [_jj_case(n_cells=n, geometry=geometry) for n in ns]
+    sols = [_jj_case(n_cells=n, geometry=geometry, heat_flux=heat_flux) for n in ns]
     orders = {}
     for var in ("u", "theta", "phi"):
         coarse = [ds[var].values[:: n // ns[0]] for ds, n in zip(sols, ns)]

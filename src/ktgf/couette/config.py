@@ -80,6 +80,7 @@ class WallConfig(_Strict):
     packing_limit: float | None = Field(None, gt=0, lt=1)
     slip: float | None = None
     temperature: float | None = Field(None, gt=0)
+    heat_flux: Literal["total", "conductive"] | None = None
 
     @field_validator("type")
     @classmethod
@@ -128,7 +129,7 @@ class WallsConfig(WallConfig):
 
 
 class NumericsConfig(_Strict):
-    n_cells: int = Field(200, ge=4, le=100000)
+    n_cells: int = Field(200, ge=8, le=100000)
     stretch: float = Field(1.5, ge=0, le=5)
     tol: float = Field(1e-10, gt=0, lt=1e-3)
 

@@ -107,6 +107,17 @@ class Problem:
         uw, uo = self.u_wall[k], self.u_wall[1 - k]
         return uw - self.walls[k].slip / self.v_scale * np.sign(uw - uo)
 
+    def _wall_gradient(self, f: np.ndarray, k: int) -> float:
+        """Second-order one-sided df/dx at wall k (0: x_0, 1: x_N) from the three nearest nodes."""
+        x = self.x
+        if k == 0:
+            h1, h2 = x[1] - x[0], x[2] - x[1]
+            f0, f1, f2, s = f[0], f[1], f[2], 1.0
+        else:
+            h1, h2 = x[-1] - x[-2], x[-2] - x[-3]
+            f0, f1, f2, s = f[-1], f[-2], f[-3], -1.0
+        return s * (-(2 * h1 + h2) / (h1 * (h1 + h2)) * f0 + (h1 + h2) / (h1 * h2) * f1 - h1 / (h2 * (h1 + h2)) * f2)
+
     # --- residual --------------------------------------------------------------------------
     def terms(self, X: np.ndarray) -> dict[str, np.ndarray]:
         """Every flux and source of the discrete balances (used by the residual and the diagnostics)."""
@@ -138,6 +149,8 @@ class Problem:
                 D = jj_dissipation(wall, phi[i], chi_w[k], theta[i])
                 G = cf * slip[k] ** 2
                 E_wall[k] = sign * self.B_wall[k] * (D - G)
+                if wall.heat_flux == "conductive":  # JJ set κ∂θ/∂n only: add the ω∂φ/∂x part
+                    E_wall[k] += self.B_wall[k] * c.omega[node][i] * self._wall_gradient(phi, k)
         return {
             "u": u, "theta": theta, "phi": phi, "p": c.p[node], "eta": c.eta[node],
             "F": F, "E": E, "P": P, "gamma": gamma, "F_wall": F_wall, "E_wall": E_wall, "slip": slip,
@@ -198,8 +211,11 @@ class Problem:
                     dR = 0.5 * (self.residual(Xp.ravel()) - self.residual(Xn.ravel())).reshape(n, N_VARS)
                 else:
                     dR = self.residual(Xp.ravel()).reshape(n, N_VARS) - R0m
-                for off in (-1, 0, 1):
-                    i = j + off
+                for off in (-1, 0, 1, "walls"):
+                    if off == "walls":  # wall rows also see the third node (one-sided wall gradients)
+                        i = np.where(j == 2, 0, np.where(j == n - 3, n - 1, -1))
+                    else:
+                        i = j + off
                     ok = (i >= 0) & (i < n)
                     for q in range(N_VARS):
                         r = i[ok] * N_VARS + q

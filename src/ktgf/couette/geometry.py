@@ -44,8 +44,8 @@ def stretched_nodes(x0: float, x1: float, n_cells: int, stretch: float = 0.0) ->
     grids with n and 2n cells are nested (every other node of the finer grid), which the
     mesh-refinement study relies on.  ``stretch = 0`` gives a uniform grid.
     """
-    if int(n_cells) != n_cells or n_cells < 4:
-        raise InputError(f"number of cells n_cells = {n_cells} is out of range: valid integer n_cells >= 4")
+    if int(n_cells) != n_cells or n_cells < 8:
+        raise InputError(f"number of cells n_cells = {n_cells} is out of range: valid integer n_cells >= 8")
     check_range("grid stretching stretch", stretch, low=0.0, high=5.0)
     xi = np.linspace(0.0, 1.0, int(n_cells) + 1)
     if stretch == 0.0:

@@ -16,9 +16,12 @@ energy
 
 Choices made here (documented defaults, exposed as options):
 
-* JJ write κ∂θ/∂n; our heat flux also has the ω∇φ term, and the condition is applied to the
-  whole flux q·n.  This keeps the energy of the cell exactly balanced (the slip work τ·u_sl
-  equals G, so everything the walls do is either dissipated or conducted).
+* JJ write κ∂θ/∂n; our heat flux also has the ω∇φ term.  Option ``heat_flux``: ``"total"``
+  (default) applies the condition to the whole flux q·n, so that the wall exchanges exactly
+  G − D with the medium (the slip work τ·u_sl equals G: everything the walls do is either
+  dissipated or conducted); ``"conductive"`` applies it literally to κ∂θ/∂n, the ω∂φ/∂n part
+  (one-sided, second order) then passes through the wall in addition.  The two agree for
+  models with ω = 0 (Enskog, Visc.div. by default).
 * φ_pk in the JJ formulas is a wall parameter (``packing_limit``, default 0.64) rather than
   the model's RDF limit, so the same wall is applied to every model (the CS-based models have
   φ_max = 1).
@@ -36,6 +39,7 @@ from ..validation import check_positive, check_range
 
 MOMENTUM_CONDITIONS = ("johnson-jackson", "prescribed", "free-slip")
 ENERGY_CONDITIONS = ("johnson-jackson", "prescribed", "adiabatic")
+HEAT_FLUX_FORMS = ("total", "conductive")
 #: Preset wall types: (momentum, energy).
 WALL_TYPES = {
     "johnson-jackson": ("johnson-jackson", "johnson-jackson"),
@@ -65,6 +69,8 @@ class Wall:
         Prescribed lag of the medium behind the wall [m/s] (``momentum="prescribed"``).
     temperature : float or None
         Prescribed granular temperature at the wall [m²/s²] (``energy="prescribed"``).
+    heat_flux : {"total", "conductive"}
+        Which flux the JJ energy condition sets (see the module notes).
     """
 
     momentum: Literal["johnson-jackson", "prescribed", "free-slip"] = "johnson-jackson"
@@ -74,8 +80,11 @@ class Wall:
     packing_limit: float = 0.64
     slip: float = 0.0
     temperature: float | None = None
+    heat_flux: Literal["total", "conductive"] = "total"
 
     def __post_init__(self) -> None:
+        if self.heat_flux not in HEAT_FLUX_FORMS:
+            raise InputError(f"wall heat_flux {self.heat_flux!r} is unknown; valid: {', '.join(HEAT_FLUX_FORMS)}")
         if self.momentum not in MOMENTUM_CONDITIONS:
             raise InputError(f"wall momentum condition {self.momentum!r} is unknown; valid: {', '.join(MOMENTUM_CONDITIONS)}")
         if self.energy not in ENERGY_CONDITIONS:
