@@ -1,0 +1,70 @@
+"""Couette benchmark: one planar profile on 200 cells (target < 0.5 s) and the four-model comparison, cold and warm.
+
+Run: ``PYTHONPATH=src /work/venv/bin/python benchmarks/bench_couette.py``.
+"Cold" is the first call in a fresh process (imports and first-use costs included); "warm"
+the best of repeated calls.  The solver is NumPy/SciPy (no JIT), so cold and warm differ only
+by import and cache effects.
+"""
+
+from __future__ import annotations
+
+import time
+
+T0 = time.perf_counter()
+from ktgf.closures import PAPER_MODELS  # noqa: E402
+from ktgf.couette import PlanarCell, Wall  # noqa: E402
+from ktgf.couette.run import Material, run  # noqa: E402
+
+IMPORT = time.perf_counter() - T0
+WALL = Wall(specularity=0.1, restitution=0.9)
+CELL = PlanarCell(0.02, 1.0)
+MAT = Material(1e-3, 2500.0, 0.9)
+
+
+def one(model: str = "ret", mean_phi: float = 0.5, n_cells: int = 200):
+    return run(model, CELL, WALL, WALL, mean_phi, MAT, n_cells=n_cells)
+
+
+def four():
+    return [one(m) for m in PAPER_MODELS]
+
+
+def timed(fn, repeat: int = 1) -> tuple[float, object]:
+    best, out = float("inf"), None
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t)
+    return best, out
+
+
+def main() -> None:
+    cold, ds = timed(one)
+    warm, ds = timed(one, repeat=5)
+    print(f"import ktgf.couette: {IMPORT:.3f} s")
+    print(f"one profile (RET, mean phi 0.5, 200 cells): cold {cold:.3f} s, warm {warm:.3f} s "
+          f"({1 / warm:.1f} profiles/s; {ds.attrs['solver_iterations']} Newton iterations; target < 0.5 s: "
+          f"{'met' if warm < 0.5 else 'NOT met'})")
+    for m in PAPER_MODELS:
+        t, d = timed(lambda: one(m), repeat=3)
+        print(f"  {m:9s} 200 cells: {t:.3f} s ({d.attrs['solver_iterations']} iterations)")
+    for n in (100, 400, 800):
+        t, _ = timed(lambda: one(n_cells=n), repeat=3)
+        print(f"  RET {n:4d} cells: {t:.3f} s ({t / warm:.2f} x the 200-cell time)")
+    c4, _ = timed(four)
+    w4, _ = timed(four, repeat=3)
+    print(f"four-model comparison (200 cells each): cold {c4:.3f} s, warm {w4:.3f} s")
+    from pathlib import Path
+
+    dem = Path(__file__).resolve().parents[2] / "shared" / "data" / "dem_couette_e0.9_phi0.50.csv"
+    if not dem.exists():
+        dem = Path("/work/shared/data/dem_couette_e0.9_phi0.50.csv")
+    if dem.exists():
+        from ktgf.couette.compare import compare_with_dem
+
+        t, _ = timed(lambda: compare_with_dem(dem))
+        print(f"four-model DEM comparison with per-model specularity calibration: {t:.2f} s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,204 @@
+"""``ktgf couette run | compare | sweep`` and ``ktgf plot couette``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from ._common import OutputFormat, emit, handle_errors, parse_values
+
+def _default_dem() -> Path:
+    """The DEM Couette file: $KTGF_DATA, then ../shared/data and shared/data from the working directory."""
+    import os
+
+    name = "dem_couette_e0.9_phi0.50.csv"
+    candidates = [Path(os.environ["KTGF_DATA"]) / name] if "KTGF_DATA" in os.environ else []
+    candidates += [Path("../shared/data") / name, Path("shared/data") / name, Path("/work/shared/data") / name]
+    return next((c for c in candidates if c.exists()), candidates[0])
+
+
+DEFAULT_DEM = _default_dem()
+
+
+def _summary(ds: Any) -> dict[str, Any]:
+    return {
+        "model": ds.attrs["model"],
+        "converged": bool(ds.attrs["converged"]),
+        "iterations": int(ds.attrs["solver_iterations"]),
+        "wall_shear_stress_Pa": float(ds["wall_shear_stress"].values[0]),
+        "slip_bottom_m/s": float(ds["wall_slip"].values[0]),
+        "slip_top_m/s": float(ds["wall_slip"].values[1]),
+        "max_phi": float(ds.attrs["max_phi"]),
+        "valid": ds.attrs["validity"],
+        "energy_budget_error": float(ds.attrs["energy_budget_relative_error"]),
+    }
+
+
+@handle_errors
+def run_cmd(
+    config: Path = typer.Argument(..., help="TOML config (see examples/couette_planar.toml)."),
+    out: Path = typer.Option(None, "--out", "-o", help="Output netCDF (default: output.path of the config)."),
+    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
+) -> None:
+    """Solve one Couette cell described by a validated TOML config and write the profiles to netCDF."""
+    from ..couette.config import load_config, run_config
+    from ..io import write_netcdf
+
+    cfg = load_config(config)
+    path = Path(out or cfg.output.path)
+    ds = run_config(cfg, failed_path=path.with_suffix(".failed.nc"))
+    write_netcdf(ds, path)
+    emit([_summary(ds)], fmt, title=f"Couette ({ds.attrs['geometry']}) -> {path}")
+    if not ds.attrs["physically_valid"]:
+        typer.echo(f"Warning: {ds.attrs['validity']}", err=True)
+
+
+@handle_errors
+def compare_cmd(
+    config: Path = typer.Argument(None, help="TOML config run for all four models (default: the DEM case with calibrated walls)."),
+    dem: Path = typer.Option(DEFAULT_DEM, "--dem", help="DEM Couette CSV (used if present)."),
+    out: Path = typer.Option(Path("couette_compare.png"), "--out", "-o", help="Figure file."),
+    models: str = typer.Option("enskog,ret,visc-div,proposed", "--models", help="Comma-separated model names."),
+    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
+) -> None:
+    """All four models on one figure (u/U, phi, sqrt(theta)/U vs y/d), with DEM points and per-model errors."""
+    from ..closures import get_model
+    from ..couette.compare import compare_with_dem, load_dem_couette
+    from ..plotting.couette import plot_profiles
+
+    names = [n.strip() for n in models.split(",") if n.strip()]
+    for n in names:
+        get_model(n)
+    if config is None:
+        if not dem.exists():
+            from ..errors import InputError
+
+            raise InputError(f"no config given and the DEM file {str(dem)!r} does not exist")
+        rows, extra = compare_with_dem(dem, names)
+        datasets = {get_model(n).label: ds for n, ds in extra["datasets"].items()}
+        emit(rows, fmt, title=f"Models vs DEM ({dem.name}); JJ walls, e_w = 0.9, specularity fitted per model to the DEM slip at |y| = 9.25 d")
+        path = plot_profiles(datasets, out, dem=extra["dem"], title="DEM Couette e = 0.9, mean phi = 0.50; specularity calibrated per model")
+    else:
+        from ..couette.config import load_config, run_config
+
+        cfg = load_config(config)
+        from ..errors import ConvergenceError
+
+        datasets, rows = {}, []
+        for n in names:
+            c = cfg.model_copy(update={"model": n, "model_options": {}})
+            try:
+                datasets[get_model(n).label] = ds = run_config(c)
+                rows.append(_summary(ds))
+            except ConvergenceError as exc:  # report it and go on with the other models
+                rows.append({"model": n, "converged": False, "valid": str(exc)[:100]})
+        rows = [{**{k: "" for k in rows[0] if k not in r}, **r} for r in rows] if rows else rows
+        emit(rows, fmt, title=f"Couette comparison ({config})")
+        dem_data = load_dem_couette(dem) if dem.exists() and _is_dem_case(cfg) else None
+        path = plot_profiles(datasets, out, dem=dem_data)
+    typer.echo(f"wrote {path}")
+
+
+def _is_dem_case(cfg: Any) -> bool:
+    g = cfg.geometry
+    return g.kind == "planar" and abs(g.gap / cfg.particle_diameter - 19.0) < 1e-9 and abs(cfg.mean_solid_fraction - 0.5) < 1e-9
+
+
+def _sweep_task(task: tuple[dict[str, Any], float, float]) -> dict[str, Any]:
+    """One sweep point (module level so that process pools and Dask can pickle it)."""
+    from ..couette.config import parse_config, run_config
+    from ..errors import ConvergenceError
+
+    data, spec, ew = task
+    walls = dict(data.get("walls", {}))
+    walls.update({"specularity": spec, "restitution": ew})
+    for side in ("bottom", "top"):
+        if isinstance(walls.get(side), dict):
+            walls[side] = {k: v for k, v in walls[side].items() if k not in ("specularity", "restitution")}
+    cfg = parse_config({**data, "walls": walls})
+    row: dict[str, Any] = {"specularity": spec, "wall_restitution": ew}
+    try:
+        ds = run_config(cfg)
+    except ConvergenceError as exc:
+        return {**row, "converged": False, "slip": float("nan"), "wall_shear_stress": float("nan"),
+                "max_phi": float("nan"), "valid": False, "message": str(exc)[:80]}
+    U = float(ds.attrs["velocity_scale"])
+    return {**row, "converged": True, "slip": float(abs(ds["wall_slip"].values[0]) / U),
+            "wall_shear_stress": float(ds["wall_shear_stress"].values[0]),
+            "max_phi": float(ds.attrs["max_phi"]), "valid": bool(ds.attrs["physically_valid"]), "message": ""}
+
+
+@handle_errors
+def sweep_cmd(
+    config: Path = typer.Argument(..., help="TOML config of the base case."),
+    specularity: str = typer.Option("0.001,0.01,0.1,1", "--specularity", help="phi' values: list or start:stop:num."),
+    wall_restitution: str = typer.Option("0.9", "--wall-restitution", help="e_w values: list or start:stop:num."),
+    workers: int = typer.Option(0, "--workers", help="Processes (0: in-process)."),
+    dask: str = typer.Option("", "--dask", help="Address of a Dask scheduler to run the sweep on."),
+    out: Path = typer.Option(None, "--out", "-o", help="Optional figure of the slip vs phi'."),
+    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
+) -> None:
+    """Sweep the specularity phi' and the wall restitution e_w (the calibration knobs) through an executor."""
+    import tomllib
+
+    from ..couette.config import load_config
+    from ..sweep import map_tasks
+    from ..validation import check_range
+
+    load_config(config)  # validate once, with field names, before dispatching
+    data = tomllib.loads(config.read_text())
+    specs = parse_values(specularity, "specularity")
+    ews = parse_values(wall_restitution, "wall-restitution")
+    check_range("specularity coefficient phi'", specs, low=0.0, high=1.0, low_open=True)
+    check_range("wall restitution e_w", ews, low=0.0, high=1.0, low_open=True)
+    tasks = [(data, float(s), float(e)) for e in ews for s in specs]
+    executor = None
+    if dask:
+        from distributed import Client
+
+        executor = Client(dask)
+    elif workers > 0:
+        from concurrent.futures import ProcessPoolExecutor
+
+        executor = ProcessPoolExecutor(workers)
+    try:
+        rows = map_tasks(_sweep_task, tasks, executor=executor)
+    finally:
+        if executor is not None:
+            executor.shutdown() if hasattr(executor, "shutdown") else executor.close()
+    emit(rows, fmt, title=f"Couette sweep ({config}): slip = |u_sl|/U at the bottom wall")
+    if out is not None:
+        from ..plotting.couette import plot_sweep
+
+        typer.echo(f"wrote {plot_sweep(rows, out)}")
+
+
+@handle_errors
+def plot_cmd(
+    files: list[Path] = typer.Argument(..., help="netCDF outputs of `ktgf couette run`."),
+    out: Path = typer.Option(Path("couette.png"), "--out", "-o", help="Figure file."),
+) -> None:
+    """Plot u/U, phi and sqrt(theta)/U of saved Couette runs on one figure."""
+    import xarray as xr
+
+    from ..errors import InputError
+    from ..plotting.couette import plot_profiles
+
+    datasets = {}
+    for f in files:
+        if not f.exists():
+            raise InputError(f"file {str(f)!r} does not exist")
+        ds = xr.load_dataset(f)
+        datasets[f"{ds.attrs.get('model_label', f.stem)} ({f.name})"] = ds
+    typer.echo(f"wrote {plot_profiles(datasets, out)}")
+
+
+def register(app: typer.Typer, plot_app: typer.Typer) -> None:
+    couette_app = typer.Typer(help="Steady Couette shear cells (planar and annular).", no_args_is_help=True)
+    couette_app.command("run")(run_cmd)
+    couette_app.command("compare")(compare_cmd)
+    couette_app.command("sweep")(sweep_cmd)
+    app.add_typer(couette_app, name="couette")
+    plot_app.command("couette")(plot_cmd)

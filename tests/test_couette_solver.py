@@ -1,0 +1,136 @@
+"""Couette solver internals and robustness: Jacobian, convergence from a naive start over the practical range."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ktgf.closures import PAPER_MODELS, get_model
+from ktgf.couette import AnnularCell, PlanarCell, Wall
+from ktgf.couette.equations import Problem, phi_from_psi, psi_from_phi
+from ktgf.couette.geometry import stretched_nodes
+from ktgf.couette.solver import naive_start, solve
+
+
+def _problem(name="ret", mean_phi=0.45, e=0.8, spec=0.2, geometry=None, n=40, walls=None, heat_flux="total"):
+    w = Wall(specularity=spec, restitution=0.85, heat_flux=heat_flux)
+    g = geometry or PlanarCell(20.0, 1.0)
+    x0, x1 = g.bounds(1.0)
+    bottom, top = walls or (w, w)
+    return Problem(get_model(name), g, bottom, top, mean_phi, e, stretched_nodes(x0, x1, n, 1.5), v_scale=1.0)
+
+
+@pytest.mark.parametrize("heat_flux", ["total", "conductive"])
+@pytest.mark.parametrize("geometry", [PlanarCell(20.0, 1.0), AnnularCell(30.0, 50.0, 1 / 30.0)], ids=["planar", "annular"])
+@pytest.mark.parametrize("name", PAPER_MODELS)
+def test_coloured_jacobian_matches_directional_derivatives(name, geometry, heat_flux):
+    """J·v from the coloured sparse Jacobian equals a central difference of the residual along random v."""
+    pr = _problem(name, geometry=geometry, heat_flux=heat_flux)
+    rng = np.random.default_rng(1)
+    X = naive_start(pr) + 0.05 * rng.standard_normal(3 * pr.n)
+    R = pr.residual(X)
+    J = pr.jacobian(X, R)
+    for _ in range(3):
+        v = rng.standard_normal(X.size)
+        h = 1e-5
+        fd = (pr.residual(X + h * v) - pr.residual(X - h * v)) / (2 * h)
+        np.testing.assert_allclose(J @ v, fd, rtol=1e-4, atol=1e-6 * np.abs(fd).max())
+
+
+def test_phi_transform_round_trip_and_bounds():
+    phi = np.array([1e-6, 0.1, 0.5, 0.6399999])
+    np.testing.assert_allclose(phi_from_psi(psi_from_phi(phi, 0.64), 0.64), phi, rtol=1e-9)
+    assert np.all(phi_from_psi(np.array([-800.0, 800.0]), 0.64) <= 0.64)
+
+
+def test_independent_walls_mixed_conditions():
+    """Bottom JJ wall, top wall with prescribed no-slip and temperature: conditions hold where imposed."""
+    top = Wall(momentum="prescribed", energy="prescribed", temperature=0.001)
+    bottom = Wall(specularity=0.3, restitution=0.8)
+    pr = _problem("proposed", walls=(bottom, top), n=80)
+    X, info = solve(pr)
+    u, theta, phi = pr.unpack(X)
+    assert u[-1] == pytest.approx(0.5, abs=1e-12)
+    assert theta[-1] == pytest.approx(0.001, rel=1e-10)
+    assert u[0] > -0.5  # JJ bottom wall slips
+
+
+CORNERS = [
+    ("enskog", 0.1, 0.5, 1e-3), ("ret", 0.62, 0.9, 1e-3), ("ret", 0.3, 0.5, 1e-3), ("visc-div", 0.62, 0.99, 1e-3),
+    ("visc-div", 0.62, 0.9, 1.0), ("proposed", 0.62, 0.5, 1.0), ("proposed", 0.62, 0.9, 1e-3), ("enskog", 0.62, 0.99, 1.0),
+]
+
+
+@pytest.mark.parametrize("name,mean_phi,e,spec", CORNERS)
+def test_converges_from_naive_start_at_corners(name, mean_phi, e, spec):
+    pr = _problem(name, mean_phi, e, spec, n=200)
+    X, info = solve(pr)
+    u, theta, phi = pr.unpack(X)
+    assert info["residual"] < 1e-8
+    assert np.all(theta > 0) and np.all(phi < pr.phi_max)
+    assert pr.V @ phi / pr.V.sum() == pytest.approx(mean_phi, abs=1e-10)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", PAPER_MODELS)
+@pytest.mark.parametrize("e", [0.7, 0.9, 0.99])
+def test_converges_over_the_practical_range(name, e):
+    """Mean φ 0.1 … 0.62 (φ_max − 0.02 for the φ_c = 0.64 RDFs), φ' 1e-3 … 1, 20 d cell, 200 cells."""
+    failures = []
+    for mean_phi in (0.1, 0.3, 0.5, 0.62):
+        for spec in (1e-3, 1e-2, 0.1, 1.0):
+            pr = _problem(name, mean_phi, e, spec, n=200)
+            try:
+                solve(pr)
+            except Exception as exc:  # noqa: BLE001 - collect every failure for the message
+                failures.append((mean_phi, spec, str(exc)[:80]))
+    assert not failures, failures
+
+
+# Known limits of the current solver, kept visible here (strict xfail: a fix shows up as XPASS).
+# Strongly inelastic (e = 0.5) Visc.div. cells: cores approaching jamming (φ_c − φ ~ 1e-4, θ ~ 1e-8 U²,
+# Jacobian condition ~1e13), and a case where the densest node crosses φ_f = 0.49, where Torquato's χ
+# and the viscosity law have a kink (the residual is not differentiable there; Newton stalls).
+KNOWN_FAILURES_E05 = {("visc-div", 0.62, 1e-3), ("visc-div", 0.62, 0.1), ("visc-div", 0.3, 1.0)}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", PAPER_MODELS)
+@pytest.mark.parametrize("mean_phi", [0.1, 0.3, 0.5, 0.62])
+@pytest.mark.parametrize("spec", [1e-3, 0.1, 1.0])
+def test_converges_at_strong_inelasticity(name, mean_phi, spec, request):
+    if (name, mean_phi, spec) in KNOWN_FAILURES_E05:
+        request.applymarker(pytest.mark.xfail(strict=True, reason="near-jammed core, known solver limit"))
+    pr = _problem(name, mean_phi, 0.5, spec, n=200)
+    X, info = solve(pr)
+    assert info["residual"] < 1e-8
+
+
+@pytest.mark.parametrize("name", ["enskog", "ret"])
+def test_literal_jj_heat_flux_option(name):
+    """heat_flux="conductive" imposes JJ on κ∂θ/∂n literally; identical to "total" when ω = 0 (Enskog)."""
+    sols = {}
+    for form in ("total", "conductive"):
+        pr = _problem(name, 0.45, 0.8, 0.2, n=200, heat_flux=form)
+        X, _ = solve(pr)
+        sols[form] = (pr, X)
+    th_t = sols["total"][0].unpack(sols["total"][1])[1]
+    th_c = sols["conductive"][0].unpack(sols["conductive"][1])[1]
+    if name == "enskog":
+        np.testing.assert_allclose(th_c, th_t, rtol=1e-9)
+    else:
+        assert np.max(np.abs(th_c / th_t - 1)) > 1e-3  # RET's ω∇φ matters at the wall
+    # the literal condition κ_w ∂θ/∂n = D − G holds at the bottom wall to discretisation accuracy
+    # (the scheme imposes it on the half-cell flux; compared here with a one-sided O(h²) gradient)
+    from ktgf.couette.walls import jj_dissipation, jj_friction
+
+    pr, X = sols["conductive"]
+    u, theta, phi = pr.unpack(X)
+    c = pr.model.coefficients(phi[:1], pr.e, theta[:1], d=1.0, rho_s=1.0, check=False)
+    chi = pr.model.chi(phi[:1])
+    w = pr.walls[0]
+    slip = u[0] - pr.u_wall[0]
+    D = jj_dissipation(w, phi[0], chi[0], theta[0])
+    G = jj_friction(w, phi[0], chi[0], theta[0]) * slip**2
+    dtheta = pr._wall_gradient(theta, 0)
+    assert float(c.kappa[0]) * dtheta == pytest.approx(D - G, rel=1e-3)
