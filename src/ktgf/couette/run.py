@@ -22,7 +22,7 @@ from ..errors import ConvergenceError
 from ..io import run_metadata, write_netcdf
 from ..validation import check_positive, check_range
 from .equations import Problem
-from .geometry import AnnularCell, PlanarCell, stretched_nodes
+from .geometry import stretched_nodes
 from .solver import CouetteConvergenceError, solve
 from .walls import Wall
 
