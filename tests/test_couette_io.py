@@ -153,15 +153,12 @@ def test_cli_sweep_through_executor(tmp_path):
         assert s[0.05] > s[0.5]
 
 
-def _dem_file() -> Path:
-    for base in (ROOT.parent / "shared", ROOT.parent.parent / "shared"):
-        f = base / "data" / "dem_couette_e0.9_phi0.50.csv"
-        if f.exists():
-            return f
-    pytest.skip("DEM Couette data (shared/data/dem_couette_e0.9_phi0.50.csv) is absent")
+@pytest.fixture
+def dem_file(data_dir: Path) -> Path:
+    return data_dir / "dem_couette_e0.9_phi0.50.csv"
 
 
-def test_dem_couette_calibrated_ret_profile():
+def test_dem_couette_calibrated_ret_profile(dem_file):
     """RET with the specularity fitted to the DEM slip (one number) predicts the DEM profiles (physical validation).
 
     Tolerances are physical: a few per cent of U in u, of φ, and of U in √θ; layering next to
@@ -169,7 +166,7 @@ def test_dem_couette_calibrated_ret_profile():
     """
     from ktgf.couette.compare import compare_with_dem
 
-    rows, _ = compare_with_dem(_dem_file(), ["ret"], n_cells=100)
+    rows, _ = compare_with_dem(dem_file, ["ret"], n_cells=100)
     r = rows[0]
     print(r)
     assert 1e-3 < r["specularity"] < 1
@@ -177,20 +174,20 @@ def test_dem_couette_calibrated_ret_profile():
 
 
 @pytest.mark.slow
-def test_cli_compare_four_models_with_dem(tmp_path):
-    dem = _dem_file()
+def test_cli_compare_four_models_with_dem(tmp_path, dem_file):
+    dem = dem_file
     out = tmp_path / "cmp.png"
     r = runner.invoke(app, ["couette", "compare", "--dem", str(dem), "-o", str(out), "--format", "json"])
     assert r.exit_code == 0, r.output
     assert out.exists()
 
 
-def test_uniform_shear_closed_forms_against_dem_uniform_shear():
+def test_uniform_shear_closed_forms_against_dem_uniform_shear(data_dir):
     """dem_uniform_shear.csv (Lees–Edwards DEM, e = 0.9): at φ = 0.3 every model is within 10 % in T, η*, p*
     (physical validation; at φ = 0.5 the models underpredict p* and η* by 11–22 %, reported, not asserted)."""
     from ktgf.couette.compare import compare_uniform_shear
 
-    f = _dem_file().with_name("dem_uniform_shear.csv")
+    f = data_dir / "dem_uniform_shear.csv"
     if not f.exists():
         pytest.skip("dem_uniform_shear.csv is absent")
     rows = compare_uniform_shear(f)

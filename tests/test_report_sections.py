@@ -105,16 +105,18 @@ def test_couette_section_errors_of_a_known_solution(monkeypatch, tmp_path, dem_d
     calls = []
     shift = 0.05  # the manufactured velocity is the DEM's plus 5 % of U: RMS(u − u_DEM)/U = 0.05 exactly
 
-    def fake(model, *, phi_mean, e, height, wall_speed, d, rho_s, n_cells):
+    def fake(model, *, phi_mean, e, height, wall_speed, d, rho_s, n_cells, dem_path=None):
         calls.append(dict(phi_mean=phi_mean, e=e, height=height, wall_speed=wall_speed, d=d, rho_s=rho_s, n_cells=n_cells))
         return xr.Dataset({"u": ("y", dem["ux"] + shift * wall_speed), "phi": ("y", dem["phi"]), "theta": ("y", dem["theta"])},
                           coords={"y": dem["y"]}, attrs={"wall": "manufactured", "valid": 1})
 
     _enable(monkeypatch, "couette", couette, fake)
-    rep = build_report(ReportSettings.preset(quick=True, out=copy_of(quick_report, tmp_path)))
+    out = copy_of(quick_report, tmp_path)
+    (out / ".cache" / "couette.json").unlink(missing_ok=True)  # the real solver's result is cached there
+    rep = build_report(ReportSettings.preset(quick=True, out=out))
     assert rep.statuses["couette"] == "computed" and rep.problems == []
     assert rep.statuses["hcs"] == "cached"
-    assert calls[0] == dict(phi_mean=0.5, e=0.9, height=20.0, wall_speed=10.0, d=1.0, rho_s=6 / math.pi, n_cells=40)
+    assert calls[0] == dict(phi_mean=0.5, e=0.9, height=19.0, wall_speed=10.0, d=1.0, rho_s=6 / math.pi, n_cells=40)
     errs = next(r for r in rep.results if r.key == "couette").numbers["couette_errors"]
     for n in ("enskog", "ret", "visc-div", "proposed"):
         assert errs[n]["u_rms_over_U"] == pytest.approx(shift, rel=1e-12)

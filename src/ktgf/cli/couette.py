@@ -9,14 +9,13 @@ import typer
 
 from ._common import OutputFormat, emit, handle_errors, parse_values
 
-def _default_dem() -> Path:
-    """The DEM Couette file: $KTGF_DATA, then ../shared/data and shared/data from the working directory."""
-    import os
 
-    name = "dem_couette_e0.9_phi0.50.csv"
-    candidates = [Path(os.environ["KTGF_DATA"]) / name] if "KTGF_DATA" in os.environ else []
-    candidates += [Path("../shared/data") / name, Path("shared/data") / name, Path("/work/shared/data") / name]
-    return next((c for c in candidates if c.exists()), candidates[0])
+def _default_dem() -> Path:
+    """The DEM Couette file in the data folder of :func:`ktgf.data.locate_data_dir` (may not exist)."""
+    from ..data import DATA_ENV, locate_data_dir
+
+    folder, _ = locate_data_dir(None)
+    return (folder or Path(f"${DATA_ENV}")) / "dem_couette_e0.9_phi0.50.csv"
 
 
 DEFAULT_DEM = _default_dem()

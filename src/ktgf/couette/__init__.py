@@ -20,6 +20,7 @@ Command line: ``ktgf couette run examples/couette_planar.toml``, ``ktgf couette 
 --wall-restitution 0.8,0.9 --workers 2``, ``ktgf plot couette out.nc``.
 """
 
+from .compare import report_profiles
 from .equations import Problem
 from .geometry import AnnularCell, PlanarCell, stretched_nodes
 from .solver import CouetteConvergenceError, solve
@@ -27,6 +28,6 @@ from .uniform_shear import UniformShear, uniform_shear
 from .walls import Wall
 
 __all__ = [
-    "AnnularCell", "CouetteConvergenceError", "PlanarCell", "Problem", "UniformShear", "Wall",
+    "AnnularCell", "CouetteConvergenceError", "PlanarCell", "Problem", "report_profiles", "UniformShear", "Wall",
     "solve", "stretched_nodes", "uniform_shear",
 ]

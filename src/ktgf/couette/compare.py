@@ -121,7 +121,7 @@ def compare_with_dem(dem_path: str | Path, models=PAPER_MODELS, *, n_cells: int 
     """
     dem = load_dem_couette(dem_path)
     y0 = DEM_CASE["calibration_y"]
-    target = 0.5 * (abs(np.interp(y0, dem.y, dem.u)) + abs(np.interp(-y0, dem.y, dem.u)))
+    target = dem_slip_target(dem)
     rows, datasets = [], {}
     for name in models:
         m = get_model(name)
@@ -173,3 +173,34 @@ def compare_uniform_shear(path: str | Path, models=PAPER_MODELS) -> list[dict[st
                 "p*": p, "p*_dem": float(rec["p_over_nT"]), "dp*": p / float(rec["p_over_nT"]) - 1,
             })
     return rows
+
+
+def dem_slip_target(dem: DemProfile) -> float:
+    """|u| at |y| = calibration_y, averaged over both walls: the one DEM number the wall is fitted to."""
+    y0 = DEM_CASE["calibration_y"]
+    return 0.5 * (abs(np.interp(y0, dem.y, dem.u)) + abs(np.interp(-y0, dem.y, dem.u)))
+
+
+def report_profiles(model: Any, *, phi_mean: float, e: float, height: float, wall_speed: float, d: float,
+                    rho_s: float, n_cells: int, dem_path: str | Path | None = None,
+                    specularity: float = 0.1) -> Any:
+    """Steady planar profiles for the report's Couette section (entry point of :mod:`ktgf.report.couette`).
+
+    Johnson–Jackson walls with e_w = e.  With ``dem_path`` (the DEM Couette file) and the DEM case's
+    parameters, the specularity is fitted per model to the DEM slip as in :func:`compare_with_dem`;
+    otherwise ``specularity`` is used.  ``attrs['wall']`` says which, ``attrs['valid']`` is 1 when
+    max φ stays below φ_rcp.
+    """
+    c = DEM_CASE
+    dem_case = (phi_mean, e, height, wall_speed, d, rho_s) == (c["mean_phi"], c["e"], c["gap"], c["wall_speed"], c["d"], c["rho_s"])
+    if dem_path is not None and dem_case:
+        target = dem_slip_target(load_dem_couette(dem_path))
+        spec, ds = calibrate_specularity(get_model(model), target, n_cells=n_cells)
+        wall = (f"Johnson–Jackson, e_w = {e:g}, specularity φ' = {spec:.3g} fitted so that u(|y| = {c['calibration_y']}) "
+                f"= {target:.3f} (the DEM slip)")
+    else:
+        w = Wall(specularity=specularity, restitution=e)
+        ds = run(model, PlanarCell(height, wall_speed), w, w, phi_mean, Material(d, rho_s, e), n_cells=n_cells, stretch=1.5)
+        wall = f"Johnson–Jackson, e_w = {e:g}, specularity φ' = {specularity:g} (not calibrated)"
+    ds.attrs.update(wall=wall, valid=int(bool(ds.attrs["physically_valid"])))
+    return ds

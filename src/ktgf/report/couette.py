@@ -1,7 +1,8 @@
 """Section 3: the planar Couette cell — u, φ and θ profiles of the models against the DEM.
 
-The case is the DEM run of ``dem_couette_e0.9_phi0.50.csv`` (H = 20 d between wall-sphere
-centres, U = 10, mean φ = 0.50, e = 0.9, units d = m = 1).  The section needs the Couette
+The case is the DEM run of ``dem_couette_e0.9_phi0.50.csv`` (U = 10, mean φ = 0.50, e = 0.9,
+units d = m = 1); the continuum cell is the slab between the planes tangent to the wall spheres,
+H = 19 d (wall-sphere centres at ±10).  The section needs the Couette
 solver (package :mod:`ktgf.couette`); without it the page says "not available in this build".
 
 Contract with the solver (the one thing to wire up)
@@ -9,7 +10,8 @@ Contract with the solver (the one thing to wire up)
 The section calls :data:`ENTRY_POINT`, ``ktgf.couette.report_profiles``, once per model::
 
     report_profiles(model: ktgf.Model, *, phi_mean: float, e: float, height: float,
-                    wall_speed: float, d: float, rho_s: float, n_cells: int) -> xarray.Dataset
+                    wall_speed: float, d: float, rho_s: float, n_cells: int,
+                    dem_path=None) -> xarray.Dataset
 
 returning the steady profiles with
 
@@ -68,13 +70,17 @@ def available() -> str | None:
     return None
 
 
-def solve_profiles(model: Any, s: ReportSettings) -> xr.Dataset:
-    """Steady profiles of one model for the report's Couette case (the only call into the solver)."""
+def solve_profiles(model: Any, s: ReportSettings, dem_path: Any = None) -> xr.Dataset:
+    """Steady profiles of one model for the report's Couette case (the only call into the solver).
+
+    With the DEM file, the solver fits each model's wall specularity to the DEM slip.
+    """
     fn = _entry()
     if fn is None:
         raise RuntimeError(available() or "Couette solver unavailable")
+    extra = {"dem_path": dem_path} if dem_path is not None else {}
     return fn(model, phi_mean=s.couette_phi_mean, e=s.couette_e, height=s.couette_height,
-              wall_speed=s.couette_wall_speed, d=1.0, rho_s=RHO_S_DEM, n_cells=s.couette_cells)
+              wall_speed=s.couette_wall_speed, d=1.0, rho_s=RHO_S_DEM, n_cells=s.couette_cells, **extra)
 
 
 def inputs(s: ReportSettings) -> dict[str, Any]:
@@ -119,6 +125,9 @@ def plot_profiles(ds: xr.Dataset, out: Any) -> Any:
         ax.set_ylabel("y / d")
         ax.grid(True, alpha=0.3)
     axes[2].set_xscale("log")
+    from matplotlib.ticker import NullFormatter
+
+    axes[2].xaxis.set_minor_formatter(NullFormatter())  # minor labels of a one-decade log axis overlap
     axes[0].legend(fontsize=8)
     fig.suptitle("Planar Couette cell: profiles across the gap")
     return save(fig, out)
@@ -131,7 +140,7 @@ def run(ctx: SectionContext) -> None:
     sols = {}
     for n in s.models:
         ctx.step(f"solving the Couette cell with {get_model(n).label}")
-        sols[n] = solve_profiles(get_model(n), s)
+        sols[n] = solve_profiles(get_model(n), s, path)
     y = np.asarray(sols[s.models[0]].y, dtype=float)
     data: dict[str, Any] = {}
     for var in ("u", "phi", "theta"):

@@ -15,10 +15,10 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from ..closures.models import PAPER_MODELS, get_model
+from ..data import DATA_ENV, default_data_dirs, locate_data_dir  # noqa: F401  (re-exported)
 from ..errors import InputError, UnknownModelError
 
 #: Environment variable naming the DEM reference-data folder (overridden by ``--data``).
-DATA_ENV = "KTGF_DATA"
 
 Restitution = Field(gt=0.0, le=1.0)
 
@@ -55,7 +55,7 @@ class ReportSettings(BaseModel):
     # (3) Couette cell (the DEM case of dem_couette_e0.9_phi0.50.csv)
     couette_phi_mean: float = Field(0.5, gt=0.0, lt=0.64, description="Mean solid fraction of the Couette cell")
     couette_e: float = Field(0.9, gt=0.0, le=1.0, description="Restitution (particle-particle and particle-wall)")
-    couette_height: float = Field(20.0, gt=0.0, description="Wall-to-wall distance H [d]")
+    couette_height: float = Field(19.0, gt=0.0, description="Gap H [d] between the planes tangent to the wall spheres (DEM: 19)")
     couette_wall_speed: float = Field(10.0, gt=0.0, description="Relative wall speed U [√(m/…) units of the DEM]")
     couette_cells: int = Field(200, ge=8, le=100000, description="Grid cells across the Couette gap")
 
@@ -117,35 +117,3 @@ class ReportSettings(BaseModel):
         return " ".join(["ktgf reproduce", *opts])
 
 
-def default_data_dirs() -> list[Path]:
-    """Where the DEM data is looked for by default: ``shared/data`` beside the source tree or one of its parents.
-
-    The project keeps it at ``../shared/data`` relative to the repository; a git worktree one
-    level deeper (``wt/<topic>``) finds it one level further up.
-    """
-    repo = Path(__file__).resolve().parents[3]
-    return [p / "shared" / "data" for p in list(repo.parents)[:2]]
-
-
-def locate_data_dir(explicit: Path | None) -> tuple[Path | None, str]:
-    """The DEM data folder to use, and a sentence saying where it came from (or why there is none).
-
-    Order: the explicit option, ``$KTGF_DATA``, then :func:`default_data_dirs`.  A folder named
-    explicitly (option or variable) that does not exist is reported, not an error: the data are optional.
-    """
-    if explicit is not None:
-        src, path = "--data", Path(explicit)
-    elif os.environ.get(DATA_ENV):
-        src, path = f"${DATA_ENV}", Path(os.environ[DATA_ENV])
-    else:
-        for cand in default_data_dirs():
-            if cand.is_dir():
-                return cand.resolve(), f"DEM reference data from {cand.resolve()} (found beside the source tree)"
-        return None, (
-            "DEM reference data folder not found (looked in "
-            + ", ".join(str(p) for p in default_data_dirs())
-            + f"; set --data or ${DATA_ENV}): comparisons with particle simulations are left out"
-        )
-    if path.is_dir():
-        return path.resolve(), f"DEM reference data from {path.resolve()} (given by {src})"
-    return None, f"DEM reference data folder {path} (given by {src}) does not exist: comparisons with particle simulations are left out"
