@@ -10,7 +10,8 @@ is large enough to amortise scheduling.
 from __future__ import annotations
 
 from concurrent.futures import Executor
-from typing import Any, Callable, Iterable, Sequence
+from contextlib import contextmanager
+from typing import Any, Callable, Iterable, Iterator, Sequence
 
 
 def as_executor(executor: Any) -> Executor | None:
@@ -61,3 +62,39 @@ def map_tasks(
             fut.cancel()
         raise
     return results
+
+
+def process_pool(workers: int) -> Executor:
+    """A local process pool whose workers are spawned, not forked.
+
+    Forking a process that has imported JAX (multithreaded) can deadlock, so ktgf never forks.
+    """
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
+
+
+@contextmanager
+def open_executor(workers: int = 0, scheduler: str | None = None) -> Iterator[Any]:
+    """The executor a command-line option pair asks for, closed on exit.
+
+    ``scheduler`` (a Dask scheduler address) wins over ``workers`` (a local spawned process
+    pool); neither gives ``None``, i.e. in-process.
+    """
+    if scheduler:
+        from distributed import Client
+
+        client = Client(scheduler)
+        try:
+            yield client
+        finally:
+            client.close()
+    elif workers > 0:
+        pool = process_pool(workers)
+        try:
+            yield pool
+        finally:
+            pool.shutdown()
+    else:
+        yield None

@@ -143,7 +143,7 @@ def sweep_cmd(
     import tomllib
 
     from ..couette.config import load_config
-    from ..sweep import map_tasks
+    from ..sweep import map_tasks, open_executor
     from ..validation import check_range
 
     load_config(config)  # validate once, with field names, before dispatching
@@ -153,20 +153,8 @@ def sweep_cmd(
     check_range("specularity coefficient phi'", specs, low=0.0, high=1.0, low_open=True)
     check_range("wall restitution e_w", ews, low=0.0, high=1.0, low_open=True)
     tasks = [(data, float(s), float(e)) for e in ews for s in specs]
-    executor = None
-    if dask:
-        from distributed import Client
-
-        executor = Client(dask)
-    elif workers > 0:
-        from concurrent.futures import ProcessPoolExecutor
-
-        executor = ProcessPoolExecutor(workers)
-    try:
+    with open_executor(workers, dask) as executor:
         rows = map_tasks(_sweep_task, tasks, executor=executor)
-    finally:
-        if executor is not None:
-            executor.shutdown() if hasattr(executor, "shutdown") else executor.close()
     emit(rows, fmt, title=f"Couette sweep ({config}): slip = |u_sl|/U at the bottom wall")
     if out is not None:
         from ..plotting.couette import plot_sweep

@@ -184,21 +184,10 @@ def map_cmd(
     phi = np.linspace(phi_min, phi_max, n_phi)
     e = np.linspace(e_min, e_max, n_e)
     start = time.perf_counter()
-    executor: Any = None
-    try:
-        if scheduler:
-            from distributed import Client
+    from ..sweep import open_executor
 
-            executor = Client(scheduler)
-        elif workers:
-            from concurrent.futures import ProcessPoolExecutor
-
-            executor = ProcessPoolExecutor(workers)
-        with DelayedProgress("stability map") as bar:
-            ds = stability_map(models, phi, e, executor=executor, progress=bar)
-    finally:
-        if executor is not None:
-            (executor.close if scheduler else executor.shutdown)()
+    with open_executor(workers, scheduler) as executor, DelayedProgress("stability map") as bar:
+        ds = stability_map(models, phi, e, executor=executor, progress=bar)
     path = write_netcdf(ds, out)
     typer.echo(f"wrote {path}: {len(models)} models x {n_phi} phi x {n_e} e in {time.perf_counter() - start:.2f} s")
 

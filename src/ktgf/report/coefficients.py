@@ -156,7 +156,7 @@ def discuss(nb: dict[str, Any]) -> list[str]:
             "Against the DEM equation of state measured in homogeneous cooling, the mean |error| of p* is "
             + ", ".join(f"{labels.get(n, get_model(n).label)} {100 * v:.1f} %" for n, v in pe.items())
             + f"; {verdict}"
-            + (f" (for φ ≥ 0.3: " + ", ".join(f"{get_model(n).label} {100 * v:.1f} %" for n, v in pd.items()) + ")." if pd else ".")
+            + (" (for φ ≥ 0.3: " + ", ".join(f"{get_model(n).label} {100 * v:.1f} %" for n, v in pd.items()) + ")." if pd else ".")
         )
     es = nb.get("eta_shear_error")
     if es:

@@ -8,7 +8,6 @@ cache key of the sections that use it.
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import Any
 
