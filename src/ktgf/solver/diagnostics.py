@@ -16,7 +16,6 @@ mode_velocity  |w_k| = |û_k|/√(2θ_mean) of the lowest mode along each axis
 
 from __future__ import annotations
 
-from functools import partial
 from typing import Any
 
 import jax
@@ -47,7 +46,7 @@ def velocity_split(u: Any, grid: Grid) -> tuple[Any, Any]:
     return upar, uh - upar
 
 
-@partial(jax.jit, static_argnames=("grid", "rho_s"))
+@jax.jit
 def diagnostics(U: Any, grid: Grid, rho_s: float) -> dict[str, Any]:
     """The diagnostics of the module docstring for state U."""
     W = primitive(U)

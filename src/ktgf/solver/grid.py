@@ -1,7 +1,7 @@
 """Uniform periodic Cartesian grids in 1, 2 or 3 dimensions (the dimension is data).
 
-A :class:`Grid` is frozen and hashable so kernels can take it as a static ``jax.jit``
-argument.  Cell ``i`` along axis ``a`` covers ``[i Δx_a, (i+1) Δx_a)``; its centre is
+A :class:`Grid` is a JAX pytree: the cell counts are static (they fix array shapes), the
+box lengths are traced leaves, so boxes of different size share one compiled kernel.  Cell ``i`` along axis ``a`` covers ``[i Δx_a, (i+1) Δx_a)``; its centre is
 ``(i + 1/2) Δx_a``.  Fields are stored as arrays of shape ``grid.cells`` (one axis per
 spatial dimension); the velocity always has three components (a 1D or 2D grid is a
 3D flow that does not vary along the missing axes), so transverse modes exist in 1D.
@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import jax
 import numpy as np
 
 from ..errors import InputError
@@ -20,6 +21,7 @@ from ..errors import InputError
 MIN_CELLS = 4
 
 
+@jax.tree_util.register_pytree_node_class
 @dataclass(frozen=True)
 class Grid:
     """Periodic box of ``cells[a]`` cells of width ``lengths[a]/cells[a]`` along axis ``a``.
@@ -50,6 +52,16 @@ class Grid:
         for a, v in enumerate(lengths):
             if not (math.isfinite(v) and v > 0):
                 raise InputError(f"grid lengths[{a}] = {v:g} is out of range: valid 0 < length (m)")
+
+    def tree_flatten(self) -> tuple[tuple[float, ...], tuple[int, ...]]:
+        return self.lengths, self.cells
+
+    @classmethod
+    def tree_unflatten(cls, cells: tuple[int, ...], lengths: tuple) -> "Grid":
+        obj = object.__new__(cls)  # no validation: leaves may be tracers
+        object.__setattr__(obj, "cells", cells)
+        object.__setattr__(obj, "lengths", tuple(lengths))
+        return obj
 
     @property
     def ndim(self) -> int:

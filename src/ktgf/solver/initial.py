@@ -97,23 +97,24 @@ def single_mode(
 def random_velocity(
     grid: Grid, phys: Physics, phi0: float, theta0: float, amplitude: float, seed: int, max_mode: int = 2,
 ) -> Any:
-    """HCS plus a seeded random velocity field of the Fourier modes |n_a| ≤ ``max_mode``.
+    """HCS plus seeded random velocity and density fields of the Fourier modes |n_a| ≤ ``max_mode``.
 
-    The field has zero mean and root-mean-square amplitude ``amplitude``·√θ0 per component;
-    it is the same physical field on every grid that resolves those modes.
+    The velocity has zero mean and root-mean-square amplitude ``amplitude``·√θ0 per
+    component, δφ/φ0 has rms ``amplitude``; both are the same physical fields on every grid
+    that resolves those modes.
     """
     rng = np.random.default_rng(seed)
     x = grid.mesh()
     ranges = [range(-max_mode, max_mode + 1)] * grid.ndim
-    u = np.zeros((3, *grid.cells))
+    f = np.zeros((4, *grid.cells))
     for n in np.array(np.meshgrid(*ranges, indexing="ij")).reshape(grid.ndim, -1).T:
         if not any(n):
             continue
         k = grid.wavevector(tuple(int(v) for v in n))
         arg = sum(k[a] * x[a] for a in range(grid.ndim))
-        amp = rng.normal(size=3) + 1j * rng.normal(size=3)
-        u += np.real(amp[:, None].reshape((3,) + (1,) * grid.ndim) * np.exp(1j * arg)[None])
-    rms = np.sqrt(np.mean(u**2))
-    u *= amplitude * math.sqrt(theta0) / rms
+        amp = rng.normal(size=4) + 1j * rng.normal(size=4)
+        f += np.real(amp.reshape((4,) + (1,) * grid.ndim) * np.exp(1j * arg)[None])
+    u = f[:3] * (amplitude * math.sqrt(theta0) / np.sqrt(np.mean(f[:3] ** 2)))
+    drho = f[3] * (amplitude / np.sqrt(np.mean(f[3] ** 2)))
     rho, _, theta = uniform_fields(grid, phys, phi0, theta0)
-    return conservative(jnp.asarray(rho), jnp.asarray(u), jnp.asarray(theta))
+    return conservative(jnp.asarray(rho * (1.0 + drho)), jnp.asarray(u), jnp.asarray(theta))

@@ -11,15 +11,20 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import jax
 import jax.numpy as jnp
 
 from ..closures.coefficients import Reduced, eta0, nu0
 from ..closures.models import Model
 
 
+@jax.tree_util.register_pytree_node_class
 @dataclass(frozen=True)
 class Physics:
-    """Closure model plus the particle properties; frozen and hashable (a static jit argument).
+    """Closure model plus the particle properties.
+
+    A JAX pytree: the model is static (it selects the closure functions), the numbers are
+    traced leaves, so changing e, d or ρ_s does not recompile.
 
     Parameters
     ----------
@@ -40,6 +45,13 @@ class Physics:
     diameter: float
     material_density: float
     phi_stop: float
+
+    def tree_flatten(self) -> tuple[tuple, Model]:
+        return (self.restitution, self.diameter, self.material_density, self.phi_stop), self.model
+
+    @classmethod
+    def tree_unflatten(cls, model: Model, leaves: tuple) -> "Physics":
+        return cls(model, *leaves)
 
     def reduced(self, rho: Any) -> Reduced:
         """Reduced coefficients at bulk density ρ (φ = ρ/ρ_s), unchecked (jit-safe)."""

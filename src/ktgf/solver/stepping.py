@@ -35,7 +35,7 @@ from .fluxes import LIMITERS, RIEMANN_SOLVERS, flux_divergence
 from .grid import Grid
 from .physics import Physics
 from .sources import cooling_source
-from .state import primitive
+from .state import primitive_fields
 
 STATUS_MESSAGES = {
     0: "ok",
@@ -85,15 +85,16 @@ class Numerics:
 
 def rhs(U: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
     """dU/dt = −∇·F(U) + S(U)."""
-    W = primitive(U)
+    W = primitive_fields(U)
     dU, divu = flux_divergence(W, grid, phys, num.limiter, num.riemann)
     source, _ = cooling_source(W, divu, phys)
-    return dU.at[4].add(source)
+    dU[4] = dU[4] + source
+    return tuple(dU)
 
 
 def stable_dt(U: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
     """Largest step allowed by the acoustic, diffusive and cooling limits (see :class:`Numerics`)."""
-    W = primitive(U)
+    W = primitive_fields(U)
     rho, u, theta = W[0], W[1:4], W[4]
     r = phys.reduced(rho)
     c = phys.sound_speed(theta, r)
@@ -111,15 +112,15 @@ def stable_dt(U: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
 def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
     """One SSP-RK3 step of size dt."""
     L = partial(rhs, grid=grid, phys=phys, num=num)
-    U1 = U + dt * L(U)
-    U2 = 0.75 * U + 0.25 * (U1 + dt * L(U1))
-    return U / 3.0 + (2.0 / 3.0) * (U2 + dt * L(U2))
+    U1 = tuple(u + dt * l for u, l in zip(U, L(U)))
+    U2 = tuple(0.75 * u + 0.25 * (u1 + dt * l) for u, u1, l in zip(U, U1, L(U1)))
+    return tuple(u / 3.0 + (2.0 / 3.0) * (u2 + dt * l) for u, u2, l in zip(U, U2, L(U2)))
 
 
 def state_status(U: Any, phys: Physics) -> Any:
     """Status code (0 fine, 1 non-finite, 2 θ ≤ 0, 3 φ ≥ phi_stop, 4 ρ ≤ 0) of a state."""
-    W = primitive(U)
-    finite = jnp.all(jnp.isfinite(U))
+    W = primitive_fields(U)
+    finite = jnp.all(jnp.stack([jnp.all(jnp.isfinite(f)) for f in U]))
     return jnp.where(
         ~finite, 1,
         jnp.where(jnp.min(W[4]) <= 0.0, 2,
@@ -128,7 +129,7 @@ def state_status(U: Any, phys: Physics) -> Any:
     ).astype(jnp.int32)
 
 
-@partial(jax.jit, static_argnames=("grid", "phys", "num"))
+@partial(jax.jit, static_argnames=("num",))
 def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physics, num: Numerics) -> tuple:
     """Step from time t towards t_end (the last step is shortened to land on it exactly).
 
@@ -149,16 +150,18 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         U_new = ssprk3_step(U, dt, grid, phys, num)
         status = jnp.where(jnp.isfinite(dt_stable) & (dt > 0), state_status(U_new, phys), 5)
         good = status == 0
-        U = jnp.where(good, U_new, U)
+        U = tuple(jnp.where(good, a, b) for a, b in zip(U_new, U))
         t = jnp.where(good, jnp.where(last, t_end, t + dt), t)
         return U, t, n + good.astype(n.dtype), status, dt
 
-    t = jnp.asarray(t, U.dtype)
-    init = (U, t, jnp.zeros((), jnp.int64 if U.dtype == jnp.float64 else jnp.int32), jnp.zeros((), jnp.int32), jnp.zeros((), U.dtype))
-    return jax.lax.while_loop(cond, body, init)
+    U = tuple(U)
+    t = jnp.asarray(t, U[0].dtype)
+    init = (U, t, jnp.zeros((), jnp.int32), jnp.zeros((), jnp.int32), jnp.zeros((), U[0].dtype))
+    U, t, n, status, dt = jax.lax.while_loop(cond, body, init)
+    return jnp.stack(U), t, n, status, dt
 
 
-@partial(jax.jit, static_argnames=("grid", "phys", "num"))
+@partial(jax.jit, static_argnames=("num",))
 def step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
     """One SSP-RK3 step (compiled), used to reproduce a failed step for its diagnosis."""
-    return ssprk3_step(U, dt, grid, phys, num)
+    return jnp.stack(ssprk3_step(tuple(U), dt, grid, phys, num))
