@@ -47,9 +47,10 @@ STATUS_MESSAGES = {
 }
 
 
+@jax.tree_util.register_pytree_node_class
 @dataclass(frozen=True)
 class Numerics:
-    """Numerical options (frozen, a static jit argument).
+    """Numerical options: a pytree whose Courant numbers are traced and whose scheme choices are static.
 
     Parameters
     ----------
@@ -73,6 +74,16 @@ class Numerics:
     limiter: str = "vanleer"
     riemann: str = "hll"
     dt_max: float = float("inf")
+
+    def tree_flatten(self) -> tuple[tuple, tuple[str, str]]:
+        return (self.cfl, self.cfl_diffusion, self.cfl_source, self.dt_max), (self.limiter, self.riemann)
+
+    @classmethod
+    def tree_unflatten(cls, aux: tuple[str, str], leaves: tuple) -> "Numerics":
+        obj = object.__new__(cls)
+        for name, v in zip(("cfl", "cfl_diffusion", "cfl_source", "dt_max", "limiter", "riemann"), (*leaves, *aux)):
+            object.__setattr__(obj, name, v)
+        return obj
 
     def __post_init__(self) -> None:
         from ..errors import InputError
@@ -129,7 +140,7 @@ def state_status(U: Any, phys: Physics) -> Any:
     ).astype(jnp.int32)
 
 
-@partial(jax.jit, static_argnames=("num",))
+@jax.jit
 def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physics, num: Numerics) -> tuple:
     """Step from time t towards t_end (the last step is shortened to land on it exactly).
 
@@ -161,7 +172,7 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
     return jnp.stack(U), t, n, status, dt
 
 
-@partial(jax.jit, static_argnames=("num",))
+@jax.jit
 def step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
     """One SSP-RK3 step (compiled), used to reproduce a failed step for its diagnosis."""
     return jnp.stack(ssprk3_step(tuple(U), dt, grid, phys, num))
