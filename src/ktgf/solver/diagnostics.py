@@ -5,7 +5,8 @@ All are scalars (or one value per grid axis) computed in one compiled function:
 ============== ==========================================================================
 theta_mean     mass-averaged granular temperature Σρθ/Σρ [m²/s²] (compare with Haff's law)
 kinetic_energy mean-flow kinetic energy per unit mass Σ½ρ|u|²/Σρ [m²/s²]
-ke_transverse  ½⟨|u⊥|²⟩, the solenoidal (vortex) part of u from its Fourier transform [m²/s²]
+ke_transverse  ½⟨|u⊥|²⟩, the solenoidal (vortex) part of u from its Fourier transform, without
+               the k = 0 (uniform drift) mode [m²/s²]
 ke_longitudinal ½⟨|u∥|²⟩, the compressive part [m²/s²]
 density_variance ⟨(φ − ⟨φ⟩)²⟩/⟨φ⟩² (cluster growth)
 phi_max, theta_min largest solid fraction, smallest temperature
@@ -43,7 +44,8 @@ def velocity_split(u: Any, grid: Grid) -> tuple[Any, Any]:
     kdotu = sum(k[j] * uh[j] for j in range(3))
     proj = kdotu / jnp.where(k2 > 0, k2, 1.0)
     upar = jnp.stack([k[j] * proj for j in range(3)])
-    return upar, uh - upar
+    uperp = (uh - upar) * (k2 > 0)
+    return upar, uperp
 
 
 @jax.jit

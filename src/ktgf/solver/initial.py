@@ -117,4 +117,7 @@ def random_velocity(
     u = f[:3] * (amplitude * math.sqrt(theta0) / np.sqrt(np.mean(f[:3] ** 2)))
     drho = f[3] * (amplitude / np.sqrt(np.mean(f[3] ** 2)))
     rho, _, theta = uniform_fields(grid, phys, phi0, theta0)
-    return conservative(jnp.asarray(rho * (1.0 + drho)), jnp.asarray(u), jnp.asarray(theta))
+    rho = rho * (1.0 + drho)
+    # Zero total momentum: the box frame is the centre-of-mass frame (no uniform drift).
+    u -= (np.sum(rho * u, axis=tuple(range(1, grid.ndim + 1))) / np.sum(rho)).reshape((3,) + (1,) * grid.ndim)
+    return conservative(jnp.asarray(rho), jnp.asarray(u), jnp.asarray(theta))
