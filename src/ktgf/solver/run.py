@@ -34,7 +34,7 @@ from .initial import haff_time, random_velocity, single_mode, t_of_tau, tau_of_t
 from .io import load_checkpoint, save_checkpoint, save_slices, write_vti
 from .physics import Physics
 from .state import PRIMITIVE_NAMES, conservative, primitive
-from .stepping import STATUS_MESSAGES, Numerics, advance, step
+from .stepping import STATUS_MESSAGES, Numerics, advance, state_status, step
 
 CHECKPOINT = "checkpoint.npz"
 TIMESERIES = "hcs.nc"
@@ -136,6 +136,12 @@ class Simulation:
             U, t, steps, k, history = self.place(ck["U"]), ck["t"], ck["steps"], ck["output_index"], ck["history"]
         else:
             U, t, steps, k = self.initial_state(), 0.0, 0, 0
+            status = int(state_status(tuple(U), self.phys))
+            if status:
+                raise InputError(
+                    f"initial state: {STATUS_MESSAGES[status]} (phi_stop = {self.phys.phi_stop:g}); "
+                    "reduce initial.amplitude or raise numerics.phi_stop"
+                )
             history = {name: [] for name in ("time", *SCALARS, *PER_AXIS)}
         self.history = history
         ckpt = self.directory / CHECKPOINT

@@ -40,7 +40,7 @@ STATUS_MESSAGES = {
     0: "ok",
     1: "non-finite value (NaN or inf)",
     2: "granular temperature theta <= 0",
-    3: "solid fraction reached phi_stop (packing limit)",
+    3: "solid fraction reached phi_stop (near the packing limit)",
     4: "density <= 0",
     5: "stable time step collapsed",
 }
@@ -166,7 +166,8 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         last = dt_stable >= t_end - t
         dt = jnp.where(last, t_end - t, dt_stable)
         U_new = ssprk3_step(U, dt, grid, phys, num)
-        status = jnp.where(jnp.isfinite(dt_stable) & (dt > 0), state_status(U_new, phys), 5)
+        bad_state = state_status(U_new, phys)
+        status = jnp.where(bad_state != 0, bad_state, jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5))
         good = status == 0
         U = tuple(jnp.where(good, a, b) for a, b in zip(U_new, U))
         t = jnp.where(good, jnp.where(last, t_end, t + dt), t)
