@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from typing import Any, Sequence
 
+import jax
 import jax.numpy as jnp
 
 from .grid import Grid
@@ -44,15 +45,46 @@ def limited_slope(dm: Any, dp: Any, limiter: str) -> Any:
     return jnp.where(prod > 0.0, s, 0.0)
 
 
-def reconstruct(W: Sequence[Any], axis: int, limiter: str) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
-    """Left and right primitive states at the faces i+1/2 along spatial ``axis`` (MUSCL)."""
+#: Ghost cells per side: the MUSCL stencil of a face reaches two cells away.
+GHOST = 2
+
+
+def pad_periodic(W: Sequence[Any], ndim: int) -> tuple[Any, ...]:
+    """Fields with GHOST periodic ghost cells on each side of every grid axis.
+
+    Padding once per stage and then reading stencils as static slices keeps the fused loops
+    free of the concatenations that ``jnp.roll`` would put in every one of them.
+    """
+    return tuple(jnp.pad(f, [(GHOST, GHOST)] * ndim, mode="wrap") for f in W)
+
+
+def window(P: Any, cells: tuple[int, ...], axis: int, offset: int, extra: int, shift: tuple[int, ...] = ()) -> Any:
+    """Block of padded field P: along ``axis`` cells offset … N−1+extra+offset, others interior.
+
+    ``shift`` optionally moves the block by ±1 along other axes (tangential stencils).
+    """
+    start, stop = [], []
+    for b, n in enumerate(cells):
+        d = shift[b] if shift else 0
+        if b == axis:
+            start.append(GHOST + offset)
+            stop.append(GHOST + offset + n + extra)
+        else:
+            start.append(GHOST + d)
+            stop.append(GHOST + d + n)
+    return jax.lax.slice(P, start, stop)
+
+
+def reconstruct(P: Sequence[Any], cells: tuple[int, ...], axis: int, limiter: str) -> tuple[list[Any], list[Any]]:
+    """Left and right primitive states at the N+1 faces −1/2 … N−1/2 along ``axis`` (MUSCL)."""
     left, right = [], []
-    for f in W:
-        fm, fp = jnp.roll(f, 1, axis), jnp.roll(f, -1, axis)
-        half = 0.5 * limited_slope(f - fm, fp - f, limiter)
-        left.append(f + half)
-        right.append(jnp.roll(f - half, -1, axis))
-    return tuple(left), tuple(right)
+    for f in P:
+        fm, fc, fp = (window(f, cells, axis, o, 2) for o in (-2, -1, 0))  # cells −1 … N
+        half = 0.5 * limited_slope(fc - fm, fp - fc, limiter)
+        n = cells[axis]
+        left.append(jax.lax.slice_in_dim(fc + half, 0, n + 1, axis=axis))
+        right.append(jax.lax.slice_in_dim(fc - half, 1, n + 2, axis=axis))
+    return left, right
 
 
 def _euler_flux(W: Sequence[Any], U: Sequence[Any], p: Any, a: int) -> list[Any]:
@@ -61,9 +93,11 @@ def _euler_flux(W: Sequence[Any], U: Sequence[Any], p: Any, a: int) -> list[Any]
     return [U[0] * un, *mom, (U[4] + p) * un]
 
 
-def convective_flux(W: Sequence[Any], axis: int, phys: Physics, limiter: str, riemann: str) -> list[Any]:
-    """Upwind flux (HLL or Rusanov) of the Euler part at the faces along ``axis``."""
-    WL, WR = reconstruct(W, axis, limiter)
+def convective_flux(
+    P: Sequence[Any], cells: tuple[int, ...], axis: int, phys: Physics, limiter: str, riemann: str
+) -> list[Any]:
+    """Upwind flux (HLL or Rusanov) of the Euler part at the N+1 faces along ``axis`` (padded input P)."""
+    WL, WR = reconstruct(P, cells, axis, limiter)
     rL, rR = phys.reduced(WL[0]), phys.reduced(WR[0])
     pL, pR = phys.pressure(WL[0], WL[4], rL), phys.pressure(WR[0], WR[4], rR)
     cL, cR = phys.sound_speed(WL[4], rL), phys.sound_speed(WR[4], rR)
@@ -80,53 +114,64 @@ def convective_flux(W: Sequence[Any], axis: int, phys: Physics, limiter: str, ri
     return [(sr * fl - sl * fr + sl * sr * (ur - ul)) * inv for fl, fr, ul, ur in zip(FL, FR, UL, UR)]
 
 
-def cell_gradients(u: Sequence[Any], grid: Grid) -> list[list[Any]]:
-    """Central differences G[b][j] = ∂u_j/∂x_b at cell centres (b over grid axes, j over 3 components)."""
-    return [
-        [(jnp.roll(u[j], -1, b) - jnp.roll(u[j], 1, b)) * (0.5 / grid.spacing[b]) for j in range(3)]
-        for b in range(grid.ndim)
-    ]
+def _central(P: Any, grid: Grid, axis: int, b: int, offset: int) -> Any:
+    """∂f/∂x_b by central differences at the cells offset … N+offset along ``axis``."""
+    plus = tuple(1 if c == b else 0 for c in range(grid.ndim))
+    minus = tuple(-1 if c == b else 0 for c in range(grid.ndim))
+    if b == axis:
+        fp = window(P, grid.cells, axis, offset + 1, 1)
+        fm = window(P, grid.cells, axis, offset - 1, 1)
+    else:
+        fp = window(P, grid.cells, axis, offset, 1, plus)
+        fm = window(P, grid.cells, axis, offset, 1, minus)
+    return (fp - fm) * (0.5 / grid.spacing[b])
 
 
-def viscous_flux(W: Sequence[Any], G: list[list[Any]], axis: int, grid: Grid, phys: Physics) -> list[Any]:
-    """Viscous and heat flux at the faces along ``axis``: (0, −τ·e_a, −(τ·u)_a + q_a).
+def viscous_flux(P: Sequence[Any], axis: int, grid: Grid, phys: Physics) -> list[Any]:
+    """Viscous and heat flux at the N+1 faces along ``axis``: (0, −τ·e_a, −(τ·u)_a + q_a).
 
     Normal derivatives are two-point differences across the face; tangential ones the mean
     of the two cells' central differences.  Coefficients use the face state (mean of cells).
     """
     a = axis
     inv_dx = 1.0 / grid.spacing[a]
-    Wn = [jnp.roll(f, -1, a) for f in W]
-    rho_f, th_f = 0.5 * (W[0] + Wn[0]), 0.5 * (W[4] + Wn[4])
-    u_f = [0.5 * (W[1 + j] + Wn[1 + j]) for j in range(3)]
+    Wl = [window(f, grid.cells, a, -1, 1) for f in P]  # cells −1 … N−1
+    Wr = [window(f, grid.cells, a, 0, 1) for f in P]  # cells 0 … N
+    rho_f, th_f = 0.5 * (Wl[0] + Wr[0]), 0.5 * (Wl[4] + Wr[4])
+    u_f = [0.5 * (Wl[1 + j] + Wr[1 + j]) for j in range(3)]
 
     def grad(b: int, j: int) -> Any:  # ∂u_j/∂x_b at the face
         if b == a:
-            return (Wn[1 + j] - W[1 + j]) * inv_dx
+            return (Wr[1 + j] - Wl[1 + j]) * inv_dx
         if b >= grid.ndim:
             return 0.0
-        return 0.5 * (G[b][j] + jnp.roll(G[b][j], -1, a))
+        return 0.5 * (_central(P[1 + j], grid, a, b, -1) + _central(P[1 + j], grid, a, b, 0))
 
     divu = sum(grad(b, b) for b in range(grid.ndim))
     r = phys.reduced(rho_f)
     eta, lam, kap, omega = phys.transport(rho_f, th_f, r)
     tau = [eta * (grad(a, j) + grad(j, a)) for j in range(3)]
     tau[a] = tau[a] + (lam - (2.0 / 3.0) * eta) * divu
-    q = -kap * (Wn[4] - W[4]) * inv_dx - omega * (Wn[0] - W[0]) * (inv_dx / phys.material_density)
+    q = -kap * (Wr[4] - Wl[4]) * inv_dx - omega * (Wr[0] - Wl[0]) * (inv_dx / phys.material_density)
     work = tau[0] * u_f[0] + tau[1] * u_f[1] + tau[2] * u_f[2]
     return [0.0, -tau[0], -tau[1], -tau[2], q - work]
 
 
 def flux_divergence(W: Sequence[Any], grid: Grid, phys: Physics, limiter: str, riemann: str) -> tuple[list[Any], Any]:
     """−∇·F of the total (convective + viscous + heat) flux per field, and the cell-centred ∇·u."""
-    G = cell_gradients(W[1:4], grid)
+    P = pad_periodic(W, grid.ndim)
     out: list[Any] = [0.0] * 5
     for a in range(grid.ndim):
-        Fc = convective_flux(W, a, phys, limiter, riemann)
-        Fv = viscous_flux(W, G, a, grid, phys)
+        Fc = convective_flux(P, grid.cells, a, phys, limiter, riemann)
+        Fv = viscous_flux(P, a, grid, phys)
         inv_dx = 1.0 / grid.spacing[a]
+        n = grid.cells[a]
         for i in range(5):
             F = Fc[i] + Fv[i]
-            out[i] = out[i] - (F - jnp.roll(F, 1, a)) * inv_dx
-    divu = sum(G[b][b] for b in range(grid.ndim))
+            dF = jax.lax.slice_in_dim(F, 1, n + 1, axis=a) - jax.lax.slice_in_dim(F, 0, n, axis=a)
+            out[i] = out[i] - dF * inv_dx
+    divu = sum(
+        (window(P[1 + b], grid.cells, b, 1, 0) - window(P[1 + b], grid.cells, b, -1, 0)) * (0.5 / grid.spacing[b])
+        for b in range(grid.ndim)
+    )
     return out, divu
