@@ -70,6 +70,34 @@ def main() -> None:
         t_copy = min(t_copy, time.perf_counter() - t0)
     bound = grid.size / (3 * t_copy)
 
+    # Where the time goes: each part of one right-hand-side evaluation compiled on its own.
+    from ktgf.solver.fluxes import convective_flux, pad_periodic, viscous_flux
+    from ktgf.solver.sources import cooling_source
+    from ktgf.solver.state import primitive_fields
+    from ktgf.solver.stepping import rhs, stable_dt
+
+    Ut = tuple(U)
+    W = primitive_fields(Ut)
+    P = pad_periodic(W, 3)
+    parts = {
+        "rhs (one RK stage)": (jax.jit(lambda U: rhs(U, grid, phys, num)), Ut),
+        "  pad + primitive": (jax.jit(lambda U: pad_periodic(primitive_fields(U), 3)), Ut),
+        "  convective flux, 3 axes": (jax.jit(lambda P: [convective_flux(P, grid.cells, a, phys, num.limiter, num.riemann)
+                                                           for a in range(3)]), P),
+        "  viscous + heat flux, 3 axes": (jax.jit(lambda P: [viscous_flux(P, a, grid, phys)[1:] for a in range(3)]), P),
+        "  cooling source": (jax.jit(lambda W: cooling_source(W, W[1], phys)[0]), W),
+        "stable dt (once per step)": (jax.jit(lambda U: stable_dt(U, grid, phys, num)), Ut),
+    }
+    timings = {}
+    for name, (fn, arg) in parts.items():
+        jax.block_until_ready(fn(arg))
+        best_part = np.inf
+        for _ in range(args.repeats):
+            t0 = time.perf_counter()
+            jax.block_until_ready(fn(arg))
+            best_part = min(best_part, time.perf_counter() - t0)
+        timings[name] = best_part
+
     if args.profile:
         jax.profiler.start_trace(args.profile)
         jax.block_until_ready(advance(U, 0.0, far, 2, grid, phys, num))
@@ -81,7 +109,11 @@ def main() -> None:
     print(f"stepping: {args.steps} steps in {best:.3f} s (best of {args.repeats}) = {args.steps / best:.2f} steps/s")
     print(f"rate: {rate / 1e6:.3f} M cell-steps/s   (aim 2 M on 2 cores)")
     print(f"bandwidth bound (one state copy of {host.nbytes / 1e6:.1f} MB per RK stage, {t_copy * 1e3:.2f} ms): "
-          f"{bound / 1e6:.1f} M cell-steps/s;  ratio rate/bound = {rate / bound:.3f}")
+          f"{bound / 1e6:.1f} M cell-steps/s;  ratio rate/bound = {rate / bound:.4f}")
+    step_time = best / args.steps
+    print(f"time per step {step_time * 1e3:.1f} ms; parts (compiled separately, best of {args.repeats}):")
+    for name, t in timings.items():
+        print(f"  {name:32s} {t * 1e3:8.1f} ms  ({t / grid.size * 1e9:6.1f} ns/cell)")
 
 
 if __name__ == "__main__":

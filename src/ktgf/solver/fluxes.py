@@ -47,6 +47,14 @@ def limited_slope(dm: Any, dp: Any, limiter: str) -> Any:
 
 #: Ghost cells per side: the MUSCL stencil of a face reaches two cells away.
 GHOST = 2
+#: Materialise shared intermediates (padded fields, face states, wave speeds, transport
+#: coefficients) with ``lax.optimization_barrier`` so XLA does not recompute them inside every
+#: consumer fusion (there are 5 flux components × 2 faces per cell consuming each).
+MATERIALISE = True
+
+
+def _keep(x: Any) -> Any:
+    return jax.lax.optimization_barrier(x) if MATERIALISE else x
 
 
 def pad_periodic(W: Sequence[Any], ndim: int) -> tuple[Any, ...]:
@@ -55,7 +63,7 @@ def pad_periodic(W: Sequence[Any], ndim: int) -> tuple[Any, ...]:
     Padding once per stage and then reading stencils as static slices keeps the fused loops
     free of the concatenations that ``jnp.roll`` would put in every one of them.
     """
-    return tuple(jnp.pad(f, [(GHOST, GHOST)] * ndim, mode="wrap") for f in W)
+    return _keep(tuple(jnp.pad(f, [(GHOST, GHOST)] * ndim, mode="wrap") for f in W))
 
 
 def window(P: Any, cells: tuple[int, ...], axis: int, offset: int, extra: int, shift: tuple[int, ...] = ()) -> Any:
@@ -97,13 +105,14 @@ def convective_flux(
     P: Sequence[Any], cells: tuple[int, ...], axis: int, phys: Physics, limiter: str, riemann: str
 ) -> list[Any]:
     """Upwind flux (HLL or Rusanov) of the Euler part at the N+1 faces along ``axis`` (padded input P)."""
-    WL, WR = reconstruct(P, cells, axis, limiter)
+    WL, WR = _keep(reconstruct(P, cells, axis, limiter))
     rL, rR = phys.reduced(WL[0]), phys.reduced(WR[0])
     pL, pR = phys.pressure(WL[0], WL[4], rL), phys.pressure(WR[0], WR[4], rR)
     cL, cR = phys.sound_speed(WL[4], rL), phys.sound_speed(WR[4], rR)
     UL, UR = conservative_fields(WL), conservative_fields(WR)
     FL, FR = _euler_flux(WL, UL, pL, axis), _euler_flux(WR, UR, pR, axis)
     uL, uR = WL[1 + axis], WR[1 + axis]
+    pL, pR, cL, cR = _keep((pL, pR, cL, cR))
     if riemann == "rusanov":
         smax = jnp.maximum(jnp.abs(uL) + cL, jnp.abs(uR) + cR)
         return [0.5 * (fl + fr) - 0.5 * smax * (ur - ul) for fl, fr, ul, ur in zip(FL, FR, UL, UR)]
@@ -114,16 +123,12 @@ def convective_flux(
     return [(sr * fl - sl * fr + sl * sr * (ur - ul)) * inv for fl, fr, ul, ur in zip(FL, FR, UL, UR)]
 
 
-def _central(P: Any, grid: Grid, axis: int, b: int, offset: int) -> Any:
-    """∂f/∂x_b by central differences at the cells offset … N+offset along ``axis``."""
+def _central(P: Any, grid: Grid, axis: int, b: int) -> Any:
+    """∂f/∂x_b (b ≠ axis) by central differences at the cells −1 … N along ``axis``."""
     plus = tuple(1 if c == b else 0 for c in range(grid.ndim))
     minus = tuple(-1 if c == b else 0 for c in range(grid.ndim))
-    if b == axis:
-        fp = window(P, grid.cells, axis, offset + 1, 1)
-        fm = window(P, grid.cells, axis, offset - 1, 1)
-    else:
-        fp = window(P, grid.cells, axis, offset, 1, plus)
-        fm = window(P, grid.cells, axis, offset, 1, minus)
+    fp = window(P, grid.cells, axis, -1, 2, plus)
+    fm = window(P, grid.cells, axis, -1, 2, minus)
     return (fp - fm) * (0.5 / grid.spacing[b])
 
 
@@ -140,18 +145,31 @@ def viscous_flux(P: Sequence[Any], axis: int, grid: Grid, phys: Physics) -> list
     rho_f, th_f = 0.5 * (Wl[0] + Wr[0]), 0.5 * (Wl[4] + Wr[4])
     u_f = [0.5 * (Wl[1 + j] + Wr[1 + j]) for j in range(3)]
 
+    n = grid.cells[a]
+    # Tangential derivatives at the faces: mean of the central differences of the two cells.
+    tangential = {}
+    for b in range(grid.ndim):
+        if b != a:
+            for j in range(3):
+                g = _central(P[1 + j], grid, a, b)
+                tangential[b, j] = 0.5 * (
+                    jax.lax.slice_in_dim(g, 0, n + 1, axis=a) + jax.lax.slice_in_dim(g, 1, n + 2, axis=a)
+                )
+    tangential = _keep(tangential)
+
     def grad(b: int, j: int) -> Any:  # ∂u_j/∂x_b at the face
         if b == a:
             return (Wr[1 + j] - Wl[1 + j]) * inv_dx
         if b >= grid.ndim:
             return 0.0
-        return 0.5 * (_central(P[1 + j], grid, a, b, -1) + _central(P[1 + j], grid, a, b, 0))
+        return tangential[b, j]
 
     divu = sum(grad(b, b) for b in range(grid.ndim))
     r = phys.reduced(rho_f)
-    eta, lam, kap, omega = phys.transport(rho_f, th_f, r)
+    eta, lam, kap, omega = _keep(phys.transport(rho_f, th_f, r))
     tau = [eta * (grad(a, j) + grad(j, a)) for j in range(3)]
     tau[a] = tau[a] + (lam - (2.0 / 3.0) * eta) * divu
+    tau = _keep(tau)
     q = -kap * (Wr[4] - Wl[4]) * inv_dx - omega * (Wr[0] - Wl[0]) * (inv_dx / phys.material_density)
     work = tau[0] * u_f[0] + tau[1] * u_f[1] + tau[2] * u_f[2]
     return [0.0, -tau[0], -tau[1], -tau[2], q - work]
@@ -166,8 +184,9 @@ def flux_divergence(W: Sequence[Any], grid: Grid, phys: Physics, limiter: str, r
         Fv = viscous_flux(P, a, grid, phys)
         inv_dx = 1.0 / grid.spacing[a]
         n = grid.cells[a]
+        F_all = _keep([Fc[i] + Fv[i] for i in range(5)])
         for i in range(5):
-            F = Fc[i] + Fv[i]
+            F = F_all[i]
             dF = jax.lax.slice_in_dim(F, 1, n + 1, axis=a) - jax.lax.slice_in_dim(F, 0, n, axis=a)
             out[i] = out[i] - dF * inv_dx
     divu = sum(
