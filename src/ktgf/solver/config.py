@@ -19,7 +19,7 @@ Example (``examples/hcs_3d.toml``)::
     factor = 1.5            # ... or give `length` in m, or `length_d` in particle diameters
     [time]
     end = 60.0
-    unit = "tau"            # "tau" (collision units along Haff's law), "haff" (t/t0) or "s"
+    unit = "tau"            # "tau" (collision units along Haff's law; outputs equally spaced in tau), "haff" (t/t0) or "s"
     outputs = 60
 
 Errors name the field (``grid.cells.0``, ``initial.solid_fraction``) and the valid range.

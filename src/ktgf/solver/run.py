@@ -75,9 +75,13 @@ class Simulation:
         self.directory = Path(directory if directory is not None else cfg.output.directory)
         self.phi0, self.theta0 = cfg.initial.solid_fraction, cfg.initial.temperature
         self.t_haff = haff_time(self.phys, self.phi0, self.theta0)
-        end = cfg.time.end
-        t_end = {"s": end, "haff": end * self.t_haff, "tau": float(t_of_tau(end, self.phys, self.phi0, self.theta0))}
-        self.output_times = np.linspace(0.0, t_end[cfg.time.unit], cfg.time.outputs + 1)
+        end, n_out = cfg.time.end, cfg.time.outputs
+        if cfg.time.unit == "tau":  # equal steps in τ: the natural clock of a cooling gas
+            self.output_times = np.asarray(t_of_tau(np.linspace(0.0, end, n_out + 1), self.phys, self.phi0, self.theta0))
+        else:
+            t_end = end if cfg.time.unit == "s" else end * self.t_haff
+            self.output_times = np.linspace(0.0, t_end, n_out + 1)
+        self.output_times[0] = 0.0
         self.sharding = self._sharding(cfg.parallel.devices)
 
     def _sharding(self, ndev: int) -> Any:
@@ -276,7 +280,7 @@ class _Progress:
     def __init__(self, enabled: bool, t_end: float, t_haff: float, phys: Physics, phi0: float, theta0: float) -> None:
         self.enabled, self.t_end = enabled, t_end
         self.args = (phys, phi0, theta0)
-        self._steps, self._wall = 0, 0.0
+        self._steps, self._wall, self._first = 0, 0.0, True
 
     def __enter__(self) -> "_Progress":
         if self.enabled:
@@ -293,8 +297,11 @@ class _Progress:
     def update(self, t: float, steps: int, wall: float) -> None:
         if not self.enabled:
             return
-        self._steps += steps
-        self._wall += wall
+        if self._first:  # the first chunk includes compilation: keep it out of the step rate
+            self._first = False
+        else:
+            self._steps += steps
+            self._wall += wall
         rate = f"{self._steps / self._wall:.1f}" if self._wall > 0 else "-"
         tau = float(tau_of_t(t, *self.args))
         self.bar.update(self.task, completed=t, t=f"{t:.4g} s", tau=f"{tau:.3g}", rate=rate)
