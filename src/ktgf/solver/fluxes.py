@@ -184,11 +184,11 @@ def flux_divergence(W: Sequence[Any], grid: Grid, phys: Physics, limiter: str, r
         Fv = viscous_flux(P, a, grid, phys)
         inv_dx = 1.0 / grid.spacing[a]
         n = grid.cells[a]
-        F_all = _keep([Fc[i] + Fv[i] for i in range(5)])
-        for i in range(5):
-            F = F_all[i]
-            dF = jax.lax.slice_in_dim(F, 1, n + 1, axis=a) - jax.lax.slice_in_dim(F, 0, n, axis=a)
-            out[i] = out[i] - dF * inv_dx
+        # One stacked array of face fluxes: XLA then computes all five components in one
+        # loop and materialises them, instead of recomputing the face state in each consumer.
+        F = jnp.stack([Fc[i] + Fv[i] for i in range(5)])
+        dF = jax.lax.slice_in_dim(F, 1, n + 1, axis=a + 1) - jax.lax.slice_in_dim(F, 0, n, axis=a + 1)
+        out = [o - dF[i] * inv_dx for i, o in enumerate(out)]
     divu = sum(
         (window(P[1 + b], grid.cells, b, 1, 0) - window(P[1 + b], grid.cells, b, -1, 0)) * (0.5 / grid.spacing[b])
         for b in range(grid.ndim)
