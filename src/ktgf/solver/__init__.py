@@ -1,0 +1,58 @@
+"""Finite-volume JAX solver of the granular Navier–Stokes equations (model.md §1) in periodic boxes.
+
+Conservative variables (ρ, ρu, E = ρ(|u|²/2 + 3θ/2)) on a uniform periodic grid in 1, 2 or 3
+dimensions (one code path; the velocity always has three components).  MUSCL-reconstructed
+HLL (or Rusanov) convective flux with the granular equation of state p = ρθp*(φ), central
+viscous and heat fluxes (η, λ_b, κ and the ω∇φ term) with the closure coefficients evaluated
+at the faces through ``Model.reduced(φ, e, check=False)``, the collisional sink
+−(3/2)ρθ(ζ0 + ζ_U∇·u), and SSP-RK3 with an adaptive step (acoustic CFL, diffusive and cooling
+limits).  Any registered closure model can be used; the solver never branches on its name.
+
+Modules: :mod:`.grid` (periodic grid, a pytree), :mod:`.state` (variables), :mod:`.physics`
+(EoS, sound speed, SI transport from the Model), :mod:`.fluxes`, :mod:`.sources`,
+:mod:`.stepping` (RHS, Δt, SSP-RK3, compiled ``advance`` with failure detection),
+:mod:`.initial` (HCS states), :mod:`.diagnostics`, :mod:`.io` (netCDF, checkpoints, VTK .vti,
+PNG), :mod:`.config` (pydantic/TOML), :mod:`.run` (:class:`Simulation`).
+
+Precision
+    ``jax_enable_x64`` is switched on when this package is imported (float64 is needed for the
+    verification against linear theory); ``numerics.precision = "float32"`` runs the state in
+    single precision (≈1.6× faster on CPU).
+
+Several devices (one host)
+    ``parallel.devices = N`` shards the first grid axis over N devices with
+    ``jax.sharding.NamedSharding(Mesh(devices, ("x",)), P(None, "x"))``; the same compiled
+    program runs, XLA inserts the halo exchanges for the periodic stencils.  On a CPU, create N
+    devices with ``XLA_FLAGS=--xla_force_host_platform_device_count=N`` (set before Python
+    starts).  The sharded run equals the single-device run to round-off
+    (tests/test_solver_sharding.py).
+
+Several hosts
+    Start one process per host with the same config and call
+    ``jax.distributed.initialize(coordinator_address="host0:1234", num_processes=P,
+    process_id=i)`` before building the :class:`Simulation`; ``jax.devices()`` then lists the
+    devices of all hosts, and ``parallel.devices`` = the total count shards the box across them
+    (grid.cells[0] divisible by it).  Only process 0 should write files: guard outputs with
+    ``jax.process_index() == 0`` and gather fields with
+    ``jax.experimental.multihost_utils.process_allgather`` (not needed on one host).
+
+GPU
+    Install ``jax[cuda12]``; nothing in the solver is CPU specific.  JAX then places arrays on
+    the GPU by default; use float32 on consumer GPUs (slow float64), keep ``time.max_steps_per_call``
+    large (the whole step loop runs on the device inside one ``lax.while_loop``), and shard
+    over several GPUs exactly as above.
+"""
+
+from __future__ import annotations
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+
+from .config import Config, load_config, parse_config  # noqa: E402
+from .grid import Grid  # noqa: E402
+from .physics import Physics  # noqa: E402
+from .run import Simulation  # noqa: E402
+from .stepping import Numerics, advance  # noqa: E402
+
+__all__ = ["Config", "Grid", "Numerics", "Physics", "Simulation", "advance", "load_config", "parse_config"]

@@ -1,0 +1,215 @@
+"""Validated run configuration (TOML → pydantic), checked completely before anything is compiled.
+
+Example (``examples/hcs_3d.toml``)::
+
+    [model]
+    name = "ret"            # any registered model (`ktgf models`)
+    restitution = 0.8
+    [particles]
+    diameter = 1e-3         # m
+    density = 2500.0        # kg/m^3
+    [initial]
+    solid_fraction = 0.25
+    temperature = 1e-4      # m^2/s^2
+    perturbation = "random" # "random", "mode" or "none"
+    amplitude = 0.05        # rms velocity / sqrt(theta0), or mode amplitude
+    [grid]
+    cells = [32, 32, 32]    # 1, 2 or 3 entries: the dimension
+    relative_to = "transverse"   # box side = factor × critical size L_perp (or "longitudinal": L_par)
+    factor = 1.5            # ... or give `length` in m, or `length_d` in particle diameters
+    [time]
+    end = 60.0
+    unit = "tau"            # "tau" (collision units along Haff's law; outputs equally spaced in tau), "haff" (t/t0) or "s"
+    outputs = 60
+
+Errors name the field (``grid.cells.0``, ``initial.solid_fraction``) and the valid range.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from ..errors import InputError, KtgfError
+from .fluxes import LIMITERS, RIEMANN_SOLVERS
+from .grid import MIN_CELLS
+
+
+class _Section(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class ModelSection(_Section):
+    name: str = "ret"
+    restitution: float = Field(0.8, gt=0.0, le=1.0, description="normal restitution coefficient e")
+    options: dict[str, Any] = Field(default_factory=dict, description="model options, e.g. {zeta11 = 'ghd'}")
+
+
+class ParticlesSection(_Section):
+    diameter: float = Field(1e-3, gt=0.0, description="particle diameter d [m]")
+    density: float = Field(2500.0, gt=0.0, description="material density rho_s [kg/m^3]")
+
+
+class InitialSection(_Section):
+    solid_fraction: float = Field(..., gt=0.0, lt=1.0, description="phi0")
+    temperature: float = Field(..., gt=0.0, description="theta0 [m^2/s^2]")
+    perturbation: Literal["random", "mode", "none"] = "random"
+    amplitude: float = Field(1e-2, ge=0.0, le=0.5)
+    seed: int = 0
+    max_mode: int = Field(2, ge=1, description="random field: Fourier modes |n| <= max_mode")
+    mode: list[int] | None = None
+    kind: Literal["transverse", "longitudinal"] = "transverse"
+    branch: int = Field(0, ge=0, le=2)
+
+
+class GridSection(_Section):
+    cells: list[int] = Field(..., min_length=1, max_length=3)
+    length: float | list[float] | None = Field(None, description="box side(s) [m]")
+    length_d: float | list[float] | None = Field(None, description="box side(s) in particle diameters")
+    relative_to: Literal["transverse", "longitudinal"] | None = None
+    factor: float | None = Field(None, gt=0.0, description="box side / critical size")
+
+    @field_validator("cells")
+    @classmethod
+    def _cells(cls, v: list[int]) -> list[int]:
+        for a, n in enumerate(v):
+            if n < MIN_CELLS:
+                raise ValueError(f"cells[{a}] = {n} is out of range: valid cells >= {MIN_CELLS} (a box of a few cells)")
+        return v
+
+    @model_validator(mode="after")
+    def _one_size(self) -> "GridSection":
+        given = [k for k in ("length", "length_d", "relative_to") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError(f"give exactly one of length, length_d or relative_to (+ factor); got {given or 'none'}")
+        if self.relative_to is not None and self.factor is None:
+            raise ValueError("relative_to needs factor (box side / critical size)")
+        for key in ("length", "length_d"):
+            v = getattr(self, key)
+            vals = v if isinstance(v, list) else ([v] if v is not None else [])
+            if vals and (len(vals) not in (1, len(self.cells)) or any(not (x > 0 and math.isfinite(x)) for x in vals)):
+                raise ValueError(f"{key} = {v} must be positive, one value or one per axis")
+        return self
+
+
+class NumericsSection(_Section):
+    cfl: float = Field(0.4, gt=0.0, le=1.0)
+    cfl_diffusion: float = Field(0.4, gt=0.0, le=1.0)
+    cfl_source: float = Field(0.5, gt=0.0, lt=1.0)
+    limiter: str = "vanleer"
+    riemann: str = "hll"
+    precision: Literal["float64", "float32"] = "float64"
+    phi_stop: float | None = Field(None, gt=0.0, description="stop when max phi reaches this (default 0.99 phi_max)")
+
+    @field_validator("limiter")
+    @classmethod
+    def _lim(cls, v: str) -> str:
+        if v not in LIMITERS:
+            raise ValueError(f"limiter {v!r} is not valid: choose one of {', '.join(LIMITERS)}")
+        return v
+
+    @field_validator("riemann")
+    @classmethod
+    def _riem(cls, v: str) -> str:
+        if v not in RIEMANN_SOLVERS:
+            raise ValueError(f"riemann {v!r} is not valid: choose one of {', '.join(RIEMANN_SOLVERS)}")
+        return v
+
+
+class TimeSection(_Section):
+    end: float = Field(..., gt=0.0)
+    unit: Literal["tau", "haff", "s"] = "tau"
+    outputs: int = Field(50, ge=1, le=100000)
+    max_steps_per_call: int = Field(200, ge=1, description="steps per compiled call (progress granularity)")
+
+
+class OutputSection(_Section):
+    directory: str = "ktgf-run"
+    checkpoint_every: int = Field(10, ge=1, description="outputs between checkpoints")
+    vtk_every: int = Field(0, ge=0, description="outputs between VTK files (0: first and last only)")
+    vtk: bool = True
+    png: bool = True
+
+
+class ParallelSection(_Section):
+    devices: int = Field(1, ge=1, description="JAX devices to shard the first grid axis over")
+
+
+class Config(_Section):
+    model: ModelSection = ModelSection()
+    particles: ParticlesSection = ParticlesSection()
+    initial: InitialSection
+    grid: GridSection
+    numerics: NumericsSection = NumericsSection()
+    time: TimeSection
+    output: OutputSection = OutputSection()
+    parallel: ParallelSection = ParallelSection()
+
+
+def _fmt_error(err: dict[str, Any]) -> str:
+    loc = ".".join(str(p) for p in err["loc"]) or "config"
+    msg = err["msg"].removeprefix("Value error, ")
+    got = err.get("input")
+    tail = f" (got {got!r})" if got is not None and not isinstance(got, dict) else ""
+    return f"field {loc}: {msg}{tail}"
+
+
+def parse_config(data: dict[str, Any], source: str = "config") -> Config:
+    """Validate a config dict; raise :class:`InputError` naming every bad field, then check the physics."""
+    try:
+        cfg = Config.model_validate(data)
+    except ValidationError as exc:
+        raise InputError(f"{source}: " + "; ".join(_fmt_error(e) for e in exc.errors())) from None
+    check_physics(cfg, source)
+    return cfg
+
+
+def load_config(path: str | Path) -> Config:
+    """Read and validate a TOML run configuration."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise InputError(f"config file {str(path)!r} does not exist") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
+    return parse_config(data, str(path))
+
+
+def check_physics(cfg: Config, source: str = "config") -> None:
+    """Cross-field checks that need the model: φ0 below the packing limit, a valid model name/options."""
+    from ..closures import get_model
+
+    try:
+        model = get_model(cfg.model.name, **cfg.model.options)
+    except KtgfError as exc:
+        raise InputError(f"{source}: field model.name/options: {exc}") from None
+    phi0 = cfg.initial.solid_fraction
+    stop = cfg.numerics.phi_stop if cfg.numerics.phi_stop is not None else 0.99 * model.phi_max
+    if phi0 >= model.phi_max:
+        raise InputError(
+            f"{source}: field initial.solid_fraction = {phi0:g} is out of range: valid 0 < phi < {model.phi_max:g} "
+            f"(packing limit of model {model.name!r})"
+        )
+    if phi0 >= stop:
+        raise InputError(f"{source}: field initial.solid_fraction = {phi0:g} is at or above numerics.phi_stop = {stop:g}")
+    if cfg.initial.perturbation == "mode":
+        if cfg.initial.mode is None or len(cfg.initial.mode) != len(cfg.grid.cells) or not any(cfg.initial.mode):
+            raise InputError(
+                f"{source}: field initial.mode = {cfg.initial.mode} must have {len(cfg.grid.cells)} integers, not all 0"
+            )
+    if cfg.grid.relative_to is not None:
+        from ..hcs.stability import critical_wavenumbers
+
+        kp, kl = critical_wavenumbers(model.reduced(phi0, cfg.model.restitution))
+        k = kp if cfg.grid.relative_to == "transverse" else kl
+        if not float(k) > 0:
+            raise InputError(
+                f"{source}: field grid.relative_to = {cfg.grid.relative_to!r}: model {model.name!r} at "
+                f"phi = {phi0:g}, e = {cfg.model.restitution:g} has no {cfg.grid.relative_to} instability "
+                "(infinite critical size); give grid.length instead"
+            )

@@ -1,0 +1,123 @@
+"""Initial states of the homogeneous-cooling (HCS) case (model.md §§8–9).
+
+Uniform φ0, θ0, u = 0, plus either a single Fourier mode shaped as an eigenvector of the
+linear stability problem (:mod:`ktgf.hcs.stability`), or a seeded random velocity field
+built from the lowest Fourier modes (so that it does not depend on the resolution).
+
+Linear-theory variables: ρ_k = δn/n, θ_k = δθ/θ_H, w = δu/√(2θ_H), τ = ∫ν0 dt, k* = kℓ.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import jax.numpy as jnp
+import numpy as np
+
+from ..closures.coefficients import mean_free_path, nu0
+from ..errors import InputError
+from ..hcs.stability import longitudinal_growth_rates, longitudinal_matrix, transverse_growth_rate
+from .grid import Grid
+from .physics import Physics
+from .state import conservative
+
+
+def uniform_fields(grid: Grid, phys: Physics, phi0: float, theta0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(ρ, u, θ) NumPy fields of the unperturbed HCS."""
+    rho = np.full(grid.cells, phys.material_density * phi0)
+    return rho, np.zeros((3, *grid.cells)), np.full(grid.cells, float(theta0))
+
+
+def haff_time(phys: Physics, phi0: float, theta0: float) -> float:
+    """Haff time t0 = 2/ζ0(θ0) [s]: θ_H(t) = θ0/(1 + t/t0)²."""
+    r = phys.model.reduced(phi0, phys.restitution)
+    return float(2.0 / (nu0(phi0, theta0, phys.diameter) * r.zeta0))
+
+
+def tau_of_t(t: Any, phys: Physics, phi0: float, theta0: float) -> Any:
+    """Collision time τ = ∫ν0(θ_H) dt = ν0(θ0) t0 ln(1 + t/t0) along Haff's law."""
+    t0 = haff_time(phys, phi0, theta0)
+    return nu0(phi0, theta0, phys.diameter) * t0 * np.log1p(np.asarray(t) / t0)
+
+
+def t_of_tau(tau: Any, phys: Physics, phi0: float, theta0: float) -> Any:
+    """Inverse of :func:`tau_of_t`."""
+    t0 = haff_time(phys, phi0, theta0)
+    return t0 * np.expm1(np.asarray(tau) / (nu0(phi0, theta0, phys.diameter) * t0))
+
+
+def _direction(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    khat = k / np.linalg.norm(k)
+    ref = np.array([0.0, 0.0, 1.0]) if abs(khat[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    perp = np.cross(ref, khat)
+    return khat, perp / np.linalg.norm(perp)
+
+
+def single_mode(
+    grid: Grid, phys: Physics, phi0: float, theta0: float, mode: tuple[int, ...], kind: str,
+    amplitude: float, branch: int = 0,
+) -> tuple[Any, complex, np.ndarray]:
+    """HCS plus one eigenmode of wave vector 2π n/L (``kind`` ``transverse`` or ``longitudinal``).
+
+    Returns the conservative state, the linear growth rate s (units of ν0, per τ) and the
+    eigenvector (ρ_k, θ_k, w) used (transverse: (0, 0, 1) for w⊥).  ``branch`` picks the
+    longitudinal eigenvalue by decreasing real part.
+    """
+    if len(mode) != grid.ndim or not any(mode):
+        raise InputError(f"mode {tuple(mode)} must have {grid.ndim} integer entries, not all zero")
+    k = grid.wavevector(tuple(mode))
+    kstar = float(np.linalg.norm(k)) * mean_free_path(phi0, phys.diameter)
+    khat, perp = _direction(k)
+    x = grid.mesh()
+    phase = np.exp(1j * sum(k[a] * x[a] for a in range(grid.ndim)))
+    r = phys.model.reduced(phi0, phys.restitution)
+    rho, u, theta = uniform_fields(grid, phys, phi0, theta0)
+    w_scale = math.sqrt(2.0 * theta0)
+    if kind == "transverse":
+        s = complex(transverse_growth_rate(r, kstar))
+        vec = np.array([0.0, 0.0, 1.0 + 0j])
+        u = u + (amplitude * w_scale * np.real(phase))[None] * perp[:, None].reshape((3,) + (1,) * grid.ndim)
+    elif kind == "longitudinal":
+        m = -np.asarray(longitudinal_matrix(r, kstar))
+        vals, vecs = np.linalg.eig(m)
+        order = np.argsort(-vals.real)
+        s, vec = complex(vals[order[branch]]), vecs[:, order[branch]]
+        vec = vec / vec[np.argmax(np.abs(vec))]
+        s_check = complex(np.asarray(longitudinal_growth_rates(r, kstar))[branch])
+        assert abs(s - s_check) <= 1e-12 * max(1.0, abs(s))
+        rho = rho * (1.0 + amplitude * np.real(vec[0] * phase))
+        theta = theta * (1.0 + amplitude * np.real(vec[1] * phase))
+        u = u + (amplitude * w_scale * np.real(vec[2] * phase))[None] * khat.reshape((3,) + (1,) * grid.ndim)
+    else:
+        raise InputError(f"mode kind {kind!r} is not valid: choose 'transverse' or 'longitudinal'")
+    return conservative(jnp.asarray(rho), jnp.asarray(u), jnp.asarray(theta)), s, vec
+
+
+def random_velocity(
+    grid: Grid, phys: Physics, phi0: float, theta0: float, amplitude: float, seed: int, max_mode: int = 2,
+) -> Any:
+    """HCS plus seeded random velocity and density fields of the Fourier modes |n_a| ≤ ``max_mode``.
+
+    The velocity has zero mean and root-mean-square amplitude ``amplitude``·√θ0 per
+    component, δφ/φ0 has rms ``amplitude``; both are the same physical fields on every grid
+    that resolves those modes.
+    """
+    rng = np.random.default_rng(seed)
+    x = grid.mesh()
+    ranges = [range(-max_mode, max_mode + 1)] * grid.ndim
+    f = np.zeros((4, *grid.cells))
+    for n in np.array(np.meshgrid(*ranges, indexing="ij")).reshape(grid.ndim, -1).T:
+        if not any(n):
+            continue
+        k = grid.wavevector(tuple(int(v) for v in n))
+        arg = sum(k[a] * x[a] for a in range(grid.ndim))
+        amp = rng.normal(size=4) + 1j * rng.normal(size=4)
+        f += np.real(amp.reshape((4,) + (1,) * grid.ndim) * np.exp(1j * arg)[None])
+    u = f[:3] * (amplitude * math.sqrt(theta0) / np.sqrt(np.mean(f[:3] ** 2)))
+    drho = f[3] * (amplitude / np.sqrt(np.mean(f[3] ** 2)))
+    rho, _, theta = uniform_fields(grid, phys, phi0, theta0)
+    rho = rho * (1.0 + drho)
+    # Zero total momentum: the box frame is the centre-of-mass frame (no uniform drift).
+    u -= (np.sum(rho * u, axis=tuple(range(1, grid.ndim + 1))) / np.sum(rho)).reshape((3,) + (1,) * grid.ndim)
+    return conservative(jnp.asarray(rho), jnp.asarray(u), jnp.asarray(theta))

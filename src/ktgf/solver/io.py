@@ -1,0 +1,144 @@
+"""Solver output: netCDF time series, checkpoints, VTK image files (.vti) and PNG slices.
+
+The VTK writer is a small XML ImageData writer (VTK file format 1.0, base64 "binary" data
+with a UInt64 byte-count header) that ParaView opens directly; fields are cell data.
+Checkpoints are ``.npz`` files written atomically (write to a temporary name, then rename),
+so an interrupted write never destroys the previous one.
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from .grid import Grid
+
+_VTK_TYPES = {np.dtype("float64"): "Float64", np.dtype("float32"): "Float32"}
+
+
+def _b64(arr: np.ndarray) -> str:
+    raw = np.ascontiguousarray(arr).astype(arr.dtype.newbyteorder("<"), copy=False).tobytes()
+    return base64.b64encode(np.uint64(len(raw)).tobytes() + raw).decode("ascii")
+
+
+def write_vti(path: str | Path, grid: Grid, fields: dict[str, np.ndarray], time: float | None = None) -> Path:
+    """Write cell fields (scalars of shape ``cells``, vectors of shape ``(3, *cells)``) as a VTK .vti file."""
+    path = Path(path)
+    cells = tuple(grid.cells) + (1,) * (3 - grid.ndim)
+    spacing = tuple(grid.spacing) + (grid.spacing[0],) * (3 - grid.ndim)
+    extent = " ".join(f"0 {n}" for n in cells)
+    arrays = []
+    for name, f in fields.items():
+        f = np.asarray(f)
+        vtype = _VTK_TYPES.get(f.dtype, "Float64")
+        f = f.astype(np.float64 if vtype == "Float64" else np.float32, copy=False)
+        if f.shape == tuple(grid.cells):
+            data = f.reshape(cells).transpose(2, 1, 0)  # VTK: x fastest
+            ncomp = 1
+        elif f.shape == (3, *grid.cells):
+            data = np.moveaxis(f.reshape((3, *cells)), 0, -1).transpose(2, 1, 0, 3)
+            ncomp = 3
+        else:
+            raise InputError(f"field {name!r} has shape {f.shape}; expected {grid.cells} or (3, *{grid.cells})")
+        arrays.append(
+            f'        <DataArray type="{vtype}" Name="{name}" NumberOfComponents="{ncomp}" format="binary">\n'
+            f"          {_b64(data)}\n        </DataArray>"
+        )
+    field_data = ""
+    if time is not None:
+        t = np.array([time], dtype=np.float64)
+        field_data = (
+            '    <FieldData>\n      <DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" format="binary">'
+            f"{_b64(t)}</DataArray>\n    </FieldData>\n"
+        )
+    xml = (
+        '<?xml version="1.0"?>\n'
+        '<VTKFile type="ImageData" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n'
+        f'  <ImageData WholeExtent="{extent}" Origin="0 0 0" Spacing="{" ".join(repr(float(h)) for h in spacing)}">\n'
+        f"{field_data}"
+        f'    <Piece Extent="{extent}">\n      <CellData>\n' + "\n".join(arrays) + "\n      </CellData>\n"
+        "    </Piece>\n  </ImageData>\n</VTKFile>\n"
+    )
+    _write_text(path, xml)
+    return path
+
+
+def read_vti(path: str | Path) -> dict[str, np.ndarray]:
+    """Read back the arrays of a .vti file written by :func:`write_vti` (flat, VTK order)."""
+    import xml.etree.ElementTree as ET
+
+    out = {}
+    for da in ET.parse(path).getroot().iter("DataArray"):
+        raw = base64.b64decode(da.text.strip())
+        n = int(np.frombuffer(raw[:8], dtype="<u8")[0])
+        dtype = "<f8" if da.get("type") == "Float64" else "<f4"
+        out[da.get("Name")] = np.frombuffer(raw[8 : 8 + n], dtype=dtype)
+    return out
+
+
+def _write_text(path: Path, text: str) -> None:
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    except (PermissionError, OSError) as exc:
+        raise InputError(f"cannot write file {str(path)!r}: {exc.strerror or exc}") from exc
+
+
+def save_checkpoint(path: str | Path, U: np.ndarray, t: float, steps: int, output_index: int,
+                    history: dict[str, list], config_json: str) -> Path:
+    """Write a checkpoint atomically: state, time, counters, diagnostics so far and the config."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp.npz")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        np.savez(
+            tmp, U=np.asarray(U), t=np.float64(t), steps=np.int64(steps), output_index=np.int64(output_index),
+            history=json.dumps({k: np.asarray(v).tolist() for k, v in history.items()}), config=config_json,
+        )
+        os.replace(tmp, path)
+    except (PermissionError, OSError) as exc:
+        raise InputError(f"cannot write checkpoint {str(path)!r}: {exc.strerror or exc}") from exc
+    return path
+
+
+def load_checkpoint(path: str | Path) -> dict[str, Any]:
+    """Read a checkpoint written by :func:`save_checkpoint`."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"checkpoint {str(path)!r} does not exist")
+    with np.load(path) as z:
+        return {
+            "U": z["U"], "t": float(z["t"]), "steps": int(z["steps"]), "output_index": int(z["output_index"]),
+            "history": {k: list(v) for k, v in json.loads(str(z["history"])).items()}, "config": str(z["config"]),
+        }
+
+
+def save_slices(path: str | Path, grid: Grid, fields: dict[str, np.ndarray], title: str = "") -> Path:
+    """PNG of scalar fields: line plots (1D), maps (2D) or the mid-plane z = L_z/2 (3D)."""
+    import matplotlib.pyplot as plt
+
+    from ..plotting import save
+
+    n = len(fields)
+    fig, axes = plt.subplots(1, n, figsize=(4.2 * n, 3.6), squeeze=False)
+    for ax, (name, f) in zip(axes[0], fields.items()):
+        f = np.asarray(f)
+        if grid.ndim == 1:
+            ax.plot(grid.centres(0) / grid.lengths[0], f)
+            ax.set_xlabel("x / L")
+        else:
+            sl = f if grid.ndim == 2 else f[:, :, grid.cells[2] // 2]
+            im = ax.imshow(sl.T, origin="lower", extent=(0, 1, 0, grid.lengths[1] / grid.lengths[0]), cmap="viridis")
+            fig.colorbar(im, ax=ax, shrink=0.8)
+            ax.set_xlabel("x / L")
+            ax.set_ylabel("y / L")
+        ax.set_title(name)
+    if title:
+        fig.suptitle(title)
+    return save(fig, path)

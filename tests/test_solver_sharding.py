@@ -1,0 +1,51 @@
+"""A domain sharded over two CPU devices (jax.sharding) gives the single-device result to round-off.
+
+XLA reads ``--xla_force_host_platform_device_count`` only at start-up, so the comparison runs
+in a fresh Python process with the flag set.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+SCRIPT = r"""
+import json, numpy as np, jax
+jax.config.update("jax_enable_x64", True)
+from ktgf.solver.config import parse_config
+from ktgf.solver.run import Simulation
+base = {
+    "model": {"name": "proposed", "restitution": 0.7},
+    "initial": {"solid_fraction": 0.4, "temperature": 1e-4, "amplitude": 0.05, "seed": 5},
+    "grid": {"cells": [16, 8], "relative_to": "transverse", "factor": 1.5},
+    "time": {"end": 3.0, "outputs": 2},
+}
+out = {"devices": jax.device_count()}
+states = []
+for ndev in (1, 2):
+    sim = Simulation(parse_config({**base, "parallel": {"devices": ndev}}))
+    ds = sim.run(progress=False, write_files=False)
+    states.append(np.asarray(sim.state))
+    out[f"steps{ndev}"] = sim.steps
+    out[f"shards{ndev}"] = len(sim.state.sharding.device_set)
+    out[f"theta{ndev}"] = float(ds.theta_mean[-1])
+scale = np.abs(states[0]).max(axis=(1, 2))
+out["maxdiff"] = float((np.abs(states[1] - states[0]).max(axis=(1, 2)) / scale).max())
+print(json.dumps(out))
+"""
+
+
+def test_two_device_sharding_matches_single_device() -> None:
+    env = dict(os.environ)
+    env["XLA_FLAGS"] = (env.get("XLA_FLAGS", "") + " --xla_force_host_platform_device_count=2").strip()
+    env["PYTHONPATH"] = str(Path(__file__).resolve().parents[1] / "src") + os.pathsep + env.get("PYTHONPATH", "")
+    res = subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True, env=env, timeout=600)
+    assert res.returncode == 0, res.stderr[-3000:]
+    out = json.loads(res.stdout.strip().splitlines()[-1])
+    assert out["devices"] == 2 and out["shards1"] == 1 and out["shards2"] == 2
+    assert out["steps1"] == out["steps2"] > 0
+    print(out)
+    assert out["maxdiff"] < 1e-12, out
