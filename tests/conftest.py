@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
-
-import os
 
 ROOT = Path(__file__).resolve().parents[1]
 # The shared folder sits next to the main checkout (/work/main -> /work/shared) and two levels up
@@ -33,3 +32,11 @@ def _jax_x64() -> None:
     except ImportError:  # pragma: no cover
         return
     jax.config.update("jax_enable_x64", True)
+
+
+@pytest.fixture(scope="session")
+def quick_report(tmp_path_factory):
+    """One ``ktgf reproduce --quick`` report per test session; tests copy it before changing it."""
+    from ktgf.report import ReportSettings, build_report
+
+    return build_report(ReportSettings.preset(quick=True, out=tmp_path_factory.mktemp("quick") / "r"))

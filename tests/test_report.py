@@ -1,6 +1,6 @@
 """The reproduction report: completeness, cache reuse, interruption, bad input, missing data.
 
-one ``--quick`` report is built per module and copied where a test needs to change it.
+one ``--quick`` report is built per test session (conftest) and copied where a test needs to change it.
 """
 
 from __future__ import annotations
@@ -45,10 +45,18 @@ def counting(monkeypatch: pytest.MonkeyPatch, key: str, effect=None) -> list[int
     return calls
 
 
-@pytest.fixture(scope="module")
-def built(tmp_path_factory: pytest.TempPathFactory):
-    out = tmp_path_factory.mktemp("report") / "r"
-    return build_report(small(out))
+def without_solvers(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Mark the Couette and 3D sections unavailable: tests of the framework that rebuild from an
+    empty cache need not rerun the solvers (their sections have tests of their own)."""
+    for key in ("couette", "cooling_gas"):
+        sec = framework._SECTIONS[key]
+        monkeypatch.setitem(framework._SECTIONS, key, dataclasses.replace(sec, available=lambda: "skipped in this test"))
+
+
+@pytest.fixture
+def built(quick_report):
+    """The session's ``--quick`` report (tests copy it before changing anything)."""
+    return quick_report
 
 
 def test_quick_report_is_complete(built) -> None:
@@ -94,6 +102,7 @@ def test_changed_input_recomputes_only_its_section(built, tmp_path, monkeypatch)
 
 def test_interrupted_run_keeps_finished_sections_and_resumes(tmp_path, monkeypatch) -> None:
     out = tmp_path / "r"
+    without_solvers(monkeypatch)
     counting(monkeypatch, "hcs", effect=KeyboardInterrupt())
     with pytest.raises(ReportInterrupted) as info:
         build_report(small(out))
@@ -102,6 +111,7 @@ def test_interrupted_run_keeps_finished_sections_and_resumes(tmp_path, monkeypat
     assert isinstance(info.value, KeyboardInterrupt)
     assert not (out / "figures" / "hcs").exists()  # half-written outputs removed
     monkeypatch.undo()
+    without_solvers(monkeypatch)
     calls = {k: counting(monkeypatch, k) for k in ("coefficients", "hcs")}
     resumed = build_report(small(out))
     assert (len(calls["coefficients"]), len(calls["hcs"])) == (0, 1)
@@ -114,6 +124,7 @@ def test_failing_section_is_reported_not_cached(built, tmp_path, monkeypatch) ->
     shutil.copytree(built.out, out)
     shutil.rmtree(out / ".cache")
     (out / ".cache").mkdir()
+    without_solvers(monkeypatch)
     counting(monkeypatch, "hcs", effect=ValueError("boom"))
     rep = build_report(small(out))
     assert rep.statuses["hcs"] == "failed" and "ValueError: boom" in rep.failed[0].reason

@@ -54,5 +54,6 @@ from .grid import Grid  # noqa: E402
 from .physics import Physics  # noqa: E402
 from .run import Simulation  # noqa: E402
 from .stepping import Numerics, advance  # noqa: E402
+from .cases import report_cooling_run  # noqa: E402
 
-__all__ = ["Config", "Grid", "Numerics", "Physics", "Simulation", "advance", "load_config", "parse_config"]
+__all__ = ["Config", "Grid", "Numerics", "Physics", "Simulation", "advance", "load_config", "parse_config", "report_cooling_run"]
