@@ -14,7 +14,6 @@ from any checkpoint reproduces the uninterrupted run bit for bit.
 from __future__ import annotations
 
 import json
-import math
 import time as _time
 from pathlib import Path
 from typing import Any, Callable
@@ -24,7 +23,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..closures import get_model
-from ..closures.coefficients import mean_free_path, nu0
+from ..closures.coefficients import mean_free_path
 from ..errors import DivergenceError, InputError
 from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
 from .config import Config
