@@ -170,3 +170,15 @@ def test_cli_run_and_bad_config(tmp_path: Path) -> None:
     res = runner.invoke(app, ["run", str(case), "--no-progress"])
     assert res.exit_code == 2 and "initial.solid_fraction" in res.output
     assert len(res.output.strip().splitlines()) == 1
+
+
+def test_float32_run_lands_on_the_output_times_and_agrees_with_float64() -> None:
+    results = {}
+    for precision in ("float32", "float64"):
+        sim = Simulation(parse_config(_cfg(numerics={"precision": precision})))
+        ds = sim.run(progress=False, write_files=False)
+        assert str(sim.state.dtype) == precision
+        results[precision] = ds
+    a, b = results["float32"], results["float64"]
+    assert np.array_equal(a.time.values, b.time.values)
+    assert np.allclose(a.theta_mean.values, b.theta_mean.values, rtol=1e-4)

@@ -165,10 +165,12 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
 
     def body(carry: tuple) -> tuple:
         U, t, n, _, _ = carry
-        dt_stable = stable_dt(U, grid, phys, num)
+        # Time is kept in float64 whatever the state precision, so a float32 run still lands
+        # exactly on t_end.
+        dt_stable = stable_dt(U, grid, phys, num).astype(t.dtype)
         last = dt_stable >= t_end - t
         dt = jnp.where(last, t_end - t, dt_stable)
-        U_new = ssprk3_step(U, dt, grid, phys, num)
+        U_new = ssprk3_step(U, dt.astype(U[0].dtype), grid, phys, num)
         bad_state = state_status(U_new, phys)
         status = jnp.where(bad_state != 0, bad_state, jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5))
         good = status == 0
@@ -177,8 +179,9 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         return U, t, n + good.astype(n.dtype), status, dt
 
     U = tuple(U)
-    t = jnp.asarray(t, U[0].dtype)
-    init = (U, t, jnp.zeros((), jnp.int32), jnp.zeros((), jnp.int32), jnp.zeros((), U[0].dtype))
+    t = jnp.asarray(t, jnp.float64)
+    t_end = jnp.asarray(t_end, jnp.float64)
+    init = (U, t, jnp.zeros((), jnp.int32), jnp.zeros((), jnp.int32), jnp.zeros((), jnp.float64))
     U, t, n, status, dt = jax.lax.while_loop(cond, body, init)
     return jnp.stack(U), t, n, status, dt
 
