@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -137,7 +136,7 @@ def test_nonfinite_state_is_rejected() -> None:
     sim = Simulation(parse_config(_cfg()))
     U = np.array(sim.initial_state())
     U[4, 3, 3] = np.nan
-    out, t, n, status, _ = advance(U, 0.0, 1.0, 10, sim.grid, sim.phys, sim.num)
+    _, t, n, status, _ = advance(U, 0.0, 1.0, 10, sim.grid, sim.phys, sim.num)
     assert int(status) == 1 and int(n) == 0 and float(t) == 0.0
 
 

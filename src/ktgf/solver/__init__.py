@@ -49,10 +49,10 @@ import jax
 
 jax.config.update("jax_enable_x64", True)
 
-from .config import Config, load_config, parse_config  # noqa: E402
-from .grid import Grid  # noqa: E402
-from .physics import Physics  # noqa: E402
-from .run import Simulation  # noqa: E402
-from .stepping import Numerics, advance  # noqa: E402
+from .config import Config, load_config, parse_config
+from .grid import Grid
+from .physics import Physics
+from .run import Simulation
+from .stepping import Numerics, advance
 
 __all__ = ["Config", "Grid", "Numerics", "Physics", "Simulation", "advance", "load_config", "parse_config"]

@@ -30,7 +30,7 @@ from typing import Any
 import jax
 import jax.numpy as jnp
 
-from .fluxes import LIMITERS, RIEMANN_SOLVERS, _keep, flux_divergence
+from .fluxes import LIMITERS, RIEMANN_SOLVERS, flux_divergence, materialise
 from .grid import Grid
 from .physics import Physics
 from .sources import cooling_source
@@ -78,7 +78,7 @@ class Numerics:
         return (self.cfl, self.cfl_diffusion, self.cfl_source, self.dt_max), (self.limiter, self.riemann)
 
     @classmethod
-    def tree_unflatten(cls, aux: tuple[str, str], leaves: tuple) -> "Numerics":
+    def tree_unflatten(cls, aux: tuple[str, str], leaves: tuple) -> Numerics:
         obj = object.__new__(cls)
         for name, v in zip(("cfl", "cfl_diffusion", "cfl_source", "dt_max", "limiter", "riemann"), (*leaves, *aux)):
             object.__setattr__(obj, name, v)
@@ -95,7 +95,7 @@ class Numerics:
 
 def rhs(U: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
     """dU/dt = −∇·F(U) + S(U)."""
-    W = _keep(primitive_fields(U))
+    W = materialise(primitive_fields(U))
     dU, divu = flux_divergence(W, grid, phys, num.limiter, num.riemann)
     source, _ = cooling_source(W, divu, phys)
     dU[4] = dU[4] + source
