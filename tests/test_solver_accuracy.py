@@ -39,7 +39,7 @@ def test_uniform_gas_follows_haff_at_third_order(model: str) -> None:
     t_end = 3.0 * t0
     errors = []
     for c in (0.2, 0.1, 0.05):
-        U, t, steps, status, _ = advance(U0, 0.0, t_end, 10**6, grid, phys, Numerics(cfl=c, cfl_diffusion=c, cfl_source=c))
+        U, t, _steps, status, _ = advance(U0, 0.0, t_end, 10**6, grid, phys, Numerics(cfl=c, cfl_diffusion=c, cfl_source=c))
         assert int(status) == 0 and float(t) == t_end
         theta = np.asarray(primitive(U))[4]
         assert np.ptp(theta) == 0.0  # stays exactly uniform

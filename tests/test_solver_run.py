@@ -136,7 +136,7 @@ def test_nonfinite_state_is_rejected() -> None:
     sim = Simulation(parse_config(_cfg()))
     U = np.array(sim.initial_state())
     U[4, 3, 3] = np.nan
-    out, t, n, status, _ = advance(U, 0.0, 1.0, 10, sim.grid, sim.phys, sim.num)
+    _, t, n, status, _ = advance(U, 0.0, 1.0, 10, sim.grid, sim.phys, sim.num)
     assert int(status) == 1 and int(n) == 0 and float(t) == 0.0
 
 
@@ -169,3 +169,15 @@ def test_cli_run_and_bad_config(tmp_path: Path) -> None:
     res = runner.invoke(app, ["run", str(case), "--no-progress"])
     assert res.exit_code == 2 and "initial.solid_fraction" in res.output
     assert len(res.output.strip().splitlines()) == 1
+
+
+def test_float32_run_lands_on_the_output_times_and_agrees_with_float64() -> None:
+    results = {}
+    for precision in ("float32", "float64"):
+        sim = Simulation(parse_config(_cfg(numerics={"precision": precision})))
+        ds = sim.run(progress=False, write_files=False)
+        assert str(sim.state.dtype) == precision
+        results[precision] = ds
+    a, b = results["float32"], results["float64"]
+    assert np.array_equal(a.time.values, b.time.values)
+    assert np.allclose(a.theta_mean.values, b.theta_mean.values, rtol=1e-4)

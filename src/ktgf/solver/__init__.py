@@ -49,11 +49,11 @@ import jax
 
 jax.config.update("jax_enable_x64", True)
 
+from .cases import report_cooling_run  # noqa: E402
 from .config import Config, load_config, parse_config  # noqa: E402
 from .grid import Grid  # noqa: E402
 from .physics import Physics  # noqa: E402
 from .run import Simulation  # noqa: E402
 from .stepping import Numerics, advance  # noqa: E402
-from .cases import report_cooling_run  # noqa: E402
 
 __all__ = ["Config", "Grid", "Numerics", "Physics", "Simulation", "advance", "load_config", "parse_config", "report_cooling_run"]

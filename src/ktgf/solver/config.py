@@ -82,7 +82,7 @@ class GridSection(_Section):
         return v
 
     @model_validator(mode="after")
-    def _one_size(self) -> "GridSection":
+    def _one_size(self) -> GridSection:
         given = [k for k in ("length", "length_d", "relative_to") if getattr(self, k) is not None]
         if len(given) != 1:
             raise ValueError(f"give exactly one of length, length_d or relative_to (+ factor); got {given or 'none'}")
@@ -197,11 +197,11 @@ def check_physics(cfg: Config, source: str = "config") -> None:
         )
     if phi0 >= stop:
         raise InputError(f"{source}: field initial.solid_fraction = {phi0:g} is at or above numerics.phi_stop = {stop:g}")
-    if cfg.initial.perturbation == "mode":
-        if cfg.initial.mode is None or len(cfg.initial.mode) != len(cfg.grid.cells) or not any(cfg.initial.mode):
-            raise InputError(
-                f"{source}: field initial.mode = {cfg.initial.mode} must have {len(cfg.grid.cells)} integers, not all 0"
-            )
+    mode = cfg.initial.mode
+    if cfg.initial.perturbation == "mode" and (mode is None or len(mode) != len(cfg.grid.cells) or not any(mode)):
+        raise InputError(
+            f"{source}: field initial.mode = {mode} must have {len(cfg.grid.cells)} integers, not all 0"
+        )
     if cfg.grid.relative_to is not None:
         from ..hcs.stability import critical_wavenumbers
 

@@ -15,7 +15,8 @@ Flux along a of (ρ, ρu, E):  (ρu_a,  ρu u_a + P·e_a,  E u_a + (P·u)_a + q_
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import jax
 import jax.numpy as jnp
@@ -50,10 +51,11 @@ GHOST = 2
 #: Materialise shared intermediates (padded fields, face states, wave speeds, transport
 #: coefficients) with ``lax.optimization_barrier`` so XLA does not recompute them inside every
 #: consumer fusion (there are 5 flux components × 2 faces per cell consuming each).
-MATERIALISE = True
+MATERIALISE = True  # switch for A/B timing of the barriers
 
 
-def _keep(x: Any) -> Any:
+def materialise(x: Any) -> Any:
+    """``x`` behind an optimisation barrier: XLA computes it once and stores it."""
     return jax.lax.optimization_barrier(x) if MATERIALISE else x
 
 
@@ -63,7 +65,7 @@ def pad_periodic(W: Sequence[Any], ndim: int) -> tuple[Any, ...]:
     Padding once per stage and then reading stencils as static slices keeps the fused loops
     free of the concatenations that ``jnp.roll`` would put in every one of them.
     """
-    return _keep(tuple(jnp.pad(f, [(GHOST, GHOST)] * ndim, mode="wrap") for f in W))
+    return materialise(tuple(jnp.pad(f, [(GHOST, GHOST)] * ndim, mode="wrap") for f in W))
 
 
 def window(P: Any, cells: tuple[int, ...], axis: int, offset: int, extra: int, shift: tuple[int, ...] = ()) -> Any:
@@ -105,14 +107,14 @@ def convective_flux(
     P: Sequence[Any], cells: tuple[int, ...], axis: int, phys: Physics, limiter: str, riemann: str
 ) -> list[Any]:
     """Upwind flux (HLL or Rusanov) of the Euler part at the N+1 faces along ``axis`` (padded input P)."""
-    WL, WR = _keep(reconstruct(P, cells, axis, limiter))
+    WL, WR = materialise(reconstruct(P, cells, axis, limiter))
     rL, rR = phys.reduced(WL[0]), phys.reduced(WR[0])
     pL, pR = phys.pressure(WL[0], WL[4], rL), phys.pressure(WR[0], WR[4], rR)
     cL, cR = phys.sound_speed(WL[4], rL), phys.sound_speed(WR[4], rR)
     UL, UR = conservative_fields(WL), conservative_fields(WR)
     FL, FR = _euler_flux(WL, UL, pL, axis), _euler_flux(WR, UR, pR, axis)
     uL, uR = WL[1 + axis], WR[1 + axis]
-    pL, pR, cL, cR = _keep((pL, pR, cL, cR))
+    pL, pR, cL, cR = materialise((pL, pR, cL, cR))
     if riemann == "rusanov":
         smax = jnp.maximum(jnp.abs(uL) + cL, jnp.abs(uR) + cR)
         return [0.5 * (fl + fr) - 0.5 * smax * (ur - ul) for fl, fr, ul, ur in zip(FL, FR, UL, UR)]
@@ -155,7 +157,7 @@ def viscous_flux(P: Sequence[Any], axis: int, grid: Grid, phys: Physics) -> list
                 tangential[b, j] = 0.5 * (
                     jax.lax.slice_in_dim(g, 0, n + 1, axis=a) + jax.lax.slice_in_dim(g, 1, n + 2, axis=a)
                 )
-    tangential = _keep(tangential)
+    tangential = materialise(tangential)
 
     def grad(b: int, j: int) -> Any:  # ∂u_j/∂x_b at the face
         if b == a:
@@ -166,10 +168,10 @@ def viscous_flux(P: Sequence[Any], axis: int, grid: Grid, phys: Physics) -> list
 
     divu = sum(grad(b, b) for b in range(grid.ndim))
     r = phys.reduced(rho_f)
-    eta, lam, kap, omega = _keep(phys.transport(rho_f, th_f, r))
+    eta, lam, kap, omega = materialise(phys.transport(rho_f, th_f, r))
     tau = [eta * (grad(a, j) + grad(j, a)) for j in range(3)]
     tau[a] = tau[a] + (lam - (2.0 / 3.0) * eta) * divu
-    tau = _keep(tau)
+    tau = materialise(tau)
     q = -kap * (Wr[4] - Wl[4]) * inv_dx - omega * (Wr[0] - Wl[0]) * (inv_dx / phys.material_density)
     work = tau[0] * u_f[0] + tau[1] * u_f[1] + tau[2] * u_f[2]
     return [0.0, -tau[0], -tau[1], -tau[2], q - work]

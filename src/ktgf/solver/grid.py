@@ -57,7 +57,7 @@ class Grid:
         return self.lengths, self.cells
 
     @classmethod
-    def tree_unflatten(cls, cells: tuple[int, ...], lengths: tuple) -> "Grid":
+    def tree_unflatten(cls, cells: tuple[int, ...], lengths: tuple) -> Grid:
         obj = object.__new__(cls)  # no validation: leaves may be tracers
         object.__setattr__(obj, "cells", cells)
         object.__setattr__(obj, "lengths", tuple(lengths))

@@ -50,7 +50,7 @@ class Physics:
         return (self.restitution, self.diameter, self.material_density, self.phi_stop), self.model
 
     @classmethod
-    def tree_unflatten(cls, model: Model, leaves: tuple) -> "Physics":
+    def tree_unflatten(cls, model: Model, leaves: tuple) -> Physics:
         return cls(model, *leaves)
 
     def reduced(self, rho: Any) -> Reduced:

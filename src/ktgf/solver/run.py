@@ -15,8 +15,9 @@ from __future__ import annotations
 
 import json
 import time as _time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import jax
 import jax.numpy as jnp
@@ -281,7 +282,7 @@ class _Progress:
         self.args = (phys, phi0, theta0)
         self._steps, self._wall, self._first = 0, 0.0, True
 
-    def __enter__(self) -> "_Progress":
+    def __enter__(self) -> _Progress:
         if self.enabled:
             from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
@@ -305,6 +306,6 @@ class _Progress:
         tau = float(tau_of_t(t, *self.args))
         self.bar.update(self.task, completed=t, t=f"{t:.4g} s", tau=f"{tau:.3g}", rate=rate)
 
-    def __exit__(self, *exc: Any) -> None:
+    def __exit__(self, *exc: object) -> None:
         if self.enabled:
             self.bar.__exit__(*exc)

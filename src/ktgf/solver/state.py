@@ -11,7 +11,8 @@ temperature per unit mass [m²/s²] (model.md §1).  Primitive state ``W`` = (ρ
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import jax.numpy as jnp
 

@@ -30,7 +30,7 @@ from typing import Any
 import jax
 import jax.numpy as jnp
 
-from .fluxes import LIMITERS, RIEMANN_SOLVERS, _keep, flux_divergence
+from .fluxes import LIMITERS, RIEMANN_SOLVERS, flux_divergence, materialise
 from .grid import Grid
 from .physics import Physics
 from .sources import cooling_source
@@ -78,7 +78,7 @@ class Numerics:
         return (self.cfl, self.cfl_diffusion, self.cfl_source, self.dt_max), (self.limiter, self.riemann)
 
     @classmethod
-    def tree_unflatten(cls, aux: tuple[str, str], leaves: tuple) -> "Numerics":
+    def tree_unflatten(cls, aux: tuple[str, str], leaves: tuple) -> Numerics:
         obj = object.__new__(cls)
         for name, v in zip(("cfl", "cfl_diffusion", "cfl_source", "dt_max", "limiter", "riemann"), (*leaves, *aux)):
             object.__setattr__(obj, name, v)
@@ -95,7 +95,7 @@ class Numerics:
 
 def rhs(U: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
     """dU/dt = −∇·F(U) + S(U)."""
-    W = _keep(primitive_fields(U))
+    W = materialise(primitive_fields(U))
     dU, divu = flux_divergence(W, grid, phys, num.limiter, num.riemann)
     source, _ = cooling_source(W, divu, phys)
     dU[4] = dU[4] + source
@@ -165,10 +165,12 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
 
     def body(carry: tuple) -> tuple:
         U, t, n, _, _ = carry
-        dt_stable = stable_dt(U, grid, phys, num)
+        # Time is kept in float64 whatever the state precision, so a float32 run still lands
+        # exactly on t_end.
+        dt_stable = stable_dt(U, grid, phys, num).astype(t.dtype)
         last = dt_stable >= t_end - t
         dt = jnp.where(last, t_end - t, dt_stable)
-        U_new = ssprk3_step(U, dt, grid, phys, num)
+        U_new = ssprk3_step(U, dt.astype(U[0].dtype), grid, phys, num)
         bad_state = state_status(U_new, phys)
         status = jnp.where(bad_state != 0, bad_state, jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5))
         good = status == 0
@@ -177,8 +179,9 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         return U, t, n + good.astype(n.dtype), status, dt
 
     U = tuple(U)
-    t = jnp.asarray(t, U[0].dtype)
-    init = (U, t, jnp.zeros((), jnp.int32), jnp.zeros((), jnp.int32), jnp.zeros((), U[0].dtype))
+    t = jnp.asarray(t, jnp.float64)
+    t_end = jnp.asarray(t_end, jnp.float64)
+    init = (U, t, jnp.zeros((), jnp.int32), jnp.zeros((), jnp.int32), jnp.zeros((), jnp.float64))
     U, t, n, status, dt = jax.lax.while_loop(cond, body, init)
     return jnp.stack(U), t, n, status, dt
 
