@@ -14,11 +14,11 @@ from pathlib import Path
 import pytest
 
 from ktgf.errors import InputError
-from ktgf.report import ReportInterrupted, ReportSettings, build_report, check_report, locate_data_dir
-from ktgf.report import framework
-from ktgf.report.couette import available as couette_available
+from ktgf.report import ReportInterrupted, ReportSettings, build_report, check_report, framework, locate_data_dir
 from ktgf.report.cooling_gas import available as cooling_available
+from ktgf.report.couette import available as couette_available
 from ktgf.report.page import PAGE_NAME
+
 
 def small(out: Path, **kw) -> ReportSettings:
     """The ``--quick`` settings (so the CLI test finds the module's report cached)."""

@@ -15,11 +15,10 @@ import pytest
 import xarray as xr
 
 from ktgf import get_model
-from ktgf.hcs.haff import haff_temperature
-from ktgf.report import ReportSettings, build_report, check_report, framework, locate_data_dir
-from ktgf.report import cooling_gas, couette
-from ktgf.report.dem import COUETTE, HCS_COOLING, read_table
 from ktgf.hcs import stability_map
+from ktgf.hcs.haff import haff_temperature
+from ktgf.report import ReportSettings, build_report, check_report, cooling_gas, couette, framework, locate_data_dir
+from ktgf.report.dem import COUETTE, HCS_COOLING, read_table
 from ktgf.report.hcs import compare_pair, cooling_comparison, dispersion, ret_proposed_sentence
 
 

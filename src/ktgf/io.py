@@ -57,3 +57,16 @@ def write_netcdf(ds: Any, path: str | Path) -> Path:
     except (PermissionError, OSError) as exc:
         raise InputError(f"cannot write output file {str(path)!r}: {exc.strerror or exc}") from exc
     return path
+
+
+def read_toml(path: str | Path) -> dict[str, Any]:
+    """Read a TOML config file, raising :class:`InputError` if it is missing or not valid TOML."""
+    import tomllib
+
+    path = Path(path)
+    try:
+        return tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise InputError(f"config file {str(path)!r} does not exist") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"config file {str(path)!r} is not valid TOML: {exc}") from None

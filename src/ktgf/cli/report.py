@@ -29,7 +29,6 @@ def reproduce(
     from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
     from ..report import ReportInterrupted, ReportSettings, build_report, sections
-
     from ..report.framework import prepare_out_dir
 
     settings = ReportSettings.preset(quick=quick, out=out, data_dir=data)

@@ -29,7 +29,6 @@ Example (``examples/couette_planar.toml``)::
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from typing import Annotated, Any, Literal, Union
 
@@ -37,6 +36,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from ..closures import get_model
 from ..errors import InputError, KtgfError
+from ..io import read_toml
 from .geometry import AnnularCell, PlanarCell
 from .run import Material
 from .walls import ENERGY_CONDITIONS, MOMENTUM_CONDITIONS, WALL_TYPES, Wall
@@ -212,13 +212,7 @@ def parse_config(data: dict[str, Any]) -> CouetteConfig:
 
 def load_config(path: str | Path) -> CouetteConfig:
     """Read and validate a TOML config file."""
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise InputError(f"config file {str(path)!r} does not exist") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
+    data = read_toml(path)
     return parse_config(data)
 
 

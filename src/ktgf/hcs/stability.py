@@ -24,7 +24,6 @@ from __future__ import annotations
 import math
 from typing import Any
 
-
 from .._array import namespace
 from ..closures.coefficients import MEAN_FREE_PATH_CONSTANT, Reduced
 

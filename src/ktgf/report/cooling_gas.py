@@ -28,9 +28,8 @@ If the solver's API differs, adapt :func:`run_box` (the only call into it).
 
 from __future__ import annotations
 
-import importlib
 import math
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -38,35 +37,14 @@ import xarray as xr
 from ..closures.models import get_model
 from ..hcs.haff import haff_temperature
 from ..hcs.stability import critical_box_size, critical_wavenumbers
-from .framework import Section, SectionContext, model_inputs, register_section
+from .framework import Section, SectionContext, model_inputs, optional_entry, register_section
 from .settings import ReportSettings
 
 ENTRY_POINT = ("ktgf.solver", "report_cooling_run")
 RHO_S_DEM = 6.0 / math.pi
 
 
-def _entry() -> Callable[..., xr.Dataset] | None:
-    try:
-        mod = importlib.import_module(ENTRY_POINT[0])
-    except ModuleNotFoundError as exc:
-        if exc.name and ENTRY_POINT[0].startswith(exc.name):
-            return None
-        raise
-    return getattr(mod, ENTRY_POINT[1], None)
-
-
-def available() -> str | None:
-    """None if the 3D solver and its report entry point are importable, else why not."""
-    try:
-        importlib.import_module(ENTRY_POINT[0])
-    except ModuleNotFoundError as exc:
-        if exc.name and not ENTRY_POINT[0].startswith(exc.name):  # the package is there, one of its imports is not
-            return f"{ENTRY_POINT[0]} is present but cannot be imported: {exc}."
-        return f"the 3D flow solver (package {ENTRY_POINT[0]}) is not installed in this build."
-    if _entry() is None:
-        return (f"{ENTRY_POINT[0]} has no function {ENTRY_POINT[1]}(model, *, phi, e, box, n_cells, t_end, seed, d, rho_s, theta0) "
-                "that the report calls (see ktgf.report.cooling_gas).")
-    return None
+_entry, available = optional_entry(*ENTRY_POINT, "the 3D flow solver", "(model, *, phi, e, box, n_cells, t_end, seed, d, rho_s, theta0)")
 
 
 def run_box(model: Any, box: float, s: ReportSettings) -> xr.Dataset:

@@ -27,9 +27,8 @@ If the solver's API differs, adapt :func:`solve_profiles` (the only call into it
 
 from __future__ import annotations
 
-import importlib
 import math
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -37,7 +36,7 @@ import xarray as xr
 from ..closures.models import get_model
 from ..io import run_metadata
 from .dem import COUETTE, read_table
-from .framework import Section, SectionContext, closest, join_labels, model_inputs, register_section
+from .framework import Section, SectionContext, closest, join_labels, model_inputs, optional_entry, register_section
 from .settings import ReportSettings
 
 #: module, function: the agreed entry point of the Couette solver.
@@ -46,28 +45,7 @@ ENTRY_POINT = ("ktgf.couette", "report_profiles")
 RHO_S_DEM = 6.0 / math.pi
 
 
-def _entry() -> Callable[..., xr.Dataset] | None:
-    try:
-        mod = importlib.import_module(ENTRY_POINT[0])
-    except ModuleNotFoundError as exc:
-        if exc.name and ENTRY_POINT[0].startswith(exc.name):
-            return None
-        raise
-    return getattr(mod, ENTRY_POINT[1], None)
-
-
-def available() -> str | None:
-    """None if the Couette solver and its report entry point are importable, else why not."""
-    try:
-        importlib.import_module(ENTRY_POINT[0])
-    except ModuleNotFoundError as exc:
-        if exc.name and not ENTRY_POINT[0].startswith(exc.name):  # the package is there, one of its imports is not
-            return f"{ENTRY_POINT[0]} is present but cannot be imported: {exc}."
-        return f"the Couette solver (package {ENTRY_POINT[0]}) is not installed in this build."
-    if _entry() is None:
-        return (f"{ENTRY_POINT[0]} has no function {ENTRY_POINT[1]}(model, *, phi_mean, e, height, wall_speed, d, rho_s, n_cells) "
-                "that the report calls (see ktgf.report.couette).")
-    return None
+_entry, available = optional_entry(*ENTRY_POINT, "the Couette solver", "(model, *, phi_mean, e, height, wall_speed, d, rho_s, n_cells)")
 
 
 def solve_profiles(model: Any, s: ReportSettings, dem_path: Any = None) -> xr.Dataset:

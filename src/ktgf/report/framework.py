@@ -362,3 +362,34 @@ def join_labels(names: list[str]) -> str:
 
     labels = [get_model(n).label or n for n in names]
     return labels[0] if len(labels) == 1 else ", ".join(labels[:-1]) + " and " + labels[-1]
+
+
+def optional_entry(module: str, function: str, what: str, signature: str) -> tuple[Callable[[], Any], Callable[[], str | None]]:
+    """The entry point ``module.function`` of an optional solver, as ``(entry, available)``.
+
+    ``entry()`` returns the function or None if the package is absent; ``available()`` returns
+    None when it can be called, else the sentence the page shows instead of the section.
+    """
+    import importlib
+
+    def entry() -> Any:
+        try:
+            mod = importlib.import_module(module)
+        except ModuleNotFoundError as exc:
+            if exc.name and module.startswith(exc.name):
+                return None
+            raise
+        return getattr(mod, function, None)
+
+    def available() -> str | None:
+        try:
+            importlib.import_module(module)
+        except ModuleNotFoundError as exc:
+            if exc.name and not module.startswith(exc.name):  # the package is there, one of its imports is not
+                return f"{module} is present but cannot be imported: {exc}."
+            return f"{what} (package {module}) is not installed in this build."
+        if entry() is None:
+            return f"{module} has no function {function}{signature} that the report calls."
+        return None
+
+    return entry, available

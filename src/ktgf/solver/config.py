@@ -28,13 +28,13 @@ Errors name the field (``grid.cells.0``, ``initial.solid_fraction``) and the val
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from ..errors import InputError, KtgfError
+from ..io import read_toml
 from .fluxes import LIMITERS, RIEMANN_SOLVERS
 from .grid import MIN_CELLS
 
@@ -170,13 +170,7 @@ def parse_config(data: dict[str, Any], source: str = "config") -> Config:
 
 def load_config(path: str | Path) -> Config:
     """Read and validate a TOML run configuration."""
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise InputError(f"config file {str(path)!r} does not exist") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
+    data = read_toml(path)
     return parse_config(data, str(path))
 
 
