@@ -1,0 +1,166 @@
+"""Frictional collisions in kinetic theory: effective restitution and the modified dissipation.
+
+A frictional (or rough) collision removes more energy than a smooth one: part of the relative
+tangential motion is destroyed, and energy fed into rotation is later dissipated too.  In a
+kinetic theory of *frictionless* spheres this is represented by an effective restitution
+coefficient e_eff < e that enters the collisional dissipation (the cooling rate ζ0) only:
+
+    ζ0*_frictional = ζ0*(φ, e) · (1 − e_eff²)/(1 − e²)                                   (1)
+
+(the form of Chialvo & Sundaresan 2013, their modified dissipation K' = K (1 − e_eff²)/(1 − e²)),
+so pressure and viscosity keep the normal restitution e.  Two laws for e_eff are given here:
+
+* :class:`ChialvoSundaresanRestitution` — e_eff = e − (3/2) μ exp(−3μ), the fit of Chialvo &
+  Sundaresan (2013) to their DEM of sheared frictional spheres (Coulomb friction μ);
+* :class:`RoughSphereRestitution` — spheres with a constant tangential restitution β, with the
+  rotational temperature from the Maxwellian collision integrals of Huthmann & Zippelius (1997);
+  it also predicts T_rot/T, which the frictional DEM file reports.
+
+Both reduce exactly to e at μ = 0.  Jenkins & Zhang (2002) give a third law (nearly elastic
+spheres with Coulomb friction and a sticking tangential restitution β0); it is *not* implemented:
+we could not read the paper's equations to check a transcription (see ``docs/friction.md``).
+
+Glossary: ``e`` normal restitution, ``mu`` particle (Coulomb) friction coefficient, ``beta``
+tangential restitution (−1 smooth … +1 perfectly rough), ``q`` = 4I/(m d²) (2/5 for a solid sphere).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from ..._array import namespace
+from ._part import FrictionPart, check_friction_coefficient, check_range
+
+
+def modified_cooling_rate(zeta0: Any, e: Any, inelasticity: Any) -> Any:
+    """ζ0* with the collisional dissipation of an effective restitution, Eq. (1) above.
+
+    ``inelasticity`` is 1 − e_eff² (from a law's :meth:`inelasticity`).  Chialvo & Sundaresan,
+    Phys. Fluids 25, 070603 (2013): K' = K (1 − e_eff²)/(1 − e²) (their Eq. 26 as cited by the
+    CFDEM-PRINCETON implementation; not checked against the printed paper).  Needs e < 1.
+    """
+    return zeta0 * inelasticity / (1.0 - e**2)
+
+
+@dataclass(frozen=True)
+class ChialvoSundaresanRestitution(FrictionPart):
+    """Chialvo & Sundaresan (2013): e_eff = e − a μ exp(−b μ), a = 3/2, b = 3.
+
+    Chialvo & Sundaresan, "A modified kinetic theory for frictional granular flows in dense and
+    dilute regimes", Phys. Fluids 25, 070603 (2013): a fit to DEM of simple shear of frictional
+    spheres.  The form and constants (3/2, 3) are those of the public implementation of this
+    model in CFDEM-PRINCETON (``twoPhaseEulerFoamPU/kineticTheoryModel.C``: ``eEff_ = e_ - 3.0/2.0*
+    muFric_*exp(-3.0*muFric_)``); the paper's own equation number could not be checked.
+    Limits: e_eff = e at μ = 0 and as μ → ∞; the largest reduction, a/(b·exp 1) = 0.184, is at μ = 1/b.
+    """
+
+    amplitude: float = 1.5
+    decay: float = 3.0
+    key: ClassVar[str] = "chialvo-sundaresan-2013"
+    label: ClassVar[str] = "Chialvo–Sundaresan e_eff"
+    reference: ClassVar[str] = "Chialvo & Sundaresan, Phys. Fluids 25, 070603 (2013)"
+
+    def __post_init__(self) -> None:
+        check_range("e_eff amplitude a", self.amplitude, low=0.0)
+        check_range("e_eff decay rate b", self.decay, low=0.0)
+
+    def effective_restitution(self, e: Any, mu: Any) -> Any:
+        """e_eff(e, μ) = e − a μ exp(−b μ)."""
+        xp = namespace(e, mu)
+        return e - self.amplitude * mu * xp.exp(-self.decay * mu)
+
+    def d_effective_restitution_dmu(self, e: Any, mu: Any) -> Any:
+        """∂e_eff/∂μ = −a exp(−b μ)(1 − b μ)."""
+        xp = namespace(e, mu)
+        return -self.amplitude * xp.exp(-self.decay * mu) * (1.0 - self.decay * mu)
+
+    def inelasticity(self, e: Any, mu: Any) -> Any:
+        """1 − e_eff², the factor of the collisional dissipation."""
+        return 1.0 - self.effective_restitution(e, mu) ** 2
+
+    def rotational_ratio(self, e: Any, mu: Any) -> Any:
+        """T_rot/T is not modelled by this law (returns ``None``)."""
+        return None
+
+    def check(self, e: Any, mu: Any) -> None:
+        """Raise :class:`~ktgf.errors.InputError` for μ < 0 or an e_eff outside (−1, 1]."""
+        check_friction_coefficient(mu)
+        check_range("effective restitution e_eff", self.effective_restitution(e, mu), low=-1.0, high=1.0,
+                    low_open=True, why="from e and mu")
+
+
+@dataclass(frozen=True)
+class RoughSphereRestitution(FrictionPart):
+    """Rough spheres of constant tangential restitution β: T_rot/T and e_eff in a steady homogeneous state.
+
+    Collision rule: normal relative contact velocity × (−e), tangential × (−β).  With Maxwellian
+    translational (T) and rotational (T_rot) velocities, the collisional rates of change are
+    (Huthmann & Zippelius, Phys. Rev. E 56, R6275 (1997); written this way by Luding, Huthmann,
+    McNamara & Zippelius, Phys. Rev. E 58, 3416 (1998), whose 3D form has equal prefactors)
+
+        dT/dt ∝ −A T + B T_rot,     dT_rot/dt ∝ B T − C T_rot,
+        A = (1 − e²)/4 + η(1 − η),  B = η²/q,  C = (η/q)(1 − η/q),   η = q(1 + β)/(2(1 + q)).
+
+    The three coefficients are checked in the tests against a direct Monte Carlo average of the
+    collision rule (independent of these formulas).  In a steady homogeneous state (uniform shear
+    heats translation only) the rotational balance gives T_rot/T = B/C = η/(1 − η/q), and the
+    net translational dissipation A − B²/C defines e_eff through (1 − e_eff²)/4 = A − B²/C:
+
+        1 − e_eff² = (1 − e²) + 4[η(1 − η) − η³/(q − η)].
+
+    Limits: β = −1 (smooth) gives η = 0, e_eff = e, T_rot = 0; β = 1 and e = 1 give equipartition
+    (T_rot = T) and no dissipation.  Frictionless particles have no tangential impulse, so at μ = 0
+    the law uses β = −1 whatever the ``beta`` option; ``beta`` is the effective tangential restitution of
+    the frictional contacts (a calibration parameter: constant β is a simplification of Coulomb friction).
+    Defaults β = −1 (smooth), q = 2/5 (solid sphere, I = m d²/10 as in the shared DEM data).
+    """
+
+    beta: float = -1.0
+    q: float = 0.4
+    key: ClassVar[str] = "rough-sphere"
+    label: ClassVar[str] = "Rough spheres (constant β)"
+    reference: ClassVar[str] = "Huthmann & Zippelius, Phys. Rev. E 56, R6275 (1997); Luding et al., Phys. Rev. E 58, 3416 (1998)"
+
+    def __post_init__(self) -> None:
+        check_range("tangential restitution beta", self.beta, low=-1.0, high=1.0)
+        check_range("reduced moment of inertia q", self.q, low=0.0, high=2.0 / 3.0, low_open=True,
+                    why="q = 4I/(m d^2); 2/3 is a hollow shell")
+
+    def _beta(self, mu: Any) -> Any:
+        xp = namespace(mu)
+        return xp.where(mu > 0.0, self.beta, -1.0)
+
+    def tangential_factor(self, mu: Any) -> Any:
+        """η = q(1 + β)/(2(1 + q)) (0 for smooth spheres)."""
+        return self.q * (1.0 + self._beta(mu)) / (2.0 * (1.0 + self.q))
+
+    def collision_coefficients(self, e: Any, mu: Any) -> tuple[Any, Any, Any]:
+        """(A, B, C) of the translational/rotational collisional energy exchange."""
+        eta = self.tangential_factor(mu)
+        q = self.q
+        return (1.0 - e**2) / 4.0 + eta * (1.0 - eta), eta**2 / q, (eta / q) * (1.0 - eta / q)
+
+    def rotational_ratio(self, e: Any, mu: Any) -> Any:
+        """T_rot/T = η/(1 − η/q) in a steady homogeneous state (independent of e and φ)."""
+        eta = self.tangential_factor(mu)
+        return eta / (1.0 - eta / self.q) + 0.0 * e
+
+    def inelasticity(self, e: Any, mu: Any) -> Any:
+        """1 − e_eff² = (1 − e²) + 4[η(1 − η) − η³/(q − η)] (it may exceed 1 for small e and β ≈ 0)."""
+        eta = self.tangential_factor(mu)
+        return (1.0 - e**2) + 4.0 * (eta * (1.0 - eta) - eta**3 / (self.q - eta))
+
+    def effective_restitution(self, e: Any, mu: Any) -> Any:
+        """e_eff = √(1 − inelasticity); NaN where the inelasticity exceeds 1 (no real e_eff)."""
+        xp = namespace(e, mu)
+        return xp.sqrt(1.0 - self.inelasticity(e, mu))
+
+    def check(self, e: Any, mu: Any) -> None:
+        """Raise :class:`~ktgf.errors.InputError` for μ < 0."""
+        check_friction_coefficient(mu)
+
+
+RESTITUTION_LAWS: dict[str, type[FrictionPart]] = {
+    cls.key: cls for cls in (ChialvoSundaresanRestitution, RoughSphereRestitution)
+}
