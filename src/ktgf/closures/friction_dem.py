@@ -1,0 +1,106 @@
+"""Frictional closures against ``dem_uniform_shear_friction.csv``: the comparison table of ``docs/friction.md``.
+
+What is fitted (and only this): the tangential restitution β of the rough-sphere dissipation, to the
+rotational temperature T_rot/T of the single row μ = 0.5, φ = 0.4 (:func:`fit_tangential_restitution`).
+Everything else is predicted: the other columns of that row, the row φ = 0.5 and the frictionless
+row (μ = 0).  The remaining compositions have no fitted parameter at all.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .friction import ChialvoSundaresanRestitution, FrictionalChialvoSundaresan, LinearDilatancy, MuIRheology
+from .friction import RoughSphereRestitution
+from .friction_shear import FrictionalShearParts, frictional_uniform_shear, mu_i_uniform_shear
+from .models import get_model
+
+DEM_FILE = "dem_uniform_shear_friction.csv"
+COMPARED = ("T", "p_star", "tau_over_p", "Trot_over_T")
+#: The row the rough-sphere β is fitted to (μ, φ).
+FIT_ROW = (0.5, 0.4)
+
+
+def read_friction_dem(path: str | Path) -> list[dict[str, float]]:
+    """Rows of ``dem_uniform_shear_friction.csv`` (comment lines start with #) as dicts of floats."""
+    with open(path, newline="") as fh:
+        lines = [ln for ln in fh if not ln.startswith("#")]
+    return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(lines)]
+
+
+def fit_row(rows: list[dict[str, float]]) -> dict[str, float]:
+    """The DEM row used for fitting (μ = 0.5, φ = 0.4)."""
+    return next(r for r in rows if (r["mu"], r["phi"]) == FIT_ROW)
+
+
+def fit_tangential_restitution(trot_over_t: float, q: float = 0.4) -> float:
+    """β with T_rot/T = η/(1 − η/q), η = q(1 + β)/(2(1 + q)) (:class:`RoughSphereRestitution`), solved exactly.
+
+    T_rot/T = r gives η = r/(1 + r/q), hence β = 2(1 + q)η/q − 1.
+    """
+    eta = trot_over_t / (1.0 + trot_over_t / q)
+    return 2.0 * (1.0 + q) * eta / q - 1.0
+
+
+def compositions(rows: list[dict[str, float]]) -> list[tuple[str, str, Any]]:
+    """(name, what is fitted, parts) of the compared models; ``parts`` is a FrictionalShearParts or a μ(I) pair."""
+    beta = fit_tangential_restitution(fit_row(rows)["Trot_over_T"])
+    ret, fcs = get_model("ret"), FrictionalChialvoSundaresan()
+    return [
+        ("RET, CS χ, frictionless", "nothing", FrictionalShearParts(ret, restitution=RoughSphereRestitution())),
+        ("RET, CS χ, e_eff Chialvo–Sundaresan", "nothing", FrictionalShearParts(ret)),
+        ("RET, χ_CS13(φ_c(μ)), e_eff Chialvo–Sundaresan", "nothing",
+         FrictionalShearParts(ret.replace(rdf=fcs), restitution=ChialvoSundaresanRestitution())),
+        (f"RET, χ_CS13(φ_c(μ)), rough spheres β = {beta:.3f}", "β to T_rot/T at μ = 0.5, φ = 0.4",
+         FrictionalShearParts(ret.replace(rdf=fcs), restitution=RoughSphereRestitution(beta=beta))),
+        ("Enskog, χ_CS13(φ_c(μ)), e_eff Chialvo–Sundaresan", "nothing",
+         FrictionalShearParts(get_model("enskog").replace(rdf=fcs))),
+        ("μ(I) + φ(I) (Jop et al. 2006 glass beads)", "nothing", (MuIRheology(), LinearDilatancy())),
+    ]
+
+
+def predict(parts: Any, row: dict[str, float]):
+    """The prediction of one composition at a DEM row's (φ, e, μ)."""
+    if isinstance(parts, tuple):
+        return mu_i_uniform_shear(parts[0], parts[1], row["phi"])
+    return frictional_uniform_shear(parts, row["phi"], row["e"], row["mu"])
+
+
+def compare_with_dem(parts: Any, rows: list[dict[str, float]]) -> list[dict[str, float]]:
+    """Prediction and relative error (model/DEM − 1) for each DEM row and each compared quantity."""
+    out = []
+    for row in rows:
+        pred = predict(parts, row)
+        rec: dict[str, float] = {"mu": row["mu"], "phi": row["phi"]}
+        for q in COMPARED:
+            value = float(np.asarray(getattr(pred, q))[0])
+            rec[q], rec[q + "_dem"] = value, row[q]
+            rec[q + "_err"] = value / row[q] - 1.0 if row[q] != 0.0 else math.nan
+        out.append(rec)
+    return out
+
+
+def _cell(value: float, err: float) -> str:
+    if math.isnan(value):
+        return "–"
+    return f"{value:.3f} ({100 * err:+.1f} %)" if not math.isnan(err) else f"{value:.3f}"
+
+
+def comparison_markdown(rows: list[dict[str, float]]) -> str:
+    """The comparison table of ``docs/friction.md`` (regenerate it with this function; a test checks it)."""
+    head = "| model | fitted | μ | φ | T | p* | τ/p | T_rot/T |\n|---|---|---|---|---|---|---|---|\n"
+    dem = "".join(
+        f"| DEM | – | {r['mu']:g} | {r['phi']:g} | {r['T']:.3f} | {r['p_star']:.3f} | {r['tau_over_p']:.3f} "
+        f"| {r['Trot_over_T']:.3f} |\n" for r in rows
+    )
+    body = ""
+    for name, fitted, parts in compositions(rows):
+        for rec in compare_with_dem(parts, rows):
+            cells = " | ".join(_cell(rec[q], rec[q + "_err"]) for q in COMPARED)
+            body += f"| {name} | {fitted} | {rec['mu']:g} | {rec['phi']:g} | {cells} |\n"
+    return head + dem + body
