@@ -1,0 +1,115 @@
+"""Frictional collisions: effective restitution laws, their limits, derivatives and the rough-sphere
+collision integrals checked against a direct Monte Carlo of the collision rule."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from ktgf.closures.friction import ChialvoSundaresanRestitution, RoughSphereRestitution, modified_cooling_rate
+from ktgf.errors import InputError
+
+jax = pytest.importorskip("jax")
+jnp = jax.numpy
+
+
+def test_chialvo_sundaresan_published_form_and_limits():
+    law = ChialvoSundaresanRestitution()
+    # e_eff = e − (3/2) μ exp(−3μ): at μ = 0.5, e = 0.7 this is 0.7 − 0.75 e^(−1.5).
+    assert law.effective_restitution(0.7, 0.5) == pytest.approx(0.7 - 0.75 * math.exp(-1.5), rel=1e-14)
+    e = np.linspace(0.1, 1.0, 7)
+    np.testing.assert_array_equal(law.effective_restitution(e, 0.0), e)  # frictionless: exactly e
+    assert law.effective_restitution(0.7, 50.0) == pytest.approx(0.7, abs=1e-50)  # the fit returns to e
+    # largest reduction a/(b·exp 1) at μ = 1/b
+    mus = np.linspace(0.0, 3.0, 30001)
+    red = 0.7 - law.effective_restitution(0.7, mus)
+    assert mus[np.argmax(red)] == pytest.approx(1.0 / 3.0, abs=1e-4)
+    assert red.max() == pytest.approx(1.5 / (3.0 * math.e), rel=1e-8)
+
+
+def test_chialvo_sundaresan_derivative_matches_autodiff():
+    law = ChialvoSundaresanRestitution()
+    grad = jax.grad(lambda mu: law.effective_restitution(0.7, mu))
+    for mu in (0.0, 0.1, 0.5, 1.3):
+        assert float(grad(mu)) == pytest.approx(float(law.d_effective_restitution_dmu(0.7, mu)), rel=1e-12, abs=1e-14)
+
+
+def test_modified_cooling_rate_is_unchanged_without_friction():
+    law = ChialvoSundaresanRestitution()
+    z = np.array([0.2, 0.5])
+    np.testing.assert_array_equal(modified_cooling_rate(z, 0.7, law.inelasticity(0.7, 0.0)), z)
+    # friction only adds dissipation
+    assert np.all(modified_cooling_rate(z, 0.7, law.inelasticity(0.7, 0.5)) > z)
+
+
+def _monte_carlo(e, beta, T, R, n=400_000, seed=3, q=0.4):
+    """Mean translational and rotational energy change per collision (collision-rate weighted)."""
+    rng = np.random.default_rng(seed)
+    m, a = 1.0, 0.5
+    inertia = q * m * a**2
+    v = rng.normal(0.0, math.sqrt(T / m), (2, n, 3))
+    w = rng.normal(0.0, math.sqrt(R / inertia), (2, n, 3))
+    nrm = rng.normal(size=(n, 3))
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    g = v[0] - v[1]
+    rate = np.maximum((g * nrm).sum(1), 0.0)  # approaching pairs, weighted by |g·n|
+    gc = g + np.cross(w[0] + w[1], a * nrm)  # relative velocity of the contact points
+    gcn = (gc * nrm).sum(1)[:, None] * nrm
+    impulse = -(m / 2) * (1 + e) * gcn - (1 + beta) * (gc - gcn) / ((2 / m) * (1 + 1 / q))
+    v1, v2 = v[0] + impulse / m, v[1] - impulse / m
+    w1, w2 = w[0] + np.cross(a * nrm, impulse) / inertia, w[1] + np.cross(a * nrm, impulse) / inertia
+    d_tr = 0.5 * m * ((v1**2).sum(1) + (v2**2).sum(1) - (v[0] ** 2).sum(1) - (v[1] ** 2).sum(1))
+    d_rot = 0.5 * inertia * ((w1**2).sum(1) + (w2**2).sum(1) - (w[0] ** 2).sum(1) - (w[1] ** 2).sum(1))
+    # normalise by (m/4)<(g·n)^2>, which equals T for a Maxwellian: the smooth loss is then (1 − e²)T
+    norm = (rate * (g * nrm).sum(1) ** 2).mean() * m / 4
+    return (rate * d_tr).mean() / norm, (rate * d_rot).mean() / norm
+
+
+@pytest.mark.parametrize("e, beta, R", [(0.7, 0.5, 0.0), (0.7, 0.5, 0.6), (0.9, 0.0, 0.3), (0.5, 0.9, 1.2)])
+def test_rough_sphere_coefficients_match_monte_carlo(e, beta, R):
+    law = RoughSphereRestitution(beta=beta)
+    A, B, C = law.collision_coefficients(e, 1.0)
+    tr, rot = _monte_carlo(e, beta, 1.0, R)
+    # the formulas give per-collision changes 4(−A T + B R) and 4(B T − C R) in these units
+    assert tr == pytest.approx(4 * (-A + B * R), rel=0.015, abs=0.01)
+    assert rot == pytest.approx(4 * (B - C * R), rel=0.015, abs=0.01)
+
+
+def test_rough_sphere_limits():
+    smooth = RoughSphereRestitution(beta=-1.0)
+    assert smooth.effective_restitution(0.7, 0.5) == pytest.approx(0.7, rel=1e-14)
+    assert smooth.rotational_ratio(0.7, 0.5) == 0.0
+    rough = RoughSphereRestitution(beta=1.0)
+    assert rough.rotational_ratio(1.0, 0.5) == pytest.approx(1.0, rel=1e-14)  # equipartition
+    assert rough.effective_restitution(1.0, 0.5) == pytest.approx(1.0, abs=1e-7)  # no dissipation
+    # μ = 0 means no tangential impulse whatever β
+    fitted = RoughSphereRestitution(beta=0.7)
+    assert fitted.effective_restitution(0.7, 0.0) == pytest.approx(0.7, rel=1e-14)
+    assert fitted.rotational_ratio(0.7, 0.0) == 0.0
+    # the steady rotational ratio 2(1 + β)/(9 − 5β) for solid spheres (q = 2/5)
+    for beta in (-0.5, 0.0, 0.7):
+        law = RoughSphereRestitution(beta=beta)
+        assert law.rotational_ratio(0.7, 0.5) == pytest.approx(2 * (1 + beta) / (9 - 5 * beta), rel=1e-13)
+        assert law.inelasticity(0.7, 0.5) > 1 - 0.7**2
+
+
+def test_rotational_ratio_is_the_steady_state_of_the_collision_integrals():
+    law = RoughSphereRestitution(beta=0.4)
+    A, B, C = law.collision_coefficients(0.8, 0.5)
+    r = law.rotational_ratio(0.8, 0.5)
+    assert B - C * r == pytest.approx(0.0, abs=1e-15)
+    assert law.inelasticity(0.8, 0.5) == pytest.approx(4 * (A - B * r), rel=1e-13)
+
+
+def test_bad_input_is_one_line():
+    with pytest.raises(InputError, match="friction coefficient mu = -0.1"):
+        ChialvoSundaresanRestitution().check(0.7, -0.1)
+    with pytest.raises(InputError, match="tangential restitution beta = 1.5"):
+        RoughSphereRestitution(beta=1.5)
+    with pytest.raises(InputError, match="moment of inertia q = 0"):
+        RoughSphereRestitution(q=0.0)
+    with pytest.raises(InputError) as err:
+        RoughSphereRestitution().check(0.7, -1.0)
+    assert "\n" not in str(err.value)
