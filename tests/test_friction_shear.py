@@ -23,6 +23,7 @@ from ktgf.closures.friction_dem import (
     DEM_FILE,
     comparison_markdown,
     compositions,
+    jamming_sensitivity_markdown,
     compare_with_dem,
     fit_row,
     fit_tangential_restitution,
@@ -135,3 +136,43 @@ def test_docs_table_is_current(dem_rows):
     assert m.group(1) == comparison_markdown(dem_rows), (
         "docs/friction.md comparison table is stale: regenerate it with ktgf.closures.friction_dem.comparison_markdown"
     )
+
+
+def test_a_second_fitted_parameter_does_not_rescue_the_dense_row(dem_rows):
+    """docs/friction.md §6: fitting μ_J (hence φ_c) to p* at the fit row fails or mispredicts φ = 0.5."""
+    from scipy.optimize import brentq
+
+    from ktgf.closures.friction import ChialvoSundaresanRestitution
+
+    row = fit_row(dem_rows)
+    dense = next(r for r in dem_rows if (r["mu"], r["phi"]) == (0.5, 0.5))
+    beta = fit_tangential_restitution(row["Trot_over_T"])
+
+    def p_star(theory, law, mu_scale, phi=0.4):
+        parts = FrictionalShearParts(get_model(theory).replace(rdf=FrictionalChialvoSundaresan(mu_scale=mu_scale)),
+                                     restitution=law)
+        return frictional_uniform_shear(parts, phi, 0.7, 0.5).p_star[0]
+
+    scales = np.logspace(-4, 3, 29)
+    rough = [p_star("ret", RoughSphereRestitution(beta=beta), s) for s in scales]
+    assert max(rough) < 0.56 < row["p_star"]  # no μ_J reaches the DEM pressure
+    cs13 = [p_star("ret", ChialvoSundaresanRestitution(), s) for s in scales]
+    assert min(cs13) > row["p_star"]  # none comes down to it either
+    law = ChialvoSundaresanRestitution()
+    log_scale = brentq(lambda x: p_star("enskog", law, 10**x) - row["p_star"], -4, 3)
+    rdf = FrictionalChialvoSundaresan(mu=0.5, mu_scale=10**log_scale)
+    assert rdf.phi_c == pytest.approx(0.612, abs=1e-3)
+    assert p_star("enskog", law, 10**log_scale, phi=0.5) / dense["p_star"] - 1 == pytest.approx(-0.35, abs=0.01)
+
+
+def test_docs_jamming_sensitivity_is_current(dem_rows):
+    """docs/friction.md §2: the μ_J table, and T, τ/p moving by less than 2 % across it."""
+    text = DOCS.read_text()
+    m = re.search(r"<!-- jamming-table-start -->\n(.*?)<!-- jamming-table-end -->", text, re.S)
+    assert m and m.group(1) == jamming_sensitivity_markdown(dem_rows)
+    parts = [FrictionalShearParts(get_model("ret").replace(rdf=FrictionalChialvoSundaresan(mu_scale=s)))
+             for s in (0.05, 0.1, 0.2, 0.5)]
+    states = [frictional_uniform_shear(p, [0.4, 0.5], 0.7, 0.5) for p in parts]
+    for q in ("T", "tau_over_p"):
+        v = np.array([getattr(st, q) for st in states])
+        assert np.all(v.max(0) / v.min(0) - 1 < 0.02)

@@ -104,3 +104,23 @@ def comparison_markdown(rows: list[dict[str, float]]) -> str:
             cells = " | ".join(_cell(rec[q], rec[q + "_err"]) for q in COMPARED)
             body += f"| {name} | {fitted} | {rec['mu']:g} | {rec['phi']:g} | {cells} |\n"
     return head + dem + body
+
+
+def jamming_sensitivity_markdown(rows: list[dict[str, float]], scales: tuple[float, ...] = (0.05, 0.1, 0.2, 0.5)) -> str:
+    """The μ_J sensitivity table of ``docs/friction.md`` §2 (RET, frictional CS13 χ, both restitution laws)."""
+    beta = fit_tangential_restitution(fit_row(rows)["Trot_over_T"])
+    dem = {r["phi"]: r["p_star"] for r in rows if r["mu"] == 0.5}
+    laws = (ChialvoSundaresanRestitution(), RoughSphereRestitution(beta=beta))
+    out = (f"| μ_J | φ_c(0.5) | p* at φ = 0.4 / 0.5, CS13 e_eff | p* at φ = 0.4 / 0.5, rough β = {beta:.3f} | DEM p* |\n"
+           "|---|---|---|---|---|\n")
+    for k, scale in enumerate(scales):
+        rdf = FrictionalChialvoSundaresan(mu_scale=scale)
+        cells = []
+        for law in laws:
+            s = frictional_uniform_shear(FrictionalShearParts(get_model("ret").replace(rdf=rdf), restitution=law),
+                                         [0.4, 0.5], 0.7, 0.5)
+            cells.append(f"{s.p_star[0]:.3f} / {s.p_star[1]:.3f}")
+        ref = f"{dem[0.4]:.3f} / {dem[0.5]:.3f}" if k == 0 else ""
+        phi_c = FrictionalChialvoSundaresan(mu=0.5, mu_scale=scale).phi_c
+        out += f"| {scale:g} | {phi_c:.3f} | {cells[0]} | {cells[1]} | {ref} |\n"
+    return out
