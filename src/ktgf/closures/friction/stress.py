@@ -96,7 +96,22 @@ class JohnsonJacksonPressure(FrictionPart):
 
 
 @dataclass(frozen=True)
-class SchaefferViscosity(FrictionPart):
+class _AngleOfInternalFriction(FrictionPart):
+    """Base of the frictional viscosities: the angle of internal friction φ_fr (degrees)."""
+
+    phi_fr_deg: float = 28.5
+
+    def __post_init__(self) -> None:
+        check_range("angle of internal friction phi_fr", self.phi_fr_deg, low=0.0, high=90.0, low_open=True,
+                    high_open=True, why="degrees")
+
+    @property
+    def sin_phi(self) -> float:
+        return math.sin(math.radians(self.phi_fr_deg))
+
+
+@dataclass(frozen=True)
+class SchaefferViscosity(_AngleOfInternalFriction):
     """Schaeffer (1987) frictional viscosity μ_f = p_f sin φ_fr / (2 √I2D) [Pa s].
 
     Schaeffer, J. Differ. Equations 66, 19 (1987); as implemented in MFiX ``calc_mu_s.f``
@@ -107,18 +122,9 @@ class SchaefferViscosity(FrictionPart):
     must regularise I2D, see ``docs/friction.md``).  Default φ_fr = 28.5° (module table).
     """
 
-    phi_fr_deg: float = 28.5
     key: ClassVar[str] = "schaeffer"
     label: ClassVar[str] = "Schaeffer frictional viscosity"
     reference: ClassVar[str] = "Schaeffer, J. Differ. Equations 66, 19 (1987)"
-
-    def __post_init__(self) -> None:
-        check_range("angle of internal friction phi_fr", self.phi_fr_deg, low=0.0, high=90.0, low_open=True,
-                    high_open=True, why="degrees")
-
-    @property
-    def sin_phi(self) -> float:
-        return math.sin(math.radians(self.phi_fr_deg))
 
     def viscosity(self, p_f: Any, i2d: Any) -> Any:
         """μ_f(p_f, I2D) [Pa s]."""
@@ -131,7 +137,7 @@ class SchaefferViscosity(FrictionPart):
 
 
 @dataclass(frozen=True)
-class SrivastavaSundaresanViscosity(FrictionPart):
+class SrivastavaSundaresanViscosity(_AngleOfInternalFriction):
     """Srivastava & Sundaresan (2003): frictional pressure and viscosity with the fluctuation term.
 
     Srivastava & Sundaresan, Powder Technol. 129, 72 (2003), in the form of MFiX ``calc_mu_s.f``
@@ -147,20 +153,14 @@ class SrivastavaSundaresanViscosity(FrictionPart):
     smaller when the particles are agitated (the fluctuations regularise the γ̇ → 0 singularity).
     """
 
-    phi_fr_deg: float = 28.5
     n_compression: float = 1.03
     key: ClassVar[str] = "srivastava-sundaresan"
     label: ClassVar[str] = "Srivastava–Sundaresan frictional viscosity"
     reference: ClassVar[str] = "Srivastava & Sundaresan, Powder Technol. 129, 72 (2003)"
 
     def __post_init__(self) -> None:
-        check_range("angle of internal friction phi_fr", self.phi_fr_deg, low=0.0, high=90.0, low_open=True,
-                    high_open=True, why="degrees")
+        super().__post_init__()
         check_range("compression exponent n_compression", self.n_compression, low=1.0, low_open=True)
-
-    @property
-    def sin_phi(self) -> float:
-        return math.sin(math.radians(self.phi_fr_deg))
 
     @property
     def n_dilation(self) -> float:
