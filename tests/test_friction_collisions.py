@@ -113,3 +113,18 @@ def test_bad_input_is_one_line():
     with pytest.raises(InputError) as err:
         RoughSphereRestitution().check(0.7, -1.0)
     assert "\n" not in str(err.value)
+
+
+def test_hcs_rotational_ratio_is_the_attractor_of_the_cooling_equations():
+    """With dT/dτ = −A T + B R and dR/dτ = B T − C R (τ the collision time), r = R/T obeys
+    dr/dτ = B + (A − C) r − B r²; integrated from r = 0 it must settle on the closed-form root."""
+    from scipy.integrate import solve_ivp
+
+    for e, beta in ((0.9, 0.5), (0.7, -0.3), (0.8, 0.95)):
+        law = RoughSphereRestitution(beta=beta)
+        A, B, C = law.collision_coefficients(e, 1.0)
+        sol = solve_ivp(lambda _t, r: B + (A - C) * r - B * r**2, (0.0, 5000.0), [0.0], method="LSODA",
+                        rtol=1e-12, atol=1e-14)
+        assert sol.y[0, -1] == pytest.approx(float(law.hcs_rotational_ratio(e, 1.0)), rel=1e-8)
+    assert RoughSphereRestitution(beta=-1.0).hcs_rotational_ratio(0.7, 0.5) == 0.0
+    assert RoughSphereRestitution(beta=0.7).hcs_rotational_ratio(0.7, 0.0) == 0.0  # frictionless

@@ -78,3 +78,17 @@ def test_bad_input_is_one_line():
         with_jamming_fraction(CarnahanStarling(), 0.5)
     with pytest.raises(InputError, match="freezing point phi_f = 0.58"):
         with_jamming_fraction(Torquato(phi_f=0.58), 0.5)
+
+
+def test_frictional_rdf_fits_the_model_registry():
+    """Flat, JSON-serialisable options; ``mu`` is routed to the RDF by Model.with_options."""
+    import json
+
+    from ktgf import get_model
+
+    model = get_model("ret").replace(rdf=FrictionalChialvoSundaresan(), name="frictional-check")
+    moved = model.with_options(mu=0.5)
+    assert moved.phi_max == pytest.approx(0.565)
+    assert json.loads(moved.metadata()["model_options"])["rdf"]["mu"] == 0.5
+    with pytest.raises(InputError, match="friction coefficient mu = -1"):
+        model.with_options(mu=-1.0)

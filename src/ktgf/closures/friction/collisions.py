@@ -156,6 +156,19 @@ class RoughSphereRestitution(FrictionPart):
         xp = namespace(e, mu)
         return xp.sqrt(1.0 - self.inelasticity(e, mu))
 
+    def hcs_rotational_ratio(self, e: Any, mu: Any) -> Any:
+        """T_rot/T in the homogeneous cooling state, where both temperatures decay together.
+
+        d(T_rot/T)/dτ = B + (A − C) r − B r² = 0 gives r = [A − C + √((A − C)² + 4B²)]/(2B)
+        (Huthmann & Zippelius 1997; Luding et al. 1998).  Smooth spheres (B = 0) exchange no energy
+        with rotation: r = 0 is returned (the state that starts without rotation keeps none).
+        """
+        xp = namespace(e, mu)
+        A, B, C = self.collision_coefficients(e, mu)
+        coupled = B > 0.0
+        safe = xp.where(coupled, B, 1.0)
+        return xp.where(coupled, (A - C + xp.sqrt((A - C) ** 2 + 4.0 * B**2)) / (2.0 * safe), 0.0)
+
     def check(self, e: Any, mu: Any) -> None:
         """Raise :class:`~ktgf.errors.InputError` for μ < 0."""
         check_friction_coefficient(mu)

@@ -2,7 +2,7 @@
 
 Frictional spheres jam (and their sheared pair correlation at contact diverges) below random close
 packing: φ_c falls from φ_rcp ≈ 0.64 at μ = 0 towards random loose packing φ_rlp ≈ 0.55 as μ
-grows over several decades (Silbert, Soft Matter 6, 2918 (2010), abstract; Chialvo, Sun &
+grows over several decades (Silbert, Soft Matter 6, 2918 (2010), arXiv:1108.0012, abstract; Chialvo, Sun &
 Sundaresan, Phys. Rev. E 85, 021305 (2012)).  We could not read those papers' tables, so φ_c(μ)
 is a smooth interpolation between the two documented end points, with its μ scale a named option:
 
