@@ -8,7 +8,13 @@ import math
 import numpy as np
 import pytest
 
-from ktgf.closures.friction import ChialvoSundaresanRestitution, RoughSphereRestitution, modified_cooling_rate
+from ktgf.closures.friction import (
+    ChialvoSundaresanRestitution,
+    RoughSphereRestitution,
+    WaltonRestitution,
+    modified_cooling_rate,
+)
+from ktgf.closures.friction.collisions import _walton_moments
 from ktgf.errors import InputError
 
 jax = pytest.importorskip("jax")
@@ -44,8 +50,11 @@ def test_modified_cooling_rate_is_unchanged_without_friction():
     assert np.all(modified_cooling_rate(z, 0.7, law.inelasticity(0.7, 0.5)) > z)
 
 
-def _monte_carlo(e, beta, T, R, n=400_000, seed=3, q=0.4):
-    """Mean translational and rotational energy change per collision (collision-rate weighted)."""
+def _monte_carlo(e, beta, T, R, n=400_000, seed=3, q=0.4, mu=None):
+    """Mean translational and rotational energy change per collision (collision-rate weighted).
+
+    With ``mu`` the tangential restitution is Walton's min(β0, −1 + μ(1 + e)(1 + 1/q)|g_n|/|g_ct|), β0 = ``beta``.
+    """
     rng = np.random.default_rng(seed)
     m, a = 1.0, 0.5
     inertia = q * m * a**2
@@ -57,6 +66,9 @@ def _monte_carlo(e, beta, T, R, n=400_000, seed=3, q=0.4):
     rate = np.maximum((g * nrm).sum(1), 0.0)  # approaching pairs, weighted by |g·n|
     gc = g + np.cross(w[0] + w[1], a * nrm)  # relative velocity of the contact points
     gcn = (gc * nrm).sum(1)[:, None] * nrm
+    if mu is not None:
+        slip = np.linalg.norm(gc - gcn, axis=1) + 1e-300
+        beta = np.minimum(beta, -1 + mu * (1 + e) * (1 + 1 / q) * np.abs((g * nrm).sum(1)) / slip)[:, None]
     impulse = -(m / 2) * (1 + e) * gcn - (1 + beta) * (gc - gcn) / ((2 / m) * (1 + 1 / q))
     v1, v2 = v[0] + impulse / m, v[1] - impulse / m
     w1, w2 = w[0] + np.cross(a * nrm, impulse) / inertia, w[1] + np.cross(a * nrm, impulse) / inertia
@@ -128,3 +140,28 @@ def test_hcs_rotational_ratio_is_the_attractor_of_the_cooling_equations():
         assert sol.y[0, -1] == pytest.approx(float(law.hcs_rotational_ratio(e, 1.0)), rel=1e-8)
     assert RoughSphereRestitution(beta=-1.0).hcs_rotational_ratio(0.7, 0.5) == 0.0
     assert RoughSphereRestitution(beta=0.7).hcs_rotational_ratio(0.7, 0.0) == 0.0  # frictionless
+
+
+@pytest.mark.parametrize("e, mu, beta0, r", [(0.7, 0.5, 1.0, 0.5), (0.9, 0.2, 0.4, 0.2), (0.7, 1.5, 0.8, 1.0)])
+def test_walton_averages_match_monte_carlo(e, mu, beta0, r):
+    m1, m2 = _walton_moments(e, mu, beta0, 0.4, r)
+    f = r / (0.4 + r)
+    rot = m2 / 0.4 - f * m1
+    tr = -(1 - e**2) - ((1 - f) * m1 - m2)
+    mc_tr, mc_rot = _monte_carlo(e, beta0, 1.0, r, mu=mu)
+    assert mc_rot == pytest.approx(rot, rel=0.015, abs=0.005)
+    assert mc_tr == pytest.approx(tr, rel=0.015, abs=0.005)
+
+
+def test_walton_limits():
+    law = WaltonRestitution(beta0=0.4)
+    assert law.effective_restitution(0.7, 0.0) == 0.7 and law.rotational_ratio(0.7, 0.0) == 0.0
+    rough = RoughSphereRestitution(beta=0.4)  # μ → ∞: every collision sticks
+    assert law.rotational_ratio(0.7, 1e4) == pytest.approx(rough.rotational_ratio(0.7, 1.0), rel=1e-6)
+    assert law.inelasticity(0.7, 1e4) == pytest.approx(rough.inelasticity(0.7, 1.0), rel=1e-6)
+    # the steady state really balances the rotational energy
+    r = law.rotational_ratio(0.7, 0.5)
+    assert law._rotational_balance(0.7, 0.5, r) == pytest.approx(0.0, abs=1e-12)
+    assert law.inelasticity(0.7, 0.5) > 1 - 0.7**2
+    with pytest.raises(InputError, match="beta0 = -1"):
+        WaltonRestitution(beta0=-1.0)

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from .friction import ChialvoSundaresanRestitution, FrictionalChialvoSundaresan, LinearDilatancy, MuIRheology
-from .friction import RoughSphereRestitution
+from .friction import RoughSphereRestitution, WaltonRestitution
 from .friction_shear import FrictionalShearParts, frictional_uniform_shear, mu_i_uniform_shear
 from .models import get_model
 
@@ -60,6 +60,8 @@ def compositions(rows: list[dict[str, float]]) -> list[tuple[str, str, Any]]:
          FrictionalShearParts(ret.replace(rdf=fcs), restitution=ChialvoSundaresanRestitution())),
         (f"RET, χ_CS13(φ_c(μ)), rough spheres β = {beta:.3f}", "β to T_rot/T at μ = 0.5, φ = 0.4",
          FrictionalShearParts(ret.replace(rdf=fcs), restitution=RoughSphereRestitution(beta=beta))),
+        ("RET, χ_CS13(φ_c(μ)), Walton μ, β0 = 1", "nothing (β0 = 1: the DEM contact law)",
+         FrictionalShearParts(ret.replace(rdf=fcs), restitution=WaltonRestitution(beta0=1.0))),
         ("Enskog, χ_CS13(φ_c(μ)), e_eff Chialvo–Sundaresan", "nothing",
          FrictionalShearParts(get_model("enskog").replace(rdf=fcs))),
         ("μ(I) + φ(I) (Jop et al. 2006 glass beads)", "nothing", (MuIRheology(), LinearDilatancy())),

@@ -10,6 +10,7 @@ from .collisions import (
     RESTITUTION_LAWS,
     ChialvoSundaresanRestitution,
     RoughSphereRestitution,
+    WaltonRestitution,
     modified_cooling_rate,
 )
 from .jamming import (
@@ -24,7 +25,8 @@ from .stress import JohnsonJacksonPressure, SchaefferViscosity, SrivastavaSundar
 
 __all__ = [
     "BLENDS", "SigmoidBlend", "TanhBlend",
-    "RESTITUTION_LAWS", "ChialvoSundaresanRestitution", "RoughSphereRestitution", "modified_cooling_rate",
+    "RESTITUTION_LAWS", "ChialvoSundaresanRestitution", "RoughSphereRestitution", "WaltonRestitution",
+    "modified_cooling_rate",
     "FrictionalChialvoSundaresan", "JammingFraction", "d_jamming_fraction_dmu", "jamming_fraction",
     "with_jamming_fraction",
     "DenseInertialTemperature", "LinearDilatancy", "MuIRheology", "inertial_number",

@@ -14,11 +14,13 @@ so pressure and viscosity keep the normal restitution e.  Two laws for e_eff are
   Sundaresan (2013) to their DEM of sheared frictional spheres (Coulomb friction μ);
 * :class:`RoughSphereRestitution` — spheres with a constant tangential restitution β, with the
   rotational temperature from the Maxwellian collision integrals of Huthmann & Zippelius (1997);
-  it also predicts T_rot/T, which the frictional DEM file reports.
+  it also predicts T_rot/T, which the frictional DEM file reports;
+* :class:`WaltonRestitution` — Coulomb friction μ with a sticking tangential restitution β0
+  (Walton's rule), averaged numerically over the same Maxwellian: no fitted roughness.
 
-Both reduce exactly to e at μ = 0.  Jenkins & Zhang (2002) give a third law (nearly elastic
-spheres with Coulomb friction and a sticking tangential restitution β0); it is *not* implemented:
-we could not read the paper's equations to check a transcription (see ``docs/friction.md``).
+All reduce exactly to e at μ = 0.  Jenkins & Zhang (2002) give closed forms for Walton's rule in the
+nearly elastic limit; those are *not* transcribed: we could not read the paper's equations to check
+them (see ``docs/friction.md``).
 
 Glossary: ``e`` normal restitution, ``mu`` particle (Coulomb) friction coefficient, ``beta``
 tangential restitution (−1 smooth … +1 perfectly rough), ``q`` = 4I/(m d²) (2/5 for a solid sphere).
@@ -26,7 +28,9 @@ tangential restitution (−1 smooth … +1 perfectly rough), ``q`` = 4I/(m d²) 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any, ClassVar
 
 from ..._array import namespace
@@ -174,6 +178,101 @@ class RoughSphereRestitution(FrictionPart):
         check_friction_coefficient(mu)
 
 
+@lru_cache(maxsize=256)
+def _walton_moments(e: float, mu: float, beta0: float, q: float, r: float) -> tuple[float, float]:
+    """⟨η ρ²⟩ and ⟨η² ρ²⟩ per collision (T = m = 1) for Walton's rule at T_rot/T = r.
+
+    ρ = |g_ct| (relative tangential contact velocity: 2D Gaussian, variance σ² = 2(1 + r/q) per
+    component), g_n rate-weighted (density (g/2) exp(−g²/4)); u = g_n²/4, v = ρ²/(2σ²).  Sticking
+    (ρ ≤ c g_n/(1 + β0), c = μ(1 + e)(1 + 1/q)) has η = η0; sliding has η = μ(1 + e) g_n/(2ρ).  The v
+    integral is analytic (incomplete gamma functions), the u integral is done numerically.
+    """
+    from scipy.integrate import quad
+    from scipy.special import gamma, gammaincc
+
+    sigma2 = 2.0 * (1.0 + r / q)
+    eta0 = q * (1.0 + beta0) / (2.0 * (1.0 + q))
+    slide = mu * (1.0 + e)
+
+    def integrands(u: float) -> tuple[float, float]:
+        gn = 2.0 * math.sqrt(u)
+        vstar = (slide * (1.0 + 1.0 / q) * gn / (1.0 + beta0)) ** 2 / (2.0 * sigma2)
+        stick = 2.0 * sigma2 * (1.0 - (1.0 + vstar) * math.exp(-vstar))  # ∫_0^v* ρ² e^(−v) dv
+        tail_rho = math.sqrt(2.0 * sigma2) * gamma(1.5) * gammaincc(1.5, vstar)  # ∫_v*^∞ ρ e^(−v) dv
+        first = eta0 * stick + 0.5 * slide * gn * tail_rho
+        second = eta0**2 * stick + 0.25 * slide**2 * gn**2 * math.exp(-vstar)
+        return first * math.exp(-u), second * math.exp(-u)
+
+    m1 = quad(lambda u: integrands(u)[0], 0.0, math.inf, epsabs=1e-13, epsrel=1e-11, limit=200)[0]
+    m2 = quad(lambda u: integrands(u)[1], 0.0, math.inf, epsabs=1e-13, epsrel=1e-11, limit=200)[0]
+    return m1, m2
+
+
+@dataclass(frozen=True)
+class WaltonRestitution(FrictionPart):
+    """Coulomb friction μ with a sticking tangential restitution β0 (Walton's collision rule), Maxwellian closure.
+
+    Walton, Mech. Mater. 16, 239 (1993) (the rule used by Jenkins & Zhang 2002): a collision has
+    tangential restitution β = min(β0, −1 + μ(1 + e)(1 + 1/q) |g_n|/|g_ct|) — it sticks (β0) when friction
+    can stop the contact, and slides otherwise.  Averaging the energy changes over Maxwellian
+    translational (T) and rotational (T_rot) velocities, as for :class:`RoughSphereRestitution`, with
+    ⟨ΔE_rot⟩ = m[⟨η²ρ²⟩/q − f⟨ηρ²⟩], ⟨ΔE_tr⟩ = −(1 − e²)T − m[(1 − f)⟨ηρ²⟩ − ⟨η²ρ²⟩],
+    f = r/(q + r), r = T_rot/T, ρ = |g_ct| (our derivation; the averages are done by
+    :func:`_walton_moments`, checked against a Monte Carlo of the collision rule in the tests).  In steady
+    uniform shear ⟨ΔE_rot⟩ = 0 fixes r, and ⟨ΔE_tr⟩ = −(1 − e_eff²)T gives the inelasticity.
+
+    Unlike the constant-β law it needs no fitted roughness: μ and β0 are contact properties.
+    Limits (tested): μ = 0 is smooth (e_eff = e, T_rot = 0); μ → ∞ always sticks and gives
+    :class:`RoughSphereRestitution` with β = β0.  Default β0 = 1: a linear tangential spring without
+    damping and k_t/k_n = 2/7 (the shared DEM's contact) oscillates at the normal frequency for solid
+    spheres, so a sticking contact reverses its tangential velocity.  NumPy/SciPy only (quadrature), scalars.
+    """
+
+    beta0: float = 1.0
+    q: float = 0.4
+    key: ClassVar[str] = "walton"
+    label: ClassVar[str] = "Coulomb friction + sticking β0 (Walton)"
+    reference: ClassVar[str] = "Walton, Mech. Mater. 16, 239 (1993); Maxwellian averages: docs/friction.md"
+
+    def __post_init__(self) -> None:
+        check_range("sticking tangential restitution beta0", self.beta0, low=-1.0, high=1.0, low_open=True)
+        check_range("reduced moment of inertia q", self.q, low=0.0, high=2.0 / 3.0, low_open=True,
+                    why="q = 4I/(m d^2); 2/3 is a hollow shell")
+
+    def _rotational_balance(self, e: float, mu: float, r: float) -> float:
+        m1, m2 = _walton_moments(float(e), float(mu), self.beta0, self.q, float(r))
+        return m2 / self.q - r / (self.q + r) * m1
+
+    def rotational_ratio(self, e: Any, mu: Any) -> float:
+        """T_rot/T with the rotational energy balance of steady homogeneous shear (0 at μ = 0)."""
+        from scipy.optimize import brentq
+
+        if float(mu) == 0.0:
+            return 0.0
+        # the balance is positive at r = 0 (friction spins the particles up) and negative for large r
+        high = 1.0
+        while self._rotational_balance(e, mu, high) > 0.0:
+            high *= 2.0
+        return brentq(lambda r: self._rotational_balance(e, mu, r), 0.0, high, xtol=1e-13, rtol=1e-12)
+
+    def inelasticity(self, e: Any, mu: Any) -> float:
+        """1 − e_eff² at the steady rotational ratio."""
+        if float(mu) == 0.0:
+            return 1.0 - float(e) ** 2
+        r = self.rotational_ratio(e, mu)
+        m1, m2 = _walton_moments(float(e), float(mu), self.beta0, self.q, r)
+        return (1.0 - float(e) ** 2) + (self.q / (self.q + r)) * m1 - m2
+
+    def effective_restitution(self, e: Any, mu: Any) -> float:
+        """e_eff = √(1 − inelasticity) (NaN if the inelasticity exceeds 1)."""
+        loss = self.inelasticity(e, mu)
+        return math.sqrt(1.0 - loss) if loss <= 1.0 else math.nan
+
+    def check(self, e: Any, mu: Any) -> None:
+        """Raise :class:`~ktgf.errors.InputError` for μ < 0."""
+        check_friction_coefficient(mu)
+
+
 RESTITUTION_LAWS: dict[str, type[FrictionPart]] = {
-    cls.key: cls for cls in (ChialvoSundaresanRestitution, RoughSphereRestitution)
+    cls.key: cls for cls in (ChialvoSundaresanRestitution, RoughSphereRestitution, WaltonRestitution)
 }
