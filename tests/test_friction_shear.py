@@ -176,3 +176,25 @@ def test_docs_jamming_sensitivity_is_current(dem_rows):
     for q in ("T", "tau_over_p"):
         v = np.array([getattr(st, q) for st in states])
         assert np.all(v.max(0) / v.min(0) - 1 < 0.02)
+
+
+def test_recommended_parts_reduce_to_the_frictionless_chialvo_sundaresan_model():
+    from ktgf.closures.friction_shear import recommended_parts
+
+    phi = np.array([0.3, 0.5])
+    rec = frictional_uniform_shear(recommended_parts(), phi, 0.7, 0.0)
+    ref = frictional_uniform_shear(FrictionalShearParts(get_model("ret").replace(rdf=ChialvoSundaresan())), phi, 0.7, 0.0)
+    for q in ("T", "p_star", "tau_over_p", "p_over_nT"):
+        np.testing.assert_array_equal(getattr(rec, q), getattr(ref, q))
+    np.testing.assert_array_equal(rec.Trot_over_T, 0.0)
+
+
+def test_closures_run_under_jit():
+    jax = pytest.importorskip("jax")
+    from ktgf.closures.friction import ChialvoSundaresanRestitution, MuIRheology, SigmoidBlend
+
+    jj, blend = JohnsonJacksonPressure(), SigmoidBlend(phi_star=0.58)
+    rdf = FrictionalChialvoSundaresan(mu=0.5)
+    for fn, x in ((jj.pressure, 0.55), (blend.weight, 0.6), (MuIRheology().friction, 0.3), (rdf.chi, 0.5),
+                  (lambda mu: ChialvoSundaresanRestitution().effective_restitution(0.7, mu), 0.5)):
+        assert float(jax.jit(fn)(x)) == pytest.approx(float(fn(x)), rel=1e-12)

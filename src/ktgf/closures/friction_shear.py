@@ -165,3 +165,16 @@ def mu_i_uniform_shear(rheology: Any, dilatancy: Any, phi: Any) -> FrictionalShe
     nan = np.full_like(phi, np.nan)
     return FrictionalShear(phi=phi, T=nan, Trot_over_T=nan.copy(), p_star=1.0 / inertial**2,
                            tau_over_p=rheology.friction(inertial), p_over_nT=nan.copy())
+
+
+def recommended_parts(theory: str = "ret") -> FrictionalShearParts:
+    """The provisional ``frictional`` composition of ``docs/friction.md`` §6 (nothing fitted).
+
+    ``theory`` (RET by default) with the Chialvo–Sundaresan χ diverging at φ_c(μ) and Walton's collision
+    rule with β0 = 1.  Not registered yet: the registry entry waits for the dense-regime issue.
+    """
+    from .friction import WaltonRestitution
+    from .models import get_model
+
+    return FrictionalShearParts(get_model(theory).replace(rdf=FrictionalChialvoSundaresan()),
+                                restitution=WaltonRestitution(beta0=1.0))
