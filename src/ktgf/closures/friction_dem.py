@@ -15,7 +15,13 @@ from typing import Any
 
 import numpy as np
 
-from .friction import ChialvoSundaresanRestitution, FrictionalChialvoSundaresan, LinearDilatancy, MuIRheology
+from .friction import (
+    ChialvoSundaresanRestitution,
+    DenseInertialTemperature,
+    FrictionalChialvoSundaresan,
+    LinearDilatancy,
+    MuIRheology,
+)
 from .friction import RoughSphereRestitution, WaltonRestitution
 from .friction_shear import FrictionalShearParts, frictional_uniform_shear, mu_i_uniform_shear
 from .models import get_model
@@ -64,6 +70,10 @@ def compositions(rows: list[dict[str, float]]) -> list[tuple[str, str, Any]]:
          FrictionalShearParts(ret.replace(rdf=fcs), restitution=WaltonRestitution(beta0=1.0))),
         ("Enskog, χ_CS13(φ_c(μ)), e_eff Chialvo–Sundaresan", "nothing",
          FrictionalShearParts(get_model("enskog").replace(rdf=fcs))),
+        ("RET, χ_CS13(φ_c(μ)), e_eff Chialvo–Sundaresan + dense-T floor", "nothing",
+         FrictionalShearParts(ret.replace(rdf=fcs), dense_temperature=DenseInertialTemperature())),
+        ("Proposed (GD99, χ_vd with φ_c(μ)), Walton μ, β0 = 1", "nothing",
+         FrictionalShearParts(get_model("proposed"), restitution=WaltonRestitution(beta0=1.0))),
         ("μ(I) + φ(I) (Jop et al. 2006 glass beads)", "nothing", (MuIRheology(), LinearDilatancy())),
     ]
 
