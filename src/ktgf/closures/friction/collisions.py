@@ -253,6 +253,8 @@ class WaltonRestitution(FrictionPart):
         high = 1.0
         while self._rotational_balance(e, mu, high) > 0.0:
             high *= 2.0
+            if high > 1e12:  # pragma: no cover - the balance turns negative for every β0 > −1
+                raise RuntimeError(f"no rotational steady state found for e = {e}, mu = {mu}, beta0 = {self.beta0}")
         return brentq(lambda r: self._rotational_balance(e, mu, r), 0.0, high, xtol=1e-13, rtol=1e-12)
 
     def inelasticity(self, e: Any, mu: Any) -> float:
