@@ -1,4 +1,4 @@
-"""Named closure models: compositions theory × radial distribution × viscosity law, and their registry.
+"""Named closure models: compositions theory × RDF × viscosity law × dissipation correction, and their registry.
 
 A :class:`Model` is a small frozen (hashable) object, so solvers can take it as a static
 argument of ``jax.jit``.  Solvers never branch on model names: they call
@@ -31,6 +31,7 @@ from .coefficients import Dimensional, Reduced, to_dimensional
 from .garzo_dufty1999 import GarzoDufty1999
 from .lun1984 import Lun1984
 from .rdf import CarnahanStarling, RadialDistribution, Torquato, ViscosityDivergence
+from .dissipation import CorrelationLength, NoDissipationCorrection
 from .viscosity_divergence import NoViscosityCorrection, ViscosityDivergenceLaw
 
 
@@ -72,6 +73,9 @@ class Model:
         χ(φ) and χ'(φ).
     viscosity : ViscosityLaw
         Multiplier of the shear viscosity (default: none).
+    dissipation : DissipationCorrection
+        Multiplier of the cooling rate ζ0 (default: none; :class:`~ktgf.closures.dissipation.
+        CorrelationLength` is extended kinetic theory, active only where a shear rate is given).
     label, description : str
         Display name and one-line description.
 
@@ -87,6 +91,7 @@ class Model:
     theory: Any
     rdf: RadialDistribution
     viscosity: Any = field(default_factory=NoViscosityCorrection)
+    dissipation: Any = field(default_factory=NoDissipationCorrection)
     label: str = ""
     description: str = ""
 
@@ -99,19 +104,25 @@ class Model:
         """Raise :class:`~ktgf.errors.InputError` if (φ, e, θ) is outside the model's domain."""
         check_state(phi, e, theta, phi_max=self.phi_max, rdf_name=self.rdf.describe())
 
-    def reduced(self, phi: Any, e: Any, *, check: bool = True) -> Reduced:
+    def reduced(self, phi: Any, e: Any, *, check: bool = True, shear: Any = None) -> Reduced:
         """Reduced coefficients at solid fraction φ and restitution e (broadcast together).
 
         Works on NumPy arrays and on JAX arrays (also under ``jit``/``grad``, where the range
         check is skipped).  Raises :class:`~ktgf.errors.InputError` for φ outside
-        [0, phi_max), e outside (0, 1] or NaN.
+        [0, phi_max), e outside (0, 1] or NaN.  ``shear`` is the local shear measure dγ̇/√θ,
+        used only by a dissipation correction (extended kinetic theory); without it ζ0 is the
+        theory's own.  g and C always refer to the theory's own ζ0 and p* (they serve the HCS,
+        where there is no shear).
         """
         phi, e = asarray(phi), asarray(e)
         if check:
             self.check(phi, e)
         chi, dchi = self.rdf.chi(phi), self.rdf.dchi(phi)
         r = self.theory.reduced(phi, e, chi, dchi)
-        return r._replace(eta=r.eta * self.viscosity.factor(phi))
+        return r._replace(
+            eta=r.eta * self.viscosity.factor(phi),
+            zeta0=r.zeta0 * self.dissipation.factor(phi, e, chi, shear),
+        )
 
     def coefficients(
         self, phi: Any, e: Any, theta: Any, *, d: Any, rho_s: Any, check: bool = True
@@ -141,7 +152,7 @@ class Model:
         ``zeta11``, ``sonine``, ``omega``, ``alpha`` go to the theory; ``phi_f``, ``phi_c``,
         ``beta``, ``a`` to the RDF and (where it has them) the viscosity law.
         """
-        parts = {"theory": self.theory, "rdf": self.rdf, "viscosity": self.viscosity}
+        parts = {"theory": self.theory, "rdf": self.rdf, "viscosity": self.viscosity, "dissipation": self.dissipation}
         new = {}
         used: set[str] = set()
         for part_name, part in parts.items():
@@ -160,6 +171,7 @@ class Model:
             **self.theory.options(),
             **{k: v for k, v in self.rdf.params().items() if not callable(v)},
             **self.viscosity.options(),
+            **self.dissipation.options(),
         }
 
     def metadata(self) -> dict[str, str]:
@@ -173,11 +185,13 @@ class Model:
             "theory_reference": self.theory.reference,
             "rdf": self.rdf.describe(),
             "viscosity_law": self.viscosity.key,
+            "dissipation": self.dissipation.key,
             "model_options": json.dumps(
                 {
                     "theory": self.theory.options(),
                     "rdf": {k: v for k, v in self.rdf.params().items() if not callable(v)},
                     "viscosity": self.viscosity.options(),
+                    "dissipation": self.dissipation.options(),
                 }
             ),
         }
