@@ -97,3 +97,7 @@ class CorrelationLength:
 
     def options(self) -> dict[str, Any]:
         return {"c": self.c}
+
+
+#: Dissipation corrections by key (``Model.with_options(dissipation=KEY)``).
+DISSIPATIONS: dict[str, type] = {cls.key: cls for cls in (NoDissipationCorrection, CorrelationLength)}

@@ -16,6 +16,9 @@ ret         Garzó & Dufty (1999)  Carnahan–Starling          theory's own
 visc-div    Lun et al. (1984)     Torquato                   Bocquet et al. divergence
 proposed    Garzó & Dufty (1999)  viscosity-divergence RDF   theory's own
 =========== ===================== ========================== ==========================
+
+and the recommended dense model ``dense`` (``docs/dense.md``): RET with the viscosity-divergence
+RDF whose freezing point φ_f is fitted to the DEM uniform shear (:mod:`ktgf.closures.dense`).
 """
 
 from __future__ import annotations
@@ -31,7 +34,8 @@ from .coefficients import Dimensional, Reduced, to_dimensional
 from .garzo_dufty1999 import GarzoDufty1999
 from .lun1984 import Lun1984
 from .rdf import CarnahanStarling, RadialDistribution, Torquato, ViscosityDivergence
-from .dissipation import CorrelationLength, NoDissipationCorrection
+from .dense import DENSE_PHI_F
+from .dissipation import DISSIPATIONS, NoDissipationCorrection
 from .viscosity_divergence import NoViscosityCorrection, ViscosityDivergenceLaw
 
 
@@ -150,8 +154,15 @@ class Model:
         """A copy with options changed, routed to the part that owns them.
 
         ``zeta11``, ``sonine``, ``omega``, ``alpha`` go to the theory; ``phi_f``, ``phi_c``,
-        ``beta``, ``a`` to the RDF and (where it has them) the viscosity law.
+        ``beta``, ``a``, ``junction``, ``junction_width`` to the RDF and (where it has them) the
+        viscosity law; ``dissipation`` (``"none"`` or ``"jenkins-berzi-2010"``) picks the
+        dissipation correction, whose ``c`` is then an option too.
         """
+        if "dissipation" in options:  # a part chosen by name, e.g. dissipation="jenkins-berzi-2010"
+            key = options.pop("dissipation")
+            if key not in DISSIPATIONS:
+                raise InputError(f"option dissipation = {key!r} is not valid; choose one of {', '.join(DISSIPATIONS)}")
+            return dataclasses.replace(self, dissipation=DISSIPATIONS[key]()).with_options(**options)
         parts = {"theory": self.theory, "rdf": self.rdf, "viscosity": self.viscosity, "dissipation": self.dissipation}
         new = {}
         used: set[str] = set()
@@ -278,5 +289,17 @@ register_model(
         ViscosityDivergence(),
         label="Proposed",
         description="RET with the radial distribution function derived from the viscosity divergence",
+    ),
+)
+register_model(
+    Model(
+        "dense",
+        GarzoDufty1999(),
+        ViscosityDivergence(phi_f=DENSE_PHI_F),
+        label="Dense",
+        description=(
+            "Recommended for dense flows: RET with the viscosity-divergence RDF, phi_f fitted to "
+            "DEM uniform shear (docs/dense.md)"
+        ),
     ),
 )
