@@ -125,7 +125,8 @@ class GarzoDufty1999:
 
     def __post_init__(self) -> None:
         choice_option("zeta11", self.zeta11, ZETA11_VARIANTS, owner=f"theory {self.key}")
-        bool_option("sonine", self.sonine, owner=f"theory {self.key}")
+        # stored as a plain bool (np.bool_ is accepted), so the model stays hashable and printable
+        object.__setattr__(self, "sonine", bool_option("sonine", self.sonine, owner=f"theory {self.key}"))
 
     def reduced(self, phi: Any, e: Any, chi: Any, dchi: Any) -> Reduced:
         """Reduced coefficients at (φ, e) given χ, χ' (model.md §3)."""

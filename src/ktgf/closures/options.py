@@ -53,7 +53,9 @@ def real_option(
 
 def bool_option(name: str, value: Any, *, owner: str = "") -> bool:
     """Check that option ``name`` is a real boolean (True/False, not a string or a number)."""
-    if not isinstance(value, bool) and type(value).__name__ != "bool_":
+    import numpy as np
+
+    if not isinstance(value, (bool, np.bool_)):
         raise InputError(f"option {name} = {value!r}{_where(owner)} must be true or false")
     return bool(value)
 
