@@ -129,18 +129,19 @@ class Model:
         )
 
     def coefficients(
-        self, phi: Any, e: Any, theta: Any, *, d: Any, rho_s: Any, check: bool = True
+        self, phi: Any, e: Any, theta: Any, *, d: Any, rho_s: Any, check: bool = True, shear: Any = None
     ) -> Dimensional:
         """SI coefficients (p [Pa], η, λ_b [Pa s], κ, ω, ζ0 [1/s], ζ_U) at (φ, e, θ [m²/s²]).
 
-        ``d`` is the particle diameter [m] and ``rho_s`` the material density [kg/m³].
+        ``d`` is the particle diameter [m] and ``rho_s`` the material density [kg/m³]; ``shear``
+        the local dγ̇/√θ for a dissipation correction (see :meth:`reduced`).
         """
         theta = asarray(theta)
         if check:
             self.check(phi, e, theta)
             check_positive("particle diameter d", d, "m")
             check_positive("material density rho_s", rho_s, "kg/m^3")
-        return to_dimensional(self.reduced(phi, e, check=False), asarray(phi), theta, d, rho_s)
+        return to_dimensional(self.reduced(phi, e, check=False, shear=shear), asarray(phi), theta, d, rho_s)
 
     def chi(self, phi: Any) -> Any:
         """The model's radial distribution function χ(φ)."""
