@@ -119,3 +119,11 @@ def test_sonine_must_be_a_boolean(value):
 def test_torquato_phi_f_below_phi_c():
     with pytest.raises(InputError, match="phi_f < phi_c"):
         Torquato(phi_f=0.6, phi_c=0.55)
+
+
+def test_missing_state_is_an_error_not_nan():
+    m = get_model("ret")
+    with pytest.raises(InputError, match="solid fraction phi is missing"):
+        m.coefficients(None, 0.9, 1.0, d=1e-3, rho_s=1500.0)
+    with pytest.raises(InputError, match="restitution coefficient e is missing"):
+        m.reduced(0.3, None)

@@ -106,6 +106,9 @@ class Model:
 
     def check(self, phi: Any, e: Any, theta: Any = None) -> None:
         """Raise :class:`~ktgf.errors.InputError` if (φ, e, θ) is outside the model's domain."""
+        for name, value in (("solid fraction phi", phi), ("restitution coefficient e", e)):
+            if value is None:
+                raise InputError(f"{name} is missing (None); give a number or an array")
         check_state(phi, e, theta, phi_max=self.phi_max, rdf_name=self.rdf.describe())
 
     def reduced(self, phi: Any, e: Any, *, check: bool = True, shear: Any = None) -> Reduced:
@@ -118,9 +121,9 @@ class Model:
         theory's own.  g and C always refer to the theory's own ζ0 and p* (they serve the HCS,
         where there is no shear).
         """
-        phi, e = asarray(phi), asarray(e)
         if check:
             self.check(phi, e)
+        phi, e = asarray(phi), asarray(e)
         chi, dchi = self.rdf.chi(phi), self.rdf.dchi(phi)
         r = self.theory.reduced(phi, e, chi, dchi)
         return r._replace(
