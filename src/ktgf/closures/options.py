@@ -1,8 +1,8 @@
 """Validation of model options, applied where closure parts are made (their ``__post_init__``).
 
 Every check raises :class:`~ktgf.errors.InputError` with one line naming the option, the value
-given and the valid range, e.g. ``option phi_c = 1.5 of RDF torquato is out of range: valid
-0.49 < phi_c <= 0.74048 (phi_f < phi_c <= close packing)``.  Booleans must be real booleans
+given and the valid range, e.g. ``option phi_c = 1.5 is out of range: valid 0.49 < phi_c <=
+0.74048 (RDF torquato: phi_f < phi_c <= close packing pi/sqrt(18))``.  Booleans must be real booleans
 (``sonine="no"`` is an error, not True) and numbers real finite numbers (not bools, strings, NaN).
 """
 
@@ -34,21 +34,13 @@ def real_option(
     why: str = "",
 ) -> float:
     """Check that option ``name`` is a finite real number in the given range; return it as float."""
+    from ..validation import check_range
+
     if isinstance(value, bool) or not isinstance(value, Real):
         raise InputError(f"option {name} = {value!r}{_where(owner)} must be a real number")
-    v = float(value)
-    ok = math.isfinite(v)
-    if ok and low is not None:
-        ok = v > low if low_open else v >= low
-    if ok and high is not None:
-        ok = v < high if high_open else v <= high
-    if not ok:
-        lo = "" if low is None else f"{low:.6g} {'<' if low_open else '<='} "
-        hi = "" if high is None else f" {'<' if high_open else '<='} {high:.6g}"
-        rng = f"{lo}{name}{hi}" if (lo or hi) else f"{name} finite"
-        tail = f" ({why})" if why else ""
-        raise InputError(f"option {name} = {value!r}{_where(owner)} is out of range: valid {rng}{tail}")
-    return v
+    why = f"{owner}: {why}" if owner and why else owner or why
+    check_range(f"option {name}", float(value), low=low, high=high, low_open=low_open, high_open=high_open, why=why)
+    return float(value)
 
 
 def bool_option(name: str, value: Any, *, owner: str = "") -> bool:

@@ -55,11 +55,6 @@ class RadialDistribution:
         return f"{self.key}({p})"
 
 
-def _check_phi_c(rdf: RadialDistribution) -> None:
-    real_option("phi_c", rdf.phi_c, owner=f"RDF {rdf.key}", low=0.0, high=CLOSE_PACKING,
-                why="0 < phi_c <= close packing pi/sqrt(18)")
-
-
 def _cs_chi(phi: Any) -> Any:
     return (1.0 - 0.5 * phi) / (1.0 - phi) ** 3
 
@@ -93,6 +88,19 @@ class CarnahanStarling(RadialDistribution):
 
     def dchi(self, phi: Any) -> Any:
         return _cs_dchi(phi)
+
+
+@dataclass(frozen=True)
+class _DivergesAtPhiC(RadialDistribution):
+    """An RDF whose parameter ``phi_c`` (0 < φ_c ≤ π/√18) is its packing limit."""
+
+    @property
+    def phi_max(self) -> float:
+        return self.phi_c  # type: ignore[attr-defined]
+
+    def __post_init__(self) -> None:
+        real_option("phi_c", self.phi_c, owner=f"RDF {self.key}", low=0.0, high=CLOSE_PACKING,  # type: ignore[attr-defined]
+                    why="0 < phi_c <= close packing pi/sqrt(18)")
 
 
 @dataclass(frozen=True)
@@ -174,7 +182,7 @@ class Torquato(_CarnahanStarlingBelowFreezing):
 
 
 @dataclass(frozen=True)
-class LunSavage(RadialDistribution):
+class LunSavage(_DivergesAtPhiC):
     """Lun & Savage (1986): χ = (1 − φ/φ_c)^(−2.5 φ_c).
 
     Lun & Savage, Acta Mech. 63, 15 (1986).  Default φ_c = 0.64.
@@ -185,13 +193,6 @@ class LunSavage(RadialDistribution):
     label: ClassVar[str] = "Lun–Savage"
     reference: ClassVar[str] = "Lun & Savage, Acta Mech. 63, 15 (1986)"
 
-    def __post_init__(self) -> None:
-        _check_phi_c(self)
-
-    @property
-    def phi_max(self) -> float:
-        return self.phi_c
-
     def chi(self, phi: Any) -> Any:
         return (1.0 - phi / self.phi_c) ** (-2.5 * self.phi_c)
 
@@ -200,7 +201,7 @@ class LunSavage(RadialDistribution):
 
 
 @dataclass(frozen=True)
-class MaAhmadi(RadialDistribution):
+class MaAhmadi(_DivergesAtPhiC):
     """Ma & Ahmadi (1986): χ = (1 + 2.5φ + 4.5904φ² + 4.515439φ³)/(1 − (φ/φ_c)³)^0.678021.
 
     Ma & Ahmadi, J. Chem. Phys. 84, 3449 (1986).  Default φ_c = 0.64356.
@@ -213,12 +214,8 @@ class MaAhmadi(RadialDistribution):
     reference: ClassVar[str] = "Ma & Ahmadi, J. Chem. Phys. 84, 3449 (1986)"
 
     def __post_init__(self) -> None:
-        _check_phi_c(self)
-        real_option("exponent", self.exponent, owner=f"RDF {self.key}", low=0.0, why="divergence exponent")
-
-    @property
-    def phi_max(self) -> float:
-        return self.phi_c
+        super().__post_init__()
+        real_option("exponent", self.exponent, owner=f"RDF {self.key}", low=0.0, high=10.0, why="divergence exponent, at most 10")
 
     def chi(self, phi: Any) -> Any:
         num = 1.0 + 2.5 * phi + 4.5904 * phi**2 + 4.515439 * phi**3
@@ -234,7 +231,7 @@ class MaAhmadi(RadialDistribution):
 
 
 @dataclass(frozen=True)
-class JammingPowerLaw(RadialDistribution):
+class JammingPowerLaw(_DivergesAtPhiC):
     """Carnahan–Starling plus a jamming divergence of free exponent: χ = χ_CS + a φ²/(φ_c − φ)^b.
 
     The form of Chialvo & Sundaresan, Phys. Fluids 25, 070603 (2013), their fitted χ (there
@@ -255,13 +252,9 @@ class JammingPowerLaw(RadialDistribution):
     reference: ClassVar[str] = "Chialvo & Sundaresan, Phys. Fluids 25, 070603 (2013), exponent free"
 
     def __post_init__(self) -> None:
-        _check_phi_c(self)
+        super().__post_init__()
         real_option("a", self.a, owner=f"RDF {self.key}", low=0.0, low_open=False, why="amplitude")
-        real_option("exponent", self.exponent, owner=f"RDF {self.key}", low=0.0, why="divergence exponent")
-
-    @property
-    def phi_max(self) -> float:
-        return self.phi_c
+        real_option("exponent", self.exponent, owner=f"RDF {self.key}", low=0.0, high=10.0, why="divergence exponent, at most 10")
 
     def chi(self, phi: Any) -> Any:
         # (2 − φ)/(2(1 − φ)³) in Chialvo & Sundaresan is the Carnahan–Starling χ written differently.
@@ -304,7 +297,7 @@ class ViscosityDivergence(_CarnahanStarlingBelowFreezing):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        real_option("beta", self.beta, owner=f"RDF {self.key}", low=0.0, why="divergence exponent")
+        real_option("beta", self.beta, owner=f"RDF {self.key}", low=0.0, high=10.0, why="divergence exponent, at most 10")
 
     def _dense(self, phi: Any) -> Any:
         return _cs_chi(self.phi_f) * ((self.phi_c - self.phi_f) / (self.phi_c - phi)) ** self.beta

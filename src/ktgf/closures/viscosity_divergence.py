@@ -58,7 +58,7 @@ class ViscosityDivergenceLaw:
         real_option("phi_f", self.phi_f, owner=owner, low=0.0, high=1.0, high_open=True)
         real_option("phi_c", self.phi_c, owner=owner, low=self.phi_f, high=CLOSE_PACKING,
                     why="phi_f < phi_c <= close packing pi/sqrt(18)")
-        real_option("beta", self.beta, owner=owner, low=0.0, why="divergence exponent")
+        real_option("beta", self.beta, owner=owner, low=0.0, high=10.0, why="divergence exponent, at most 10")
         choice_option("junction", self.junction, JUNCTIONS, owner=owner)
         real_option("junction_width", self.junction_width, owner=owner, low=0.0, high=self.phi_c - self.phi_f,
                     high_open=True, why="0 < width < phi_c - phi_f")
