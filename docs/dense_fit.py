@@ -30,14 +30,16 @@ role = ["fit"] * fit_rows.size + ["held out"] * held_rows.size
 
 
 def table(models):
-    print("| model | φ | e | set | η* model | η* DEM | err η* | p/(nT) model | p/(nT) DEM | err p | T model | T DEM | err T |")
+    print("| model | φ | e | set | η* model | η* DEM | err η* | p/(nT) model | p/(nT) DEM | err p "
+          "| T model | T DEM | err T |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name, m in models:
         s = shear_state(m, rows["phi"], rows["e"])
         for i, rec in enumerate(rows):
             eta, p, T = (float(np.broadcast_to(v, rows.shape)[i]) for v in (s.eta_over_eta0, s.p_over_nT, s.T))
             print(f"| {name} | {rec['phi']:g} | {rec['e']:g} | {role[i]} | {eta:.3f} | {rec['eta_over_eta0']:.3f} | "
-                  f"{eta / rec['eta_over_eta0'] - 1:+.1%} | {p:.3f} | {rec['p_over_nT']:.3f} | {p / rec['p_over_nT'] - 1:+.1%} | "
+                  f"{eta / rec['eta_over_eta0'] - 1:+.1%} | {p:.3f} | {rec['p_over_nT']:.3f} | "
+                  f"{p / rec['p_over_nT'] - 1:+.1%} | "
                   f"{T:.4f} | {rec['T']:.4f} | {T / rec['T'] - 1:+.1%} |")
 
 
@@ -45,7 +47,8 @@ print("## fit of dense: phi_f of the viscosity-divergence RDF with RET, on", dat
 phi_f, sol = fit_freezing_point(get_model("ret"), fit_rows)
 J = sol.jac
 cov = np.linalg.inv(J.T @ J) * (2 * sol.cost / max(sol.fun.size - 1, 1))
-print(f"phi_f = {phi_f:.5f} ± {np.sqrt(cov[0, 0]):.5f} (registered {DENSE_PHI_F}); cost {sol.cost:.5f}; residuals {np.round(sol.fun, 4)}")
+print(f"phi_f = {phi_f:.5f} ± {np.sqrt(cov[0, 0]):.5f} (registered {DENSE_PHI_F}); cost {sol.cost:.5f}; "
+      f"residuals {np.round(sol.fun, 4)}")
 print("held-out residuals [eta, p]:", np.round(relative_errors(get_model("dense"), held_rows), 4))
 
 print("\n## candidates tried (same fit set, same residuals; held-out = e = 0.7 row)")
@@ -53,7 +56,8 @@ base = {"ret": get_model("ret"), "enskog": get_model("enskog")}
 candidates = [
     ("phi_f", lambda x: ViscosityDivergence(phi_f=x[0]), [0.49], ([0.3], [0.6])),
     ("phi_f, beta", lambda x: ViscosityDivergence(phi_f=x[0], beta=x[1]), [0.49, 1.75], ([0.3, 0.1], [0.6, 5])),
-    ("phi_c, beta (phi_f 0.49)", lambda x: ViscosityDivergence(phi_c=x[0], beta=x[1]), [0.64, 1.75], ([0.5, 0.1], [0.7404, 5])),
+    ("phi_c, beta (phi_f 0.49)", lambda x: ViscosityDivergence(phi_c=x[0], beta=x[1]), [0.64, 1.75],
+     ([0.5, 0.1], [0.7404, 5])),
     ("jamming a (b 1.5)", lambda x: JammingPowerLaw(a=x[0]), [0.3], ([0.0], [5.0])),
     ("jamming a (b 2)", lambda x: JammingPowerLaw(a=x[0], exponent=2.0), [0.3], ([0.0], [5.0])),
     ("jamming a, b", lambda x: JammingPowerLaw(a=x[0], exponent=x[1]), [0.3, 1.5], ([0.0, 0.1], [5.0, 5.0])),
@@ -64,11 +68,13 @@ for tname, b in base.items():
     for label, make, x0, bounds in candidates:
         s = least_squares(lambda x: relative_errors(b.replace(rdf=make(x)), fit_rows), x0, bounds=bounds)
         held = relative_errors(b.replace(rdf=make(s.x)), held_rows)
-        print(f"| {tname} | {label} | {', '.join(f'{v:.4g}' for v in s.x)} | {s.cost:.5f} | {np.abs(s.fun).max():.1%} | "
+        values = ", ".join(f"{v:.4g}" for v in s.x)
+        print(f"| {tname} | {label} | {values} | {s.cost:.5f} | {np.abs(s.fun).max():.1%} | "
               f"{held[0]:+.1%}, {held[1]:+.1%} |")
 
 print("\n## uniform shear: paper models and dense (Navier–Stokes closed forms, model.md §9)")
 table([(n, get_model(n)) for n in (*PAPER_MODELS, "dense")])
 
 print("\n## extended kinetic theory on dense (correlation length constant c)")
-table([(f"dense + EKT c={c:g}", get_model("dense").replace(dissipation=CorrelationLength(c=c))) for c in (1.0, 1.5, 2.0)])
+table([(f"dense + EKT c={c:g}", get_model("dense").replace(dissipation=CorrelationLength(c=c)))
+       for c in (1.0, 1.5, 2.0)])

@@ -44,10 +44,8 @@ def shear_rows(model: Any, phi: np.ndarray, e: np.ndarray) -> list[dict[str, flo
     s = shear_state(model, phis, es)
     cols = {"T": s.T, "eta_star": s.eta_star, "eta_over_eta0": s.eta_over_eta0, "p_over_nT": s.p_over_nT,
             "astar": s.astar, "tau_over_p": s.stress_ratio, "L_over_d": s.L_over_d}
-    return [
-        {"phi": float(phis[i]), "e": float(es[i]), **{k: float(np.broadcast_to(v, phis.shape)[i]) for k, v in cols.items()}}
-        for i in range(phis.size)
-    ]
+    cols = {k: np.broadcast_to(v, phis.shape) for k, v in cols.items()}
+    return [{"phi": float(phis[i]), "e": float(es[i]), **{k: float(v[i]) for k, v in cols.items()}} for i in range(phis.size)]
 
 
 @handle_errors
@@ -55,7 +53,9 @@ def shear(
     model: str = typer.Option(..., "--model", "-m", help="Model name (see `ktgf models`)."),
     phi: str = typer.Option(..., "--phi", help="Solid fraction: value, list a,b,c or range start:stop:num."),
     e: str = typer.Option(..., "--e", help="Restitution coefficient(s), 0 < e < 1."),
-    option: list[str] = typer.Option(None, "--option", "-O", help="Model option KEY=VALUE (repeatable), e.g. phi_f=0.46."),
+    option: list[str] = typer.Option(
+        None, "--option", "-O", help="Model option KEY=VALUE (repeatable), e.g. phi_f=0.46."
+    ),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Steady uniform (Lees–Edwards) shear from the closed forms of model.md §9.

@@ -78,7 +78,8 @@ class Lun1984:
         owner = f"theory {self.key}"
         choice_option("omega", self.omega, OMEGA_VARIANTS, owner=owner)
         # (2 + α)/3 multiplies the kinetic-collisional viscosity: it must stay positive
-        real_option("alpha", self.alpha, owner=owner, low=-2.0, high=10.0, why="(2 + alpha)/3 in (0, 4]: eta > 0, MFiX uses 1.6")
+        real_option("alpha", self.alpha, owner=owner, low=-2.0, high=10.0,
+                    why="(2 + alpha)/3 in (0, 4]: eta > 0, MFiX uses 1.6")
 
     def reduced(self, phi: Any, e: Any, chi: Any, dchi: Any) -> Reduced:
         """Reduced coefficients at (φ, e) given χ, χ' (model.md §4)."""

@@ -55,6 +55,10 @@ class RadialDistribution:
         return f"{self.key}({p})"
 
 
+def _check_exponent(name: str, value: Any, key: str) -> None:
+    real_option(name, value, owner=f"RDF {key}", low=0.0, high=10.0, why="divergence exponent, at most 10")
+
+
 def _cs_chi(phi: Any) -> Any:
     return (1.0 - 0.5 * phi) / (1.0 - phi) ** 3
 
@@ -99,7 +103,8 @@ class _DivergesAtPhiC(RadialDistribution):
         return self.phi_c  # type: ignore[attr-defined]
 
     def __post_init__(self) -> None:
-        real_option("phi_c", self.phi_c, owner=f"RDF {self.key}", low=0.0, high=CLOSE_PACKING,  # type: ignore[attr-defined]
+        phi_c = self.phi_c  # type: ignore[attr-defined]
+        real_option("phi_c", phi_c, owner=f"RDF {self.key}", low=0.0, high=CLOSE_PACKING,
                     why="0 < phi_c <= close packing pi/sqrt(18)")
 
 
@@ -215,7 +220,7 @@ class MaAhmadi(_DivergesAtPhiC):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        real_option("exponent", self.exponent, owner=f"RDF {self.key}", low=0.0, high=10.0, why="divergence exponent, at most 10")
+        _check_exponent("exponent", self.exponent, self.key)
 
     def chi(self, phi: Any) -> Any:
         num = 1.0 + 2.5 * phi + 4.5904 * phi**2 + 4.515439 * phi**3
@@ -254,7 +259,7 @@ class JammingPowerLaw(_DivergesAtPhiC):
     def __post_init__(self) -> None:
         super().__post_init__()
         real_option("a", self.a, owner=f"RDF {self.key}", low=0.0, low_open=False, why="amplitude")
-        real_option("exponent", self.exponent, owner=f"RDF {self.key}", low=0.0, high=10.0, why="divergence exponent, at most 10")
+        _check_exponent("exponent", self.exponent, self.key)
 
     def chi(self, phi: Any) -> Any:
         # (2 − φ)/(2(1 − φ)³) in Chialvo & Sundaresan is the Carnahan–Starling χ written differently.
@@ -297,7 +302,7 @@ class ViscosityDivergence(_CarnahanStarlingBelowFreezing):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        real_option("beta", self.beta, owner=f"RDF {self.key}", low=0.0, high=10.0, why="divergence exponent, at most 10")
+        _check_exponent("beta", self.beta, self.key)
 
     def _dense(self, phi: Any) -> Any:
         return _cs_chi(self.phi_f) * ((self.phi_c - self.phi_f) / (self.phi_c - phi)) ** self.beta
@@ -346,7 +351,9 @@ class CustomRDF(RadialDistribution):
 
 RDFS: dict[str, type[RadialDistribution]] = {
     cls.key: cls
-    for cls in (CarnahanStarling, Torquato, LunSavage, MaAhmadi, ChialvoSundaresan, ViscosityDivergence, JammingPowerLaw)
+    for cls in (
+        CarnahanStarling, Torquato, LunSavage, MaAhmadi, ChialvoSundaresan, ViscosityDivergence, JammingPowerLaw,
+    )
 }
 
 
