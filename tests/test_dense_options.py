@@ -82,7 +82,8 @@ finite = st.floats(allow_nan=True, allow_infinity=True, width=64)
 @settings(max_examples=300, deadline=None)
 @given(phi_f=finite, phi_c=finite, beta=finite)
 def test_piecewise_rdf_accepts_exactly_the_documented_range(phi_f, phi_c, beta):
-    """Valid iff 0 < φ_f < 1, φ_f < φ_c ≤ π/√18, φ_c − φ_f > width (0.01), 0 < β ≤ 10; then χ is finite and rising."""
+    """Valid iff 0 < φ_f < 1, φ_f < φ_c ≤ π/√18, φ_c − φ_f > width (0.01), 0 < β ≤ 10; then χ is finite and
+    rising, or (only where the dense branch starts flatter than CS) the smooth junction refuses by name."""
     valid = (
         all(math.isfinite(v) for v in (phi_f, phi_c, beta))
         and 0 < phi_f < 1 and phi_f < phi_c <= CLOSE_PACKING and phi_c - phi_f > 0.01 and 0 < beta <= 10
@@ -91,7 +92,13 @@ def test_piecewise_rdf_accepts_exactly_the_documented_range(phi_f, phi_c, beta):
         with pytest.raises(InputError):
             ViscosityDivergence(phi_f=phi_f, phi_c=phi_c, beta=beta)
         return
-    r = ViscosityDivergence(phi_f=phi_f, phi_c=phi_c, beta=beta)
+    try:
+        r = ViscosityDivergence(phi_f=phi_f, phi_c=phi_c, beta=beta)
+    except InputError as exc:  # the smooth bridge refuses only when the dense branch starts flatter than CS
+        assert "not monotone" in str(exc)
+        c0 = ViscosityDivergence(phi_f=phi_f, phi_c=phi_c, beta=beta, junction="c0")
+        assert c0.dchi(np.array(phi_f + 1e-12)) < c0.dchi(np.array(phi_f))
+        return
     x = np.linspace(0.0, phi_c * (1 - 1e-6), 200)
     chi = r.chi(x)
     assert np.all(np.isfinite(chi)) and np.all(np.diff(chi) >= 0)
@@ -127,3 +134,11 @@ def test_missing_state_is_an_error_not_nan():
         m.coefficients(None, 0.9, 1.0, d=1e-3, rho_s=1500.0)
     with pytest.raises(InputError, match="restitution coefficient e is missing"):
         m.reduced(0.3, None)
+
+
+def test_non_monotone_bridge_is_refused_and_c0_still_allowed():
+    """Found by hypothesis: φ_f = 0.125, φ_c = 0.5, β = 0.25 — the dense branch starts flatter than CS."""
+    with pytest.raises(InputError, match="not monotone"):
+        ViscosityDivergence(phi_f=0.125, phi_c=0.5, beta=0.25)
+    r = ViscosityDivergence(phi_f=0.125, phi_c=0.5, beta=0.25, junction="c0")
+    assert np.all(np.diff(r.chi(np.linspace(0, 0.49, 100))) > 0)

@@ -19,7 +19,10 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 from typing import Any, Callable, ClassVar
 
+import numpy as np
+
 from .._array import namespace
+from ..errors import InputError
 from .junction import DEFAULT_WIDTH, JUNCTIONS, hermite
 from .options import CLOSE_PACKING, choice_option, real_option
 
@@ -131,6 +134,19 @@ class _CarnahanStarlingBelowFreezing(RadialDistribution):
         real_option("junction_width", self.junction_width, owner=owner, low=0.0, high=self.phi_c - self.phi_f,
                     high_open=True, why="0 < width < phi_c - phi_f")
 
+    def _check_bridge(self) -> None:
+        """The smooth bridge must keep χ increasing; it can fail to when the dense branch starts
+        flatter than CS at φ_f (not so for the published parameters: 66.4 or 37.9 against 29.7)."""
+        if self.junction != "c1":
+            return
+        t = np.linspace(0.0, 1.0, 257)
+        if np.any(self._bridge(self.phi_f + t * self.junction_width)[1] <= 0):
+            raise InputError(
+                f"junction c1 of RDF {self.key} (phi_f={self.phi_f:g}, phi_c={self.phi_c:g}, "
+                f"width={self.junction_width:g}) is not monotone: the dense branch starts flatter than CS; "
+                "use junction='c0' or a wider junction_width"
+            )
+
     @property
     def phi_max(self) -> float:
         return self.phi_c
@@ -175,6 +191,10 @@ class Torquato(_CarnahanStarlingBelowFreezing):
     key: ClassVar[str] = "torquato"
     label: ClassVar[str] = "Torquato"
     reference: ClassVar[str] = "Torquato, Phys. Rev. E 51, 3170 (1995)"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self._check_bridge()
 
     def _dense(self, phi: Any) -> Any:
         return _cs_chi(self.phi_f) * (self.phi_c - self.phi_f) / (self.phi_c - phi)
@@ -303,6 +323,7 @@ class ViscosityDivergence(_CarnahanStarlingBelowFreezing):
     def __post_init__(self) -> None:
         super().__post_init__()
         _check_exponent("beta", self.beta, self.key)
+        self._check_bridge()
 
     def _dense(self, phi: Any) -> Any:
         return _cs_chi(self.phi_f) * ((self.phi_c - self.phi_f) / (self.phi_c - phi)) ** self.beta
