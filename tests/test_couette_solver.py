@@ -89,8 +89,8 @@ def test_converges_over_the_practical_range(name, e):
 
 # Known limits of the current solver, kept visible here (strict xfail: a fix shows up as XPASS).
 # Strongly inelastic (e = 0.5) Visc.div. cells: cores approaching jamming (φ_c − φ ~ 1e-4, θ ~ 1e-8 U²,
-# Jacobian condition ~1e13), and a case where the densest node crosses φ_f = 0.49, where Torquato's χ
-# and the viscosity law have a kink (the residual is not differentiable there; Newton stalls).
+# Jacobian condition ~1e13), and a case where the densest node crosses φ_f = 0.49.  That one still
+# stalls with the smooth (C²) junction at φ_f (issue 9, docs/dense.md §5): the kink was not the cause.
 KNOWN_FAILURES_E05 = {("visc-div", 0.62, 1e-3), ("visc-div", 0.62, 0.1), ("visc-div", 0.3, 1.0)}
 
 

@@ -29,6 +29,7 @@ def model_rows() -> list[dict[str, str]]:
             "theory": m.theory.label,
             "rdf": m.rdf.describe(),
             "viscosity": m.viscosity.label,
+            "dissipation": m.dissipation.label,
             "options": ", ".join(f"{k}={v}" for k, v in m.options().items()),
             "reference": m.theory.reference,
             "description": m.description,

@@ -15,8 +15,8 @@ import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, Literal
 
-from ..errors import InputError
 from .coefficients import Reduced
+from .options import bool_option, choice_option
 
 Zeta11Variant = Literal["gd99", "ghd", "none"]
 ZETA11_VARIANTS: tuple[str, ...] = ("gd99", "ghd", "none")
@@ -124,8 +124,9 @@ class GarzoDufty1999:
     reference: ClassVar[str] = "Garzó & Dufty, Phys. Rev. E 59, 5895 (1999)"
 
     def __post_init__(self) -> None:
-        if self.zeta11 not in ZETA11_VARIANTS:
-            raise InputError(f"zeta11={self.zeta11!r} is not valid; choose one of {ZETA11_VARIANTS}")
+        choice_option("zeta11", self.zeta11, ZETA11_VARIANTS, owner=f"theory {self.key}")
+        # stored as a plain bool (np.bool_ is accepted), so the model stays hashable and printable
+        object.__setattr__(self, "sonine", bool_option("sonine", self.sonine, owner=f"theory {self.key}"))
 
     def reduced(self, phi: Any, e: Any, chi: Any, dchi: Any) -> Reduced:
         """Reduced coefficients at (φ, e) given χ, χ' (model.md §3)."""

@@ -20,9 +20,9 @@ import math
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from ..errors import InputError
 from .coefficients import Reduced
 from .garzo_dufty1999 import stability_derivatives
+from .options import choice_option, real_option
 
 OMEGA_VARIANTS: tuple[str, ...] = ("none", "lun")
 
@@ -75,8 +75,11 @@ class Lun1984:
     reference: ClassVar[str] = "Lun, Savage, Jeffrey & Chepurniy, J. Fluid Mech. 140, 223 (1984)"
 
     def __post_init__(self) -> None:
-        if self.omega not in OMEGA_VARIANTS:
-            raise InputError(f"omega={self.omega!r} is not valid; choose one of {OMEGA_VARIANTS}")
+        owner = f"theory {self.key}"
+        choice_option("omega", self.omega, OMEGA_VARIANTS, owner=owner)
+        # (2 + α)/3 multiplies the kinetic-collisional viscosity: it must stay positive
+        real_option("alpha", self.alpha, owner=owner, low=-2.0, high=10.0,
+                    why="(2 + alpha)/3 in (0, 4]: eta > 0, MFiX uses 1.6")
 
     def reduced(self, phi: Any, e: Any, chi: Any, dchi: Any) -> Reduced:
         """Reduced coefficients at (φ, e) given χ, χ' (model.md §4)."""

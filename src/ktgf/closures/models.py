@@ -1,4 +1,4 @@
-"""Named closure models: compositions theory × radial distribution × viscosity law, and their registry.
+"""Named closure models: compositions theory × RDF × viscosity law × dissipation correction, and their registry.
 
 A :class:`Model` is a small frozen (hashable) object, so solvers can take it as a static
 argument of ``jax.jit``.  Solvers never branch on model names: they call
@@ -16,6 +16,9 @@ ret         Garzó & Dufty (1999)  Carnahan–Starling          theory's own
 visc-div    Lun et al. (1984)     Torquato                   Bocquet et al. divergence
 proposed    Garzó & Dufty (1999)  viscosity-divergence RDF   theory's own
 =========== ===================== ========================== ==========================
+
+and the recommended dense model ``dense`` (``docs/dense.md``): RET with the viscosity-divergence
+RDF whose freezing point φ_f is fitted to the DEM uniform shear (:mod:`ktgf.closures.dense`).
 """
 
 from __future__ import annotations
@@ -31,6 +34,8 @@ from .coefficients import Dimensional, Reduced, to_dimensional
 from .garzo_dufty1999 import GarzoDufty1999
 from .lun1984 import Lun1984
 from .rdf import CarnahanStarling, RadialDistribution, Torquato, ViscosityDivergence
+from .dense import DENSE_PHI_F
+from .dissipation import DISSIPATIONS, NoDissipationCorrection
 from .viscosity_divergence import NoViscosityCorrection, ViscosityDivergenceLaw
 
 
@@ -72,6 +77,9 @@ class Model:
         χ(φ) and χ'(φ).
     viscosity : ViscosityLaw
         Multiplier of the shear viscosity (default: none).
+    dissipation : DissipationCorrection
+        Multiplier of the cooling rate ζ0 (default: none; :class:`~ktgf.closures.dissipation.
+        CorrelationLength` is extended kinetic theory, active only where a shear rate is given).
     label, description : str
         Display name and one-line description.
 
@@ -87,6 +95,7 @@ class Model:
     theory: Any
     rdf: RadialDistribution
     viscosity: Any = field(default_factory=NoViscosityCorrection)
+    dissipation: Any = field(default_factory=NoDissipationCorrection)
     label: str = ""
     description: str = ""
 
@@ -97,35 +106,45 @@ class Model:
 
     def check(self, phi: Any, e: Any, theta: Any = None) -> None:
         """Raise :class:`~ktgf.errors.InputError` if (φ, e, θ) is outside the model's domain."""
+        for name, value in (("solid fraction phi", phi), ("restitution coefficient e", e)):
+            if value is None:
+                raise InputError(f"{name} is missing (None); give a number or an array")
         check_state(phi, e, theta, phi_max=self.phi_max, rdf_name=self.rdf.describe())
 
-    def reduced(self, phi: Any, e: Any, *, check: bool = True) -> Reduced:
+    def reduced(self, phi: Any, e: Any, *, check: bool = True, shear: Any = None) -> Reduced:
         """Reduced coefficients at solid fraction φ and restitution e (broadcast together).
 
         Works on NumPy arrays and on JAX arrays (also under ``jit``/``grad``, where the range
         check is skipped).  Raises :class:`~ktgf.errors.InputError` for φ outside
-        [0, phi_max), e outside (0, 1] or NaN.
+        [0, phi_max), e outside (0, 1] or NaN.  ``shear`` is the local shear measure dγ̇/√θ,
+        used only by a dissipation correction (extended kinetic theory); without it ζ0 is the
+        theory's own.  g and C always refer to the theory's own ζ0 and p* (they serve the HCS,
+        where there is no shear).
         """
-        phi, e = asarray(phi), asarray(e)
         if check:
             self.check(phi, e)
+        phi, e = asarray(phi), asarray(e)
         chi, dchi = self.rdf.chi(phi), self.rdf.dchi(phi)
         r = self.theory.reduced(phi, e, chi, dchi)
-        return r._replace(eta=r.eta * self.viscosity.factor(phi))
+        return r._replace(
+            eta=r.eta * self.viscosity.factor(phi),
+            zeta0=r.zeta0 * self.dissipation.factor(phi, e, chi, shear),
+        )
 
     def coefficients(
-        self, phi: Any, e: Any, theta: Any, *, d: Any, rho_s: Any, check: bool = True
+        self, phi: Any, e: Any, theta: Any, *, d: Any, rho_s: Any, check: bool = True, shear: Any = None
     ) -> Dimensional:
         """SI coefficients (p [Pa], η, λ_b [Pa s], κ, ω, ζ0 [1/s], ζ_U) at (φ, e, θ [m²/s²]).
 
-        ``d`` is the particle diameter [m] and ``rho_s`` the material density [kg/m³].
+        ``d`` is the particle diameter [m] and ``rho_s`` the material density [kg/m³]; ``shear``
+        the local dγ̇/√θ for a dissipation correction (see :meth:`reduced`).
         """
         theta = asarray(theta)
         if check:
             self.check(phi, e, theta)
             check_positive("particle diameter d", d, "m")
             check_positive("material density rho_s", rho_s, "kg/m^3")
-        return to_dimensional(self.reduced(phi, e, check=False), asarray(phi), theta, d, rho_s)
+        return to_dimensional(self.reduced(phi, e, check=False, shear=shear), asarray(phi), theta, d, rho_s)
 
     def chi(self, phi: Any) -> Any:
         """The model's radial distribution function χ(φ)."""
@@ -139,9 +158,16 @@ class Model:
         """A copy with options changed, routed to the part that owns them.
 
         ``zeta11``, ``sonine``, ``omega``, ``alpha`` go to the theory; ``phi_f``, ``phi_c``,
-        ``beta``, ``a`` to the RDF and (where it has them) the viscosity law.
+        ``beta``, ``a``, ``junction``, ``junction_width`` to the RDF and (where it has them) the
+        viscosity law; ``dissipation`` (``"none"`` or ``"jenkins-berzi-2010"``) picks the
+        dissipation correction, whose ``c`` is then an option too.
         """
-        parts = {"theory": self.theory, "rdf": self.rdf, "viscosity": self.viscosity}
+        if "dissipation" in options:  # a part chosen by name, e.g. dissipation="jenkins-berzi-2010"
+            key = options.pop("dissipation")
+            if key not in DISSIPATIONS:
+                raise InputError(f"option dissipation = {key!r} is not valid; choose one of {', '.join(DISSIPATIONS)}")
+            return dataclasses.replace(self, dissipation=DISSIPATIONS[key]()).with_options(**options)
+        parts = {"theory": self.theory, "rdf": self.rdf, "viscosity": self.viscosity, "dissipation": self.dissipation}
         new = {}
         used: set[str] = set()
         for part_name, part in parts.items():
@@ -160,6 +186,7 @@ class Model:
             **self.theory.options(),
             **{k: v for k, v in self.rdf.params().items() if not callable(v)},
             **self.viscosity.options(),
+            **self.dissipation.options(),
         }
 
     def metadata(self) -> dict[str, str]:
@@ -173,11 +200,13 @@ class Model:
             "theory_reference": self.theory.reference,
             "rdf": self.rdf.describe(),
             "viscosity_law": self.viscosity.key,
+            "dissipation": self.dissipation.key,
             "model_options": json.dumps(
                 {
                     "theory": self.theory.options(),
                     "rdf": {k: v for k, v in self.rdf.params().items() if not callable(v)},
                     "viscosity": self.viscosity.options(),
+                    "dissipation": self.dissipation.options(),
                 }
             ),
         }
@@ -264,5 +293,17 @@ register_model(
         ViscosityDivergence(),
         label="Proposed",
         description="RET with the radial distribution function derived from the viscosity divergence",
+    ),
+)
+register_model(
+    Model(
+        "dense",
+        GarzoDufty1999(),
+        ViscosityDivergence(phi_f=DENSE_PHI_F),
+        label="Dense",
+        description=(
+            "Recommended for dense flows: RET with the viscosity-divergence RDF, phi_f fitted to "
+            "DEM uniform shear (docs/dense.md)"
+        ),
     ),
 )

@@ -125,12 +125,18 @@ class Problem:
         n = self.n
         phi_f = 0.5 * (phi[1:] + phi[:-1])
         theta_f = 0.5 * (theta[1:] + theta[:-1])
-        c = self.model.coefficients(
-            np.concatenate([phi, phi_f]), self.e, np.concatenate([theta, theta_f]), d=1.0, rho_s=1.0, check=False
-        )
-        node, face = slice(0, n), slice(n, None)
         w = self.geometry.angular(u, self.x)
         dw = np.diff(w)
+        shear = None
+        if self.model.dissipation.key != "none":  # EKT: ζ0 at the nodes sees the local dγ̇/√θ
+            rate = np.abs(self.A / self.geometry.stress_metric(self.xf) * dw / self.dx)  # face shear rates
+            node_rate = np.concatenate([rate[:1], 0.5 * (rate[1:] + rate[:-1]), rate[-1:]])
+            shear = np.concatenate([node_rate / np.sqrt(theta), np.zeros(n - 1)])
+        c = self.model.coefficients(
+            np.concatenate([phi, phi_f]), self.e, np.concatenate([theta, theta_f]), d=1.0, rho_s=1.0, check=False,
+            shear=shear,
+        )
+        node, face = slice(0, n), slice(n, None)
         F = self.A * c.eta[face] * dw / self.dx
         E = self.B * (c.kappa[face] * np.diff(theta) + c.omega[face] * np.diff(phi)) / self.dx
         P = F * dw

@@ -1,8 +1,20 @@
 """Uniform simple shear: the closed forms of model.md §9 (the far-from-wall / Lees–Edwards limit).
 
-In uniform shear at rate γ̇ the energy balance η γ̇² = (3/2)ρθζ0 fixes the temperature:
+In uniform shear at rate γ̇ the energy balance η γ̇² = (3/2)ρθζ0 fixes the temperature.  With
+a* = γ̇/ν0 and the reduced coefficients (ρθ/η0 = ν0):
 
-    γ̇/ν0 = √(3ζ0*/(2η*)),   |P_xy|/p = √(3η*ζ0*/2)/p*,   θ/(γ̇d)² = 25π η*/(13824 φ² ζ0*).
+    a*² = 3ζ0*/(2η*),   |P_xy|/p = η* a*/p*,   θ/(γ̇d)² = 25π/(9216 φ² a*²) = 25π η*/(13824 φ² ζ0*).
+
+With a dissipation correction of extended kinetic theory (:mod:`ktgf.closures.dissipation`),
+ζ0* → ζ0* d/L with L/d = max(1, Λ s) and s = dγ̇/√θ = k a*, k = (96/5) φ/√π.  The energy
+balance is then solved consistently: a*² = 3ζ0*/(2η* max(1, Λ k a*)), whose root is
+
+    a* = a0                        if Λ k a0 ≤ 1   (L = d, the standard theory),
+    a* = (a0²/(Λ k))^(1/3)         otherwise,       a0 = √(3ζ0*/(2η*)).
+
+The DEM file's columns (``shared/data/dem_uniform_shear.csv`` header, d = m = 1):
+T = θ/(γ̇d)², η_star = η d²/√(mT) = (5/(16√π)) η*, eta_over_eta0 = η*, p_over_nT = p*,
+astar = γ̇/ν0 with ν0 = (16/5)√π n √T (= model.md's ν0).
 """
 
 from __future__ import annotations
@@ -11,6 +23,11 @@ import math
 from typing import Any, NamedTuple
 
 import numpy as np
+
+#: η0 d²/√(mT) = 5/(16√π): converts η* = η/η0 to the DEM file's η d²/√(mT).
+ETA0_DEM = 5.0 / (16.0 * math.sqrt(math.pi))
+#: s = dγ̇/√θ = SHEAR_PER_ASTAR · φ · a*, from ν0 = (96/5)(φ/d)√(θ/π).
+SHEAR_PER_ASTAR = 96.0 / (5.0 * math.sqrt(math.pi))
 
 
 class UniformShear(NamedTuple):
@@ -21,14 +38,84 @@ class UniformShear(NamedTuple):
     temperature_ratio: Any
 
 
+class ShearState(NamedTuple):
+    """Uniform-shear steady state in the DEM file's dimensionless columns (plus a*, L/d)."""
+
+    phi: Any
+    T: Any
+    eta_star: Any
+    eta_over_eta0: Any
+    p_over_nT: Any
+    astar: Any
+    stress_ratio: Any
+    L_over_d: Any
+
+
+def _solve(model: Any, phi: Any, e: Any) -> tuple[Any, Any, Any, Any]:
+    """(reduced coefficients without shear, a*, L/d, η*) of the steady uniform shear."""
+    phi = np.asarray(phi, dtype=float)
+    r = model.reduced(phi, e)
+    zeta0, eta = np.asarray(r.zeta0, dtype=float), np.asarray(r.eta, dtype=float)
+    a0 = np.sqrt(1.5 * zeta0 / eta)
+    lam = np.asarray(model.dissipation.coefficient(phi, np.asarray(e, dtype=float), model.chi(phi)), dtype=float)
+    k = SHEAR_PER_ASTAR * phi
+    with np.errstate(invalid="ignore", divide="ignore"):
+        x = lam * k * a0
+        correlated = np.isfinite(x) & (x > 1.0)
+        a = np.where(correlated, np.cbrt(a0**2 / np.where(correlated, lam * k, 1.0)), a0)
+    length = np.where(correlated, lam * k * a, 1.0)
+    return r, a, length, eta
+
+
 def uniform_shear(model: Any, phi: Any, e: Any) -> UniformShear:
     """Closed-form uniform-shear state of ``model`` at solid fraction φ and restitution e < 1."""
-    r = model.reduced(phi, e)
-    zeta0 = np.asarray(r.zeta0, dtype=float)
-    eta = np.asarray(r.eta, dtype=float)
+    r, a, _, eta = _solve(model, phi, e)
     phi = np.asarray(phi, dtype=float)
     return UniformShear(
-        shear_rate_ratio=np.sqrt(1.5 * zeta0 / eta),
-        stress_ratio=np.sqrt(1.5 * eta * zeta0) / np.asarray(r.p, dtype=float),
-        temperature_ratio=25.0 * math.pi * eta / (13824.0 * phi**2 * zeta0),
+        shear_rate_ratio=a,
+        stress_ratio=eta * a / np.asarray(r.p, dtype=float),
+        temperature_ratio=25.0 * math.pi / (9216.0 * phi**2 * a**2),
     )
+
+
+def shear_state(model: Any, phi: Any, e: Any) -> ShearState:
+    """Uniform-shear steady state of ``model`` in the DEM file's columns (module docstring)."""
+    r, a, length, eta = _solve(model, phi, e)
+    phi = np.asarray(phi, dtype=float)
+    p = np.asarray(r.p, dtype=float)
+    return ShearState(
+        phi=phi, T=25.0 * math.pi / (9216.0 * phi**2 * a**2), eta_star=ETA0_DEM * eta, eta_over_eta0=eta,
+        p_over_nT=p, astar=a, stress_ratio=eta * a / p, L_over_d=length,
+    )
+
+
+#: Columns the uniform-shear DEM files must have (``shared/data/dem_uniform_shear*.csv``).
+DEM_COLUMNS: tuple[str, ...] = ("phi", "e", "T", "eta_over_eta0", "p_over_nT")
+
+
+def load_uniform_shear(path: Any, *, where: dict[str, float] | None = None) -> np.ndarray:
+    """Rows of a uniform-shear DEM CSV (comment header, then named columns) as a record array.
+
+    ``where`` keeps only rows whose columns equal the given values (e.g. ``{"mu": 0.0}`` for the
+    frictionless row of ``dem_uniform_shear_friction.csv``).  Raises
+    :class:`~ktgf.errors.InputError` for a missing file, missing columns or non-finite values.
+    """
+    import io
+    from pathlib import Path
+
+    from ..errors import InputError
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"DEM data file {str(path)!r} does not exist")
+    body = "\n".join(ln for ln in path.read_text().splitlines() if not ln.startswith("#"))
+    data = np.atleast_1d(np.genfromtxt(io.StringIO(body), delimiter=",", names=True))
+    missing = [c for c in DEM_COLUMNS if c not in (data.dtype.names or ())]
+    if missing:
+        raise InputError(f"DEM file {path.name} lacks column(s) {', '.join(missing)}; needs {', '.join(DEM_COLUMNS)}")
+    for key, value in (where or {}).items():
+        data = data[data[key] == value]
+    for c in DEM_COLUMNS:
+        if not np.all(np.isfinite(data[c])):
+            raise InputError(f"DEM file {path.name} column {c} has non-finite values")
+    return data
