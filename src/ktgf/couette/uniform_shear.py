@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any, NamedTuple
 
-import numpy as np
+from .._array import asarray
 
 
 class UniformShear(NamedTuple):
@@ -21,14 +21,16 @@ class UniformShear(NamedTuple):
     temperature_ratio: Any
 
 
-def uniform_shear(model: Any, phi: Any, e: Any) -> UniformShear:
-    """Closed-form uniform-shear state of ``model`` at solid fraction φ and restitution e < 1."""
-    r = model.reduced(phi, e)
-    zeta0 = np.asarray(r.zeta0, dtype=float)
-    eta = np.asarray(r.eta, dtype=float)
-    phi = np.asarray(phi, dtype=float)
+def uniform_shear(model: Any, phi: Any, e: Any, *, check: bool = True) -> UniformShear:
+    """Closed-form uniform-shear state of ``model`` at solid fraction φ and restitution e < 1.
+
+    NumPy in, NumPy out; JAX arrays (also tracers under ``jax.jacfwd``, with ``check=False``) pass
+    through, so calibrations can differentiate it exactly.
+    """
+    r = model.reduced(phi, e, check=check)
+    phi = asarray(phi)
     return UniformShear(
-        shear_rate_ratio=np.sqrt(1.5 * zeta0 / eta),
-        stress_ratio=np.sqrt(1.5 * eta * zeta0) / np.asarray(r.p, dtype=float),
-        temperature_ratio=25.0 * math.pi * eta / (13824.0 * phi**2 * zeta0),
+        shear_rate_ratio=(1.5 * r.zeta0 / r.eta) ** 0.5,
+        stress_ratio=(1.5 * r.eta * r.zeta0) ** 0.5 / r.p,
+        temperature_ratio=25.0 * math.pi * r.eta / (13824.0 * phi**2 * r.zeta0),
     )
