@@ -26,7 +26,7 @@ import numpy as np
 from ..closures.models import Model
 from ..errors import ConvergenceError, InputError
 from .data import CouetteData, UniformShearData
-from .residuals import WALL_PARAMETERS, make_terms, model_at
+from .residuals import DEFAULT_SPECULARITY, WALL_PARAMETERS, make_terms, model_at
 
 #: Bounds of the common options (φ_c, φ_f, β, a, RDF exponent); other float options default to (0, ∞)
 #: when positive.  ``bounds=`` of :func:`calibrate` overrides any of them.
@@ -103,12 +103,14 @@ def _parameters(model: Model, names: Sequence[str], datasets: Sequence[Any], sta
     opts = model.options()
     max_phi = max([float(np.max(d.phi)) for d in datasets if isinstance(d, UniformShearData)]
                   + [d.case.mean_phi for d in datasets if isinstance(d, CouetteData)])
+    couette_e = [d.case.e for d in datasets if isinstance(d, CouetteData)]
+    wall_defaults = {"specularity": DEFAULT_SPECULARITY, "wall_restitution": couette_e[0] if couette_e else math.nan}
     params = []
     for n in names:
         if n not in valid:
             extra = "" if couette or n not in WALL_PARAMETERS else " (wall parameters need Couette data)"
             raise InputError(f"--fit: {n!r} is not a parameter of model {model.name!r}{extra}; valid: {', '.join(valid)}")
-        default_start = fixed_walls.get(n, opts.get(n))
+        default_start = fixed_walls.get(n, opts.get(n, wall_defaults.get(n)))
         x0 = float(start.get(n, default_start))
         default = DEFAULT_BOUNDS.get(n, (0.0, math.inf) if x0 > 0 else (-math.inf, math.inf))
         lo, hi = bounds.get(n, default)
