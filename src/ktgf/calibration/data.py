@@ -76,16 +76,30 @@ def _columns(path: Path, names: list[str], table: np.ndarray, needed: tuple[str,
     return out
 
 
+_UNIT = r"\s*=\s*(?:m\s*=\s*)?([-+\d.eE]+)\s*([A-Za-z]*)"
+
+
+def _unit_is_one(text: str, symbol: str) -> bool:
+    """``symbol = 1`` (or ``d = m = 1``) stated without a unit word after the number."""
+    m = re.search(rf"(?<![A-Za-z_]){symbol}{_UNIT}", text)
+    if m is None:
+        return False
+    try:
+        return float(m.group(1)) == 1.0 and not m.group(2)
+    except ValueError:
+        return False
+
+
 def _check_units(path: Path, header: list[str], *, shear_rate: bool) -> None:
     """The header must state d = m = 1 (and γ̇ = 1 for uniform shear): the units the model's reduced values are compared in."""
-    text = " ".join(header).lower().replace(" ", "")
     units = [ln for ln in header if ln.lower().lstrip().startswith("units")]
     if not units:
         raise InputError(f"data file {Path(path).name}: header states no units (expected a line 'units d = m = 1 ...')")
-    unit_text = " ".join(units).lower().replace(" ", "")
-    if not ("d=m=1" in unit_text or ("d=1" in unit_text and "m=1" in unit_text)):
+    text = " ".join(units)
+    m_ok = _unit_is_one(text, "m") or re.search(r"(?<![A-Za-z_])d\s*=\s*m\s*=\s*1(?![\d.])", text) is not None
+    if not (_unit_is_one(text, "d") and m_ok):
         raise InputError(f"data file {Path(path).name}: units {units[0]!r} do not match the shared format (d = m = 1)")
-    if shear_rate and "gdot=1" not in text:
+    if shear_rate and not _unit_is_one(" ".join(header), "gdot"):
         raise InputError(f"data file {Path(path).name}: header does not state the shear rate gdot = 1 the columns are scaled with")
 
 

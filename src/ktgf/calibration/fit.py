@@ -222,13 +222,14 @@ def calibrate(model: Model, datasets: Sequence[Any], names: Sequence[str], *, st
         except _Stop:
             J = np.full((m, n), np.nan)
     cov = _covariance(J)
+    with np.errstate(all="ignore"):
+        sd = np.sqrt(np.diag(cov))
+        corr = cov / np.outer(sd, sd)  # scale-free: the same for stated and scaled errors
     if errors == "scaled":
         cov = cov * float(r @ r) / (m - n)
     se = np.sqrt(np.diag(cov))
     if not np.all(np.isfinite(se)):
         message += "; the data do not determine every fitted parameter (J^T J is singular: infinite standard errors)"
-    with np.errstate(all="ignore"):
-        corr = cov / np.outer(se, se)
     values = as_values(x)
     obs = np.concatenate([t.obs for t in terms])
     pred = np.concatenate([t.predict(values) for t in terms]) if success or J is not None else obs * np.nan
