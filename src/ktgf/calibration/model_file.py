@@ -182,8 +182,10 @@ def fit_text(result: Any, *, command: str = "", start_file: ModelFile | None = N
     from .data import file_hash
 
     reference = get_model(result.base)
-    if start_file is not None:
-        reference = reference.replace(rdf=start_file.model.rdf)
+    if start_file is not None and start_file.rdf:  # options are written relative to the swapped part's defaults
+        from ..closures.rdf import get_rdf
+
+        reference = reference.replace(rdf=get_rdf(start_file.rdf))
     ref_opts = reference.options()
     opts = {k: v for k, v in result.model.options().items()
             if k in result.names or (k in ref_opts and ref_opts[k] != v and isinstance(v, (int, float, str)))}
