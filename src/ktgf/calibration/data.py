@@ -207,8 +207,8 @@ _NUM = r"([-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)"
 COUETTE_HEADER = {
     "e": (rf"restitution\)?\s*:\s*{_NUM}", "# e (particle-particle = particle-wall normal restitution): 0.9"),
     "mean_phi": (rf"mean solid fraction\s+{_NUM}", "# ... mean solid fraction 0.5000 ..."),
-    "H": (rf"\bH\s*=\s*{_NUM}", "# ... H = 20 (wall-centre to wall-centre)"),
-    "U": (rf"\bU\s*=\s*{_NUM}", "# walls move rigidly at ... U = 10"),
+    "H": (rf"(?<![/\w])H\s*=\s*{_NUM}", "# ... H = 20 (wall-centre to wall-centre)"),
+    "U": (rf"(?<![/\w])U\s*=\s*{_NUM}", "# walls move rigidly at ... U = 10"),
     "tau": (rf"wall shear stress tau\s*=\s*{_NUM}\s*\+-\s*{_NUM}", "# wall shear stress tau = 0.65518 +- 0.0035"),
     "p_yy": (rf"wall normal stress p_yy\s*=\s*{_NUM}\s*\+-\s*{_NUM}", "# wall normal stress p_yy = 2.6588 +- 0.0091"),
 }
