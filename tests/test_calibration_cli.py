@@ -162,3 +162,15 @@ def test_calibrate_from_a_model_file_continues_from_its_values(fitted, tmp_path)
     assert res["parameters"][0]["start"] == pytest.approx(TRUE["beta"], rel=1e-6)
     f = tomllib.loads(out2.read_text())
     assert f["model"]["base"] == "proposed" and f["model"]["options"]["phi_c"] == pytest.approx(TRUE["phi_c"], rel=1e-6)
+
+
+def test_calibrate_that_stops_early_writes_its_best_point_and_exits_1(fitted, tmp_path):
+    _, data, _ = fitted
+    out = tmp_path / "partial.toml"
+    r = runner.invoke(app, ["calibrate", "--model", "proposed", "--data", str(data), "--fit", "phi_c,beta", "--out", str(out),
+                            "--max-evaluations", "2"])
+    assert r.exit_code == 1
+    assert "best point written to" in r.output
+    f = tomllib.loads(out.read_text())
+    assert f["fit"]["success"] is False and "stopped" in f["fit"]["message"]
+    assert "FIT FAILED" in out.read_text().splitlines()[0]

@@ -88,3 +88,30 @@ def test_generic_parameters_are_the_float_options():
     assert set(fittable_parameters(get_model("ret"))) == set()
     assert {"specularity", "wall_restitution"} <= set(fittable_parameters(get_model("ret"), couette=True))
     assert math.isnan(fittable_parameters(get_model("ret"), couette=True)["specularity"])
+
+
+def test_a_failing_evaluation_stops_the_fit_and_keeps_the_best_point(synthetic, monkeypatch):
+    """A solver failure in the middle of a fit: no exception, success False, the reason, the best point so far."""
+    from ktgf.calibration import residuals
+    from ktgf.errors import ConvergenceError
+
+    calls = []
+    original = residuals.ShearTerm.residuals
+
+    def flaky(self, values):
+        calls.append(dict(values))
+        if len(calls) == 3:
+            raise ConvergenceError("the Couette solver did not converge at beta=...")
+        return original(self, values)
+
+    monkeypatch.setattr(residuals.ShearTerm, "residuals", flaky)
+    fit = calibrate(get_model("proposed"), [read_data(synthetic)], ["phi_c", "beta"])
+    assert not fit.success and fit.message.startswith("fit failed: the Couette solver did not converge")
+    costs = [0.5 * float(np.sum(original(_term(synthetic), v) ** 2)) for v in calls[:2]]
+    assert fit.cost == pytest.approx(min(costs))
+
+
+def _term(path):
+    from ktgf.calibration.residuals import make_terms
+
+    return make_terms(get_model("proposed"), [read_data(path)], ["phi_c", "beta"], "sigma")[0]
