@@ -73,6 +73,8 @@ def test_unidentifiable_parameters_are_reported(data_dir):
     (["specularity"], {}, r"wall parameters need Couette data"),
     (["phi_c"], {"bounds": {"phi_c": (0.7, 0.65)}}, r"empty range"),
     (["phi_c"], {"weights": "abs"}, r"weights 'abs' is not valid"),
+    (["phi_c"], {"walls": {"specularity": 1.5}}, r"wall parameter specularity = 1.5 is out of range"),
+    (["phi_c"], {"walls": {"roughness": 0.5}}, r"wall parameter 'roughness' is unknown"),
 ])
 def test_bad_parameters_are_one_line_errors(synthetic, names, kw, match):
     with pytest.raises(InputError, match=match) as exc:

@@ -160,6 +160,12 @@ def calibrate(model: Model, datasets: Sequence[Any], names: Sequence[str], *, st
     start, bounds, walls = dict(start or {}), dict(bounds or {}), dict(walls or {})
     if not datasets:
         raise InputError("no data file given (--data)")
+    for k, v in walls.items():
+        if k not in WALL_PARAMETERS:
+            raise InputError(f"wall parameter {k!r} is unknown; valid: {', '.join(WALL_PARAMETERS)}")
+        lo, hi = WALL_PARAMETERS[k]
+        if not lo <= v <= hi:
+            raise InputError(f"wall parameter {k} = {v:g} is out of range: valid {lo:g} <= {k} <= {hi:g}")
     params = _parameters(model, list(names), datasets, start, bounds, walls)
     names = [p.name for p in params]
     fixed = {k: v for k, v in walls.items() if k not in names}
@@ -232,7 +238,10 @@ def calibrate(model: Model, datasets: Sequence[Any], names: Sequence[str], *, st
         message += "; the data do not determine every fitted parameter (J^T J is singular: infinite standard errors)"
     values = as_values(x)
     obs = np.concatenate([t.obs for t in terms])
-    pred = np.concatenate([t.predict(values) for t in terms]) if success or J is not None else obs * np.nan
+    try:
+        pred = np.concatenate([t.predict(values) for t in terms])
+    except ConvergenceError:  # the best point was solved once; a failure here leaves the predictions unknown
+        pred = obs * np.nan
     fitted_model = model_at(model, values)
     used_walls = {}
     for t in terms:
