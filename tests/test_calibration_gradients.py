@@ -32,6 +32,7 @@ def test_uniform_shear_jax_jacobian_matches_finite_differences(tmp_path, model, 
     f = synthetic_shear(tmp_path / "s.csv", get_model("ret"), [0.3, 0.5, 0.55, 0.6])
     (term,) = make_terms(get_model(model), [read_data(f)], list(x), "sigma")
     J = term.jacobian(x)
+    assert term.method == "jax", term.method_note  # exact: traced through the closures and the closed form
     assert np.abs(J).max() > 1.0  # the parameters matter
     np.testing.assert_allclose(J, _fd(term, x), rtol=1e-6, atol=1e-7 * np.abs(J).max())
 
@@ -73,3 +74,27 @@ def test_couette_fit_recovers_walls_and_rdf_exponent(synthetic_couette):
     assert fit.success, fit.message
     assert fit.value_dict() == pytest.approx(TRUTH, rel=1e-4)
     assert fit.walls["wall_restitution"] == 0.9  # not fitted: e_w = e of the header
+
+
+def test_jax_jacobian_survives_option_checks_that_reject_tracers(tmp_path):
+    """Parts whose __post_init__ accepts only real numbers (as strict option checks do) are still traced exactly."""
+    import dataclasses
+    from numbers import Real
+
+    from ktgf.closures.rdf import ViscosityDivergence
+    from ktgf.errors import InputError
+
+    @dataclasses.dataclass(frozen=True)
+    class StrictVD(ViscosityDivergence):
+        def __post_init__(self) -> None:
+            for k in ("phi_f", "phi_c", "beta"):
+                if not isinstance(getattr(self, k), Real):
+                    raise InputError(f"option {k} must be a real number")
+
+    model = get_model("proposed").replace(rdf=StrictVD())
+    f = synthetic_shear(tmp_path / "s.csv", get_model("proposed", beta=2.2), [0.52, 0.56, 0.6])
+    (term,) = make_terms(model, [read_data(f)], ["phi_c", "beta"], "sigma")
+    x = {"phi_c": 0.63, "beta": 1.9}
+    J = term.jacobian(x)
+    assert term.method == "jax", term.method_note
+    np.testing.assert_allclose(J, _fd(term, x), rtol=1e-6, atol=1e-7 * np.abs(J).max())

@@ -236,6 +236,9 @@ def calibrate(model: Model, datasets: Sequence[Any], names: Sequence[str], *, st
     se = np.sqrt(np.diag(cov))
     if not np.all(np.isfinite(se)):
         message += "; the data do not determine every fitted parameter (J^T J is singular: infinite standard errors)"
+    notes = sorted({t.method_note for t in terms if getattr(t, "method_note", "")})
+    if notes:
+        message += "; " + "; ".join(notes)
     values = as_values(x)
     obs = np.concatenate([t.obs for t in terms])
     try:

@@ -91,6 +91,7 @@ class ShearTerm:
         self.scale = _scale(self.obs, self.sigma, weights)
         self.labels = data.labels
         self._jac = None
+        self.method, self.method_note = "jax", ""
 
     def predict(self, values: dict[str, float]) -> np.ndarray:
         return np.asarray(shear_prediction(model_at(self.model, values), self.data), dtype=float)
@@ -99,16 +100,29 @@ class ShearTerm:
         return (self.predict(values) - self.obs) / self.scale
 
     def jacobian(self, values: dict[str, float]) -> np.ndarray:
+        """Exact (JAX) Jacobian; central differences only if the closure chain cannot be traced (``method`` says which)."""
+        if self.method == "jax":
+            try:
+                return self._jax_jacobian(values)
+            except Exception as exc:  # noqa: BLE001  (any part that is not JAX code: fall back, and say so)
+                self.method = "finite differences"
+                self.method_note = f"uniform-shear Jacobian by central differences: the model is not JAX-traceable ({type(exc).__name__})"
+        J = np.empty((self.obs.size, len(self.names)))
+        for j, n in enumerate(self.names):
+            h = 1e-6 * max(abs(values[n]), 1e-2)
+            J[:, j] = (self.residuals({**values, n: values[n] + h}) - self.residuals({**values, n: values[n] - h})) / (2 * h)
+        return J
+
+    def _jax_jacobian(self, values: dict[str, float]) -> np.ndarray:
         import jax
         import jax.numpy as jnp
 
         enable_x64()
         fitted = [n for n in self.names if n not in WALL_PARAMETERS]
         if self._jac is None:
-            fixed = {k: v for k, v in values.items() if k not in fitted}
 
             def pred(x):
-                return shear_prediction(model_at(self.model, {**fixed, **dict(zip(fitted, x))}), self.data)
+                return shear_prediction(traced_model(self.model, dict(zip(fitted, x))), self.data)
 
             self._jac = jax.jit(jax.jacfwd(pred))
         J = np.zeros((self.obs.size, len(self.names)))
@@ -117,6 +131,35 @@ class ShearTerm:
             for j, n in enumerate(fitted):
                 J[:, self.names.index(n)] = Jm[:, j]
         return J / self.scale[:, None]
+
+
+def traced_model(model: Model, values: dict[str, Any]) -> Model:
+    """``model`` with options set to JAX values (tracers), routed to every part that has them, as
+    :meth:`Model.with_options` does.
+
+    Option checks cannot look at abstract values (and may reject them), so the parts are copied and
+    the values set directly; the same options are checked with concrete values by :func:`model_at`
+    at every evaluation of the residuals, before any Jacobian.
+    """
+    import copy
+    import dataclasses
+
+    new = copy.copy(model)
+    used: set[str] = set()
+    for f in dataclasses.fields(model):
+        part = getattr(model, f.name)
+        if not dataclasses.is_dataclass(part) or isinstance(part, type):
+            continue
+        names = {g.name for g in dataclasses.fields(part)} & set(values)
+        if names:
+            part = copy.copy(part)
+            for n in names:
+                object.__setattr__(part, n, values[n])
+            object.__setattr__(new, f.name, part)
+            used |= names
+    if set(values) - used:
+        raise InputError(f"model {model.name!r} has no option(s) {sorted(set(values) - used)}")
+    return new
 
 
 class CouetteTerm:
