@@ -64,7 +64,8 @@ def shear_prediction(model: Model, data: UniformShearData) -> Any:
     xp = _namespace_of(model)
     phi, e = xp.asarray(data.phi), xp.asarray(data.e)
     r = model.reduced(phi, e, check=False)
-    T = uniform_shear(model, phi, e, check=False).temperature_ratio
+    # traced options have no value to range-check; concrete ones are checked as everywhere else
+    T = (uniform_shear(model, phi, e, check=False) if xp is not np else uniform_shear(model, phi, e)).temperature_ratio
     return xp.concatenate([T, r.eta, r.p])
 
 

@@ -24,8 +24,8 @@ class UniformShear(NamedTuple):
 def uniform_shear(model: Any, phi: Any, e: Any, *, check: bool = True) -> UniformShear:
     """Closed-form uniform-shear state of ``model`` at solid fraction φ and restitution e < 1.
 
-    NumPy in, NumPy out; JAX arrays (also tracers under ``jax.jacfwd``, with ``check=False``) pass
-    through, so calibrations can differentiate it exactly.
+    NumPy in, NumPy out; JAX values pass through, so with ``check=False`` (options that are JAX
+    tracers have no value to check) ``jax.jacfwd`` differentiates it exactly (used by calibration).
     """
     r = model.reduced(phi, e, check=check)
     phi = asarray(phi)
