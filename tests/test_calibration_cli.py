@@ -174,3 +174,19 @@ def test_calibrate_that_stops_early_writes_its_best_point_and_exits_1(fitted, tm
     f = tomllib.loads(out.read_text())
     assert f["fit"]["success"] is False and "stopped" in f["fit"]["message"]
     assert "FIT FAILED" in out.read_text().splitlines()[0]
+
+
+def test_plot_coefficients_and_couette_sweep_take_the_model_file(fitted, tmp_path):
+    out, _, _ = fitted
+    png = tmp_path / "coef.png"
+    r = runner.invoke(app, ["plot", "coefficients", "--models", "ret", "--model-file", str(out), "-o", str(png)])
+    assert r.exit_code == 0, r.output
+    assert png.is_file()
+    cfg = tmp_path / "c.toml"
+    cfg.write_text((ROOT / "examples" / "couette_planar.toml").read_text().replace("n_cells = 200", "n_cells = 40"))
+    args = ["couette", "sweep", str(cfg), "--specularity", "0.1", "--format", "json"]
+    plain = json.loads(runner.invoke(app, args).stdout)[0]
+    r = runner.invoke(app, [*args, "--model-file", str(out)])
+    assert r.exit_code == 0, r.output
+    mine = json.loads(r.stdout)[0]
+    assert mine["converged"] and mine["wall_shear_stress"] != pytest.approx(plain["wall_shear_stress"], rel=1e-3)

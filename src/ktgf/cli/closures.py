@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from ..closures import get_model, list_models
+from ..closures import list_models
 from ._common import OutputFormat, emit, handle_errors, model_file_option, parse_values, resolve_models
 
 REDUCED_NAMES = {
@@ -97,11 +97,12 @@ def plot_coefficients(
     out: Path = typer.Option(Path("coefficients.png"), "--out", "-o", help="Output figure file."),
     phi_max: float = typer.Option(0.6, "--phi-max", help="Largest solid fraction plotted."),
     models: str = typer.Option("enskog,ret,visc-div,proposed", "--models", help="Comma-separated model names."),
+    model_file: Path = model_file_option(),
 ) -> None:
     """Reduced p*, eta*, kappa*, mu*, zeta0* vs phi for several models on one figure."""
     from ..plotting.coefficients import plot_reduced_coefficients
 
-    path = plot_reduced_coefficients([get_model(n) for n in models.split(",")], e=e, phi_max=phi_max, out=out)
+    path = plot_reduced_coefficients(resolve_models(models, model_file, option="--models"), e=e, phi_max=phi_max, out=out)
     typer.echo(f"wrote {path}")
 
 

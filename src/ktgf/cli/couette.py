@@ -132,7 +132,7 @@ def _sweep_task(task: tuple[dict[str, Any], float, float]) -> dict[str, Any]:
     from ..couette.config import parse_config, run_config
     from ..errors import ConvergenceError
 
-    data, spec, ew = task
+    data, spec, ew, model_file = task
     walls = dict(data.get("walls", {}))
     walls.update({"specularity": spec, "restitution": ew})
     for side in ("bottom", "top"):
@@ -140,8 +140,13 @@ def _sweep_task(task: tuple[dict[str, Any], float, float]) -> dict[str, Any]:
             walls[side] = {k: v for k, v in walls[side].items() if k not in ("specularity", "restitution")}
     cfg = parse_config({**data, "walls": walls})
     row: dict[str, Any] = {"specularity": spec, "wall_restitution": ew}
+    model = None
+    if model_file is not None:
+        from ..calibration.model_file import load_model_file
+
+        model = load_model_file(model_file).model
     try:
-        ds = run_config(cfg)
+        ds = run_config(cfg, model)
     except ConvergenceError as exc:
         return {**row, "converged": False, "slip": float("nan"), "wall_shear_stress": float("nan"),
                 "max_phi": float("nan"), "valid": False, "message": str(exc)[:80]}
@@ -159,9 +164,13 @@ def sweep_cmd(
     workers: int = typer.Option(0, "--workers", help="Processes (0: in-process)."),
     dask: str = typer.Option("", "--dask", help="Address of a Dask scheduler to run the sweep on."),
     out: Path = typer.Option(None, "--out", "-o", help="Optional figure of the slip vs phi'."),
+    model_file: Path = model_file_option(),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
 ) -> None:
-    """Sweep the specularity phi' and the wall restitution e_w (the calibration knobs) through an executor."""
+    """Sweep the specularity phi' and the wall restitution e_w (the calibration knobs) through an executor.
+
+    With ``--model-file`` the file's model replaces the config's.
+    """
     import tomllib
 
     from ..couette.config import load_config
@@ -174,7 +183,12 @@ def sweep_cmd(
     ews = parse_values(wall_restitution, "wall-restitution")
     check_range("specularity coefficient phi'", specs, low=0.0, high=1.0, low_open=True)
     check_range("wall restitution e_w", ews, low=0.0, high=1.0, low_open=True)
-    tasks = [(data, float(s), float(e)) for e in ews for s in specs]
+    if model_file is not None:
+        from ..calibration.model_file import load_model_file
+
+        load_model_file(model_file)  # check it once, with field names, before dispatching
+        model_file = model_file.resolve()
+    tasks = [(data, float(s), float(e), model_file) for e in ews for s in specs]
     with open_executor(workers, dask) as executor:
         rows = map_tasks(_sweep_task, tasks, executor=executor)
     emit(rows, fmt, title=f"Couette sweep ({config}): slip = |u_sl|/U at the bottom wall")
