@@ -63,3 +63,15 @@ def with_header(src: Path, dst: Path, header: str) -> Path:
     body = [ln for ln in src.read_text().splitlines() if not ln.startswith("#")]
     dst.write_text(header + "\n".join(body) + "\n")
     return dst
+
+
+def synthetic_couette(path: Path, model, specularity: float, case, n_cells: int) -> Path:
+    """Couette data of ``model`` with JJ walls φ' = ``specularity`` in ``case``, through the Dataset route of the solver."""
+    from ktgf.couette.compare import dem_cell, wall_stresses
+
+    ds = dem_cell(specularity, model, case, n_cells=n_cells)
+    tau, p = wall_stresses(ds)
+    y = np.arange(-9.25, 9.26, 0.5)
+    at = {k: np.interp(y, ds.y.values, ds[k].values) for k in ("phi", "u", "theta")}
+    header = couette_header(e=case.e, phi=case.mean_phi, H=case.gap + 1.0, U=case.wall_speed, tau=tau, p=p)
+    return write_couette(path, header, y, at["phi"], at["u"], at["theta"])

@@ -190,3 +190,25 @@ def test_plot_coefficients_and_couette_sweep_take_the_model_file(fitted, tmp_pat
     assert r.exit_code == 0, r.output
     mine = json.loads(r.stdout)[0]
     assert mine["converged"] and mine["wall_shear_stress"] != pytest.approx(plain["wall_shear_stress"], rel=1e-3)
+
+
+def test_couette_calibration_round_trip_walls_through_compare(tmp_path, data_dir):
+    """Calibrate φ' and β on synthetic Couette data; `couette compare` with the file then uses its walls and reproduces the data."""
+    from _calibration_synthetic import synthetic_couette
+
+    from ktgf.calibration.data import read_couette
+
+    case = read_couette(data_dir / "dem_couette_e0.9_phi0.50.csv").case
+    data = synthetic_couette(tmp_path / "c.csv", get_model("proposed", beta=2.0), 0.2, case, 60)
+    out = tmp_path / "walls.toml"
+    r = runner.invoke(app, ["calibrate", "--model", "proposed", "--data", str(data), "--fit", "specularity,beta", "--cells", "60",
+                            "--out", str(out), "--format", "json"])
+    assert r.exit_code == 0, r.output
+    f = tomllib.loads(out.read_text())
+    assert f["walls"] == pytest.approx({"specularity": 0.2, "wall_restitution": 0.9}, rel=1e-4)
+    r = runner.invoke(app, ["couette", "compare", "--dem", str(data), "--models", "", "--model-file", str(out), "--cells", "60",
+                            "-o", str(tmp_path / "c.png"), "--format", "json"])
+    assert r.exit_code == 0, r.output
+    (row,) = json.loads(r.stdout)
+    assert row["specularity"] == pytest.approx(0.2, rel=1e-4)
+    assert abs(row["tau_error"]) < 1e-4 and abs(row["p_error"]) < 1e-4

@@ -10,7 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from _calibration_synthetic import couette_header, synthetic_shear, write_couette
+from _calibration_synthetic import synthetic_couette as synthetic_couette_file
+from _calibration_synthetic import synthetic_shear
 from ktgf import get_model
 from ktgf.calibration import calibrate, read_data
 from ktgf.calibration.residuals import make_terms
@@ -45,15 +46,10 @@ TRUTH = {"specularity": 0.2, "beta": 2.0}
 def synthetic_couette(tmp_path_factory, data_dir):
     """Couette data of proposed (β = 2) with JJ walls φ' = 0.2 in the shared file's case, from the Dataset route."""
     from ktgf.calibration.data import read_couette
-    from ktgf.couette.compare import dem_cell, wall_stresses
 
     case = read_couette(data_dir / "dem_couette_e0.9_phi0.50.csv").case
-    ds = dem_cell(TRUTH["specularity"], get_model("proposed", beta=TRUTH["beta"]), case, n_cells=N_CELLS)
-    tau, p = wall_stresses(ds)
-    y = np.arange(-9.25, 9.26, 0.5)
-    at = {k: np.interp(y, ds.y.values, ds[k].values) for k in ("phi", "u", "theta")}
-    path = tmp_path_factory.mktemp("syn") / "couette.csv"
-    return write_couette(path, couette_header(tau=tau, p=p), y, at["phi"], at["u"], at["theta"])
+    return synthetic_couette_file(tmp_path_factory.mktemp("syn") / "couette.csv", get_model("proposed", beta=TRUTH["beta"]),
+                                  TRUTH["specularity"], case, N_CELLS)
 
 
 def test_couette_ift_jacobian_matches_resolved_finite_differences(synthetic_couette):
