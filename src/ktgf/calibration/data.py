@@ -181,6 +181,7 @@ class CouetteData:
     phi: np.ndarray
     u: np.ndarray
     theta: np.ndarray
+    u_sem: np.ndarray | None = None
     kind: str = field(default="couette", init=False)
 
     @property
@@ -200,6 +201,13 @@ class CouetteData:
         """|u| at |y| = slip_y, averaged over both walls (the DEM slip the wall condition is fitted to)."""
         y0 = self.slip_y
         return 0.5 * (abs(float(np.interp(y0, self.y, self.u))) + abs(float(np.interp(-y0, self.y, self.u))))
+
+    def slip_sigma(self) -> float:
+        """Standard error of :meth:`slip_speed` from the ``ux_sem`` column (NaN without it)."""
+        if self.u_sem is None:
+            return math.nan
+        y0 = self.slip_y
+        return 0.5 * math.hypot(float(np.interp(-y0, self.y, self.u_sem)), float(np.interp(y0, self.y, self.u_sem)))
 
 
 #: Header fields of the Couette format: name → (regular expression, example of the expected line).
@@ -245,7 +253,8 @@ def read_couette(path: str | Path) -> CouetteData:
     keep = (cols["phi"] > 0.05) & (cols["theta"] > 0)
     if keep.sum() < 3:
         raise InputError(f"data file {path.name}: fewer than 3 occupied bins (phi > 0.05, theta > 0)")
-    return CouetteData(path, case, cols["y"][keep], cols["phi"][keep], cols["ux"][keep], cols["theta"][keep])
+    sem = _columns(path, names, table, ("ux_sem",))["ux_sem"][keep] if "ux_sem" in names else None
+    return CouetteData(path, case, cols["y"][keep], cols["phi"][keep], cols["ux"][keep], cols["theta"][keep], sem)
 
 
 def read_data(path: str | Path) -> UniformShearData | CouetteData:

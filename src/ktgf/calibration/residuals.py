@@ -54,29 +54,22 @@ def model_at(model: Model, values: dict[str, Any]) -> Model:
     return model.with_options(**opts) if opts else model
 
 
-def shear_prediction(model: Model, data: UniformShearData) -> Any:
+def shear_prediction(model: Model, data: UniformShearData, *, traced: bool = False) -> Any:
     """T = θ/(γ̇d)², η/η0 and p/(nT) at the data's (φ, e), concatenated in :data:`~.data.SHEAR_OBSERVABLES` order.
 
-    Works on NumPy and, when the model's options are JAX tracers, inside ``jax.jacfwd``.
+    NumPy; with ``traced=True`` (options that are JAX tracers, inside ``jax.jacfwd``) JAX, without
+    range checks (a tracer has no value to check; the same values are checked concretely elsewhere).
     """
     from ..couette.uniform_shear import uniform_shear
 
-    xp = _namespace_of(model)
+    if traced:
+        import jax.numpy as xp
+    else:
+        xp = np
     phi, e = xp.asarray(data.phi), xp.asarray(data.e)
     r = model.reduced(phi, e, check=False)
-    # traced options have no value to range-check; concrete ones are checked as everywhere else
-    T = (uniform_shear(model, phi, e, check=False) if xp is not np else uniform_shear(model, phi, e)).temperature_ratio
+    T = (uniform_shear(model, phi, e, check=False) if traced else uniform_shear(model, phi, e)).temperature_ratio
     return xp.concatenate([T, r.eta, r.p])
-
-
-def _namespace_of(model: Model) -> Any:
-    from .._array import is_jax
-
-    if any(is_jax(v) for v in model.options().values()):
-        import jax.numpy as jnp
-
-        return jnp
-    return np
 
 
 def _scale(obs: np.ndarray, sigma: np.ndarray, weights: str) -> np.ndarray:
@@ -123,7 +116,7 @@ class ShearTerm:
         if self._jac is None:
 
             def pred(x):
-                return shear_prediction(traced_model(self.model, dict(zip(fitted, x))), self.data)
+                return shear_prediction(traced_model(self.model, dict(zip(fitted, x))), self.data, traced=True)
 
             self._jac = jax.jit(jax.jacfwd(pred))
         J = np.zeros((self.obs.size, len(self.names)))
@@ -176,23 +169,13 @@ class CouetteTerm:
         self.n_cells, self.stretch = n_cells, stretch
         self.fixed = {"specularity": DEFAULT_SPECULARITY, "wall_restitution": data.case.e, **(fixed or {})}
         self.obs = np.array([data.tau_wall, data.p_wall, data.slip_speed()])
-        self.sigma = np.array([data.case.tau_wall_sigma, data.case.p_wall_sigma, self._slip_sigma()])
+        self.sigma = np.array([data.case.tau_wall_sigma, data.case.p_wall_sigma, data.slip_sigma()])
         if weights == "sigma" and not np.all(np.isfinite(self.sigma) & (self.sigma > 0)):
             raise InputError(f"data file {data.path.name}: column ux_sem is needed for weights 'sigma' (slip uncertainty)")
         self.scale = _scale(self.obs, self.sigma, weights)
         self.labels = [f"{data.path.name} {k}" for k in COUETTE_OBSERVABLES]
         self._start: np.ndarray | None = None
         self._cache: tuple[tuple[float, ...], Any, np.ndarray] | None = None
-
-    def _slip_sigma(self) -> float:
-        from .data import _split
-
-        _, names, table = _split(self.data.path)
-        if "ux_sem" not in names:
-            return math.nan
-        y, sem = table[:, names.index("y")], table[:, names.index("ux_sem")]
-        y0 = self.data.slip_y
-        return 0.5 * math.hypot(float(np.interp(-y0, y, sem)), float(np.interp(y0, y, sem)))
 
     def problem(self, values: dict[str, float]):
         """The discrete Couette problem of the DEM case at parameter values ``values``."""
