@@ -85,9 +85,13 @@ def test_bad_parameters_are_one_line_errors(synthetic, names, kw, match):
 def test_generic_parameters_are_the_float_options():
     from ktgf.calibration import fittable_parameters
 
-    # Lun et al.'s alpha (a float option) counts; RET's zeta11 (a string) and sonine (a bool) do not
-    assert set(fittable_parameters(get_model("visc-div"))) == {"alpha", "phi_f", "phi_c", "beta"}
-    assert set(fittable_parameters(get_model("ret"))) == set()
+    # Lun et al.'s alpha (a float option) counts; strings (zeta11, omega) and bools (sonine) do not
+    for name in ("visc-div", "ret"):
+        opts = get_model(name).options()
+        expected = {k for k, v in opts.items() if isinstance(v, float) and not isinstance(v, bool)}
+        assert set(fittable_parameters(get_model(name))) == expected
+    assert {"alpha", "phi_f", "phi_c", "beta"} <= set(fittable_parameters(get_model("visc-div")))
+    assert not {"zeta11", "sonine", "omega"} & (set(fittable_parameters(get_model("ret"))) | set(fittable_parameters(get_model("enskog"))))
     assert {"specularity", "wall_restitution"} <= set(fittable_parameters(get_model("ret"), couette=True))
     assert math.isnan(fittable_parameters(get_model("ret"), couette=True)["specularity"])
 
