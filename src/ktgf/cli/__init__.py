@@ -20,7 +20,7 @@ app = typer.Typer(
 plot_app = typer.Typer(help="Figures (PNG/PDF/SVG by file extension).", no_args_is_help=True)
 app.add_typer(plot_app, name="plot")
 
-COMMAND_MODULES = ("closures", "shear", "hcs", "couette", "solver", "report")
+COMMAND_MODULES = ("closures", "shear", "hcs", "couette", "solver", "report", "calibrate")
 
 
 def _print_version(value: bool) -> None:

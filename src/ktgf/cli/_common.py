@@ -93,3 +93,26 @@ def emit(rows: Sequence[dict[str, Any]], fmt: OutputFormat, title: str = "") -> 
     for r in rows:
         table.add_row(*(f"{v:.6g}" if isinstance(v, float) else str(v) for v in r.values()))
     Console(width=max(120, 14 * len(keys))).print(table)
+
+
+MODEL_FILE_HELP = "Model file (TOML) written by `ktgf calibrate`: a registered model with changed options."
+
+
+def model_file_option() -> Any:
+    """The ``--model-file FILE`` option shared by every command that takes ``--model``."""
+    return typer.Option(None, "--model-file", help=MODEL_FILE_HELP)
+
+
+def resolve_models(names: str | None, model_file: Any = None, *, option: str = "--model") -> list[Any]:
+    """Models named by ``--model`` (comma-separated) followed by the one of ``--model-file``; at least one."""
+    from ..closures import get_model
+    from ..errors import InputError
+
+    models = [get_model(n.strip()) for n in (names or "").split(",") if n.strip()]
+    if model_file is not None:
+        from ..calibration.model_file import load_model_file
+
+        models.append(load_model_file(model_file).model)
+    if not models:
+        raise InputError(f"give a model: {option} NAME (see `ktgf models`) or --model-file FILE")
+    return models

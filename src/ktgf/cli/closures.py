@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from ..closures import get_model, list_models
-from ._common import OutputFormat, emit, handle_errors, parse_values
+from ..closures import list_models
+from ._common import OutputFormat, emit, handle_errors, model_file_option, parse_values, resolve_models
 
 REDUCED_NAMES = {
     "p": "p*", "eta": "eta*", "lambda_b": "lambda_b*", "kappa": "kappa*", "mu": "mu*",
@@ -20,8 +20,8 @@ SI_NAMES = {
 }
 
 
-def model_rows() -> list[dict[str, str]]:
-    """One row per registered model: parts, options and references (feeds the CLI and docs/models.md)."""
+def model_rows(models: list | None = None) -> list[dict[str, str]]:
+    """One row per model (default: the registered ones): parts, options and references (feeds the CLI and docs/models.md)."""
     return [
         {
             "name": m.name,
@@ -34,18 +34,38 @@ def model_rows() -> list[dict[str, str]]:
             "reference": m.theory.reference,
             "description": m.description,
         }
-        for m in list_models()
+        for m in (list_models() if models is None else models)
     ]
 
 
-def models(fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown.")) -> None:
-    """List the registered closure models with their parts, references and options."""
-    emit(model_rows(), fmt, title="ktgf closure models")
+@handle_errors
+def models(
+    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
+    model_file: Path = model_file_option(),
+) -> None:
+    """List the registered closure models with their parts, references and options (or describe a model file)."""
+    if model_file is None:
+        emit(model_rows(), fmt, title="ktgf closure models")
+        return
+    from ..calibration.model_file import load_model_file
+
+    mf = load_model_file(model_file)
+    row = {**model_rows([mf.model])[0], "base": mf.base, "walls": ", ".join(f"{k}={v:g}" for k, v in mf.walls.items()),
+           "fit": ", ".join(f"{n}={v:.6g}+-{s:.2g}" for n, v, s in zip(mf.fit.get("parameters", []), mf.fit.get("values", []),
+                                                                        mf.fit.get("standard_errors", []))),
+           "cost": mf.fit.get("cost", ""),
+           "data": ", ".join(f"{d.get('file')} (sha256 {str(d.get('sha256', ''))[:12]})" for d in mf.provenance.get("data", [])),
+           "created": mf.provenance.get("created", ""), "ktgf_version": mf.provenance.get("ktgf_version", "")}
+    if fmt == OutputFormat.table:
+        emit([{"field": k, "value": str(v)} for k, v in row.items()], fmt, title=f"model file {model_file}")
+    else:
+        emit([row], fmt)
 
 
 @handle_errors
 def coefficients(
-    model: str = typer.Option(..., "--model", "-m", help="Model name (see `ktgf models`)."),
+    model: str = typer.Option(None, "--model", "-m", help="Model name (see `ktgf models`)."),
+    model_file: Path = model_file_option(),
     phi: str = typer.Option(..., "--phi", help="Solid fraction: value, list a,b,c or range start:stop:num."),
     e: str = typer.Option(..., "--e", help="Restitution coefficient(s), 0 < e <= 1."),
     theta: float = typer.Option(1e-2, "--theta", help="Granular temperature theta [m^2/s^2] for SI values."),
@@ -54,7 +74,11 @@ def coefficients(
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
 ) -> None:
     """Reduced and SI transport coefficients of one model at states (phi, e)."""
-    m = get_model(model)
+    if model is not None and model_file is not None:
+        from ..errors import InputError
+
+        raise InputError("give one of --model NAME or --model-file FILE, not both")
+    (m,) = resolve_models(model, model_file)
     phis, es = np.meshgrid(parse_values(phi, "phi"), parse_values(e, "e"), indexing="ij")
     phis, es = phis.ravel(), es.ravel()
     red = m.reduced(phis, es)
@@ -74,11 +98,12 @@ def plot_coefficients(
     out: Path = typer.Option(Path("coefficients.png"), "--out", "-o", help="Output figure file."),
     phi_max: float = typer.Option(0.6, "--phi-max", help="Largest solid fraction plotted."),
     models: str = typer.Option("enskog,ret,visc-div,proposed", "--models", help="Comma-separated model names."),
+    model_file: Path = model_file_option(),
 ) -> None:
     """Reduced p*, eta*, kappa*, mu*, zeta0* vs phi for several models on one figure."""
     from ..plotting.coefficients import plot_reduced_coefficients
 
-    path = plot_reduced_coefficients([get_model(n) for n in models.split(",")], e=e, phi_max=phi_max, out=out)
+    path = plot_reduced_coefficients(resolve_models(models, model_file, option="--models"), e=e, phi_max=phi_max, out=out)
     typer.echo(f"wrote {path}")
 
 

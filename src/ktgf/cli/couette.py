@@ -7,7 +7,7 @@ from typing import Any
 
 import typer
 
-from ._common import OutputFormat, emit, handle_errors, parse_values
+from ._common import OutputFormat, emit, handle_errors, model_file_option, parse_values
 
 
 def _default_dem() -> Path:
@@ -39,15 +39,24 @@ def _summary(ds: Any) -> dict[str, Any]:
 def run_cmd(
     config: Path = typer.Argument(..., help="TOML config (see examples/couette_planar.toml)."),
     out: Path = typer.Option(None, "--out", "-o", help="Output netCDF (default: output.path of the config)."),
+    model_file: Path = model_file_option(),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
 ) -> None:
-    """Solve one Couette cell described by a validated TOML config and write the profiles to netCDF."""
+    """Solve one Couette cell described by a validated TOML config and write the profiles to netCDF.
+
+    With ``--model-file`` the file's model replaces the config's ``model`` (the config's walls stay).
+    """
     from ..couette.config import load_config, run_config
     from ..io import write_netcdf
 
     cfg = load_config(config)
+    model = None
+    if model_file is not None:
+        from ..calibration.model_file import load_model_file
+
+        model = load_model_file(model_file).model
     path = Path(out or cfg.output.path)
-    ds = run_config(cfg, failed_path=path.with_suffix(".failed.nc"))
+    ds = run_config(cfg, model, failed_path=path.with_suffix(".failed.nc"))
     write_netcdf(ds, path)
     emit([_summary(ds)], fmt, title=f"Couette ({ds.attrs['geometry']}) -> {path}")
     if not ds.attrs["physically_valid"]:
@@ -56,29 +65,39 @@ def run_cmd(
 
 @handle_errors
 def compare_cmd(
-    config: Path = typer.Argument(None, help="TOML config run for all four models (default: the DEM case with calibrated walls)."),
-    dem: Path = typer.Option(DEFAULT_DEM, "--dem", help="DEM Couette CSV (used if present)."),
+    config: Path = typer.Argument(None, help="TOML config run for all models (default: the DEM file's case with calibrated walls)."),
+    dem: Path = typer.Option(DEFAULT_DEM, "--dem", help="DEM Couette CSV; its header gives the case (e, mean phi, gap, wall speed)."),
     out: Path = typer.Option(Path("couette_compare.png"), "--out", "-o", help="Figure file."),
-    models: str = typer.Option("enskog,ret,visc-div,proposed", "--models", help="Comma-separated model names."),
+    models: str = typer.Option("enskog,ret,visc-div,proposed", "--models", help="Comma-separated model names ('' for none)."),
+    model_file: Path = model_file_option(),
+    n_cells: int = typer.Option(200, "--cells", help="Grid cells across the gap (DEM case)."),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
 ) -> None:
-    """All four models on one figure (u/U, phi, sqrt(theta)/U vs y/d), with DEM points and per-model errors."""
-    from ..closures import get_model
+    """Models on one figure (u/U, phi, sqrt(theta)/U vs y/d) with DEM points, profile errors and wall stresses against the DEM."""
     from ..couette.compare import compare_with_dem, load_dem_couette
     from ..plotting.couette import plot_profiles
+    from ._common import resolve_models
 
-    names = [n.strip() for n in models.split(",") if n.strip()]
-    for n in names:
-        get_model(n)
+    chosen = resolve_models(models, model_file, option="--models")
+    walls = {}
+    if model_file is not None:
+        from ..calibration.model_file import load_model_file
+
+        mf = load_model_file(model_file)
+        if mf.walls.get("specularity") is not None:
+            walls[mf.model.name] = mf.walls
     if config is None:
         if not dem.exists():
             from ..errors import InputError
 
             raise InputError(f"no config given and the DEM file {str(dem)!r} does not exist")
-        rows, extra = compare_with_dem(dem, names)
-        datasets = {get_model(n).label: ds for n, ds in extra["datasets"].items()}
-        emit(rows, fmt, title=f"Models vs DEM ({dem.name}); JJ walls, e_w = 0.9, specularity fitted per model to the DEM slip at |y| = 9.25 d")
-        path = plot_profiles(datasets, out, dem=extra["dem"], title="DEM Couette e = 0.9, mean phi = 0.50; specularity calibrated per model")
+        rows, extra = compare_with_dem(dem, chosen, n_cells=n_cells, walls=walls)
+        c = extra["case"]
+        datasets = {m.label or m.name: extra["datasets"][m.name] for m in chosen if m.name in extra["datasets"]}
+        emit(rows, fmt, title=(f"Models vs DEM ({dem.name}: e = {c.e:g}, mean phi = {c.mean_phi:g}, gap = {c.gap:g} d, U = {c.wall_speed:g}); "
+                               f"JJ walls, e_w = e, specularity fitted per model to the DEM slip at |y| = {extra['dem'].slip_y:g} d"))
+        path = plot_profiles(datasets, out, dem=extra["dem"],
+                             title=f"DEM Couette e = {c.e:g}, mean phi = {c.mean_phi:g}; specularity calibrated per model")
     else:
         from ..couette.config import load_config, run_config
 
@@ -86,23 +105,26 @@ def compare_cmd(
         from ..errors import ConvergenceError
 
         datasets, rows = {}, []
-        for n in names:
-            c = cfg.model_copy(update={"model": n, "model_options": {}})
+        for m in chosen:
             try:
-                datasets[get_model(n).label] = ds = run_config(c)
+                datasets[m.label or m.name] = ds = run_config(cfg, m)
                 rows.append(_summary(ds))
             except ConvergenceError as exc:  # report it and go on with the other models
-                rows.append({"model": n, "converged": False, "valid": str(exc)[:100]})
+                rows.append({"model": m.name, "converged": False, "valid": str(exc)[:100]})
         rows = [{**{k: "" for k in rows[0] if k not in r}, **r} for r in rows] if rows else rows
         emit(rows, fmt, title=f"Couette comparison ({config})")
-        dem_data = load_dem_couette(dem) if dem.exists() and _is_dem_case(cfg) else None
+        dem_data = load_dem_couette(dem) if dem.exists() and _is_dem_case(cfg, dem) else None
         path = plot_profiles(datasets, out, dem=dem_data)
-    typer.echo(f"wrote {path}")
+    typer.echo(f"wrote {path}", err=fmt == OutputFormat.json)
 
 
-def _is_dem_case(cfg: Any) -> bool:
+def _is_dem_case(cfg: Any, dem: Path) -> bool:
+    """True if the config is the planar cell of the DEM file's header (gap in diameters and mean phi)."""
+    from ..calibration.data import read_couette_case
+
+    c = read_couette_case(dem)
     g = cfg.geometry
-    return g.kind == "planar" and abs(g.gap / cfg.particle_diameter - 19.0) < 1e-9 and abs(cfg.mean_solid_fraction - 0.5) < 1e-9
+    return g.kind == "planar" and abs(g.gap / cfg.particle_diameter - c.gap) < 1e-9 and abs(cfg.mean_solid_fraction - c.mean_phi) < 1e-9
 
 
 def _sweep_task(task: tuple[dict[str, Any], float, float]) -> dict[str, Any]:
@@ -110,7 +132,7 @@ def _sweep_task(task: tuple[dict[str, Any], float, float]) -> dict[str, Any]:
     from ..couette.config import parse_config, run_config
     from ..errors import ConvergenceError
 
-    data, spec, ew = task
+    data, spec, ew, model_file = task
     walls = dict(data.get("walls", {}))
     walls.update({"specularity": spec, "restitution": ew})
     for side in ("bottom", "top"):
@@ -118,8 +140,13 @@ def _sweep_task(task: tuple[dict[str, Any], float, float]) -> dict[str, Any]:
             walls[side] = {k: v for k, v in walls[side].items() if k not in ("specularity", "restitution")}
     cfg = parse_config({**data, "walls": walls})
     row: dict[str, Any] = {"specularity": spec, "wall_restitution": ew}
+    model = None
+    if model_file is not None:
+        from ..calibration.model_file import load_model_file
+
+        model = load_model_file(model_file).model
     try:
-        ds = run_config(cfg)
+        ds = run_config(cfg, model)
     except ConvergenceError as exc:
         return {**row, "converged": False, "slip": float("nan"), "wall_shear_stress": float("nan"),
                 "max_phi": float("nan"), "valid": False, "message": str(exc)[:80]}
@@ -137,9 +164,13 @@ def sweep_cmd(
     workers: int = typer.Option(0, "--workers", help="Processes (0: in-process)."),
     dask: str = typer.Option("", "--dask", help="Address of a Dask scheduler to run the sweep on."),
     out: Path = typer.Option(None, "--out", "-o", help="Optional figure of the slip vs phi'."),
+    model_file: Path = model_file_option(),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
 ) -> None:
-    """Sweep the specularity phi' and the wall restitution e_w (the calibration knobs) through an executor."""
+    """Sweep the specularity phi' and the wall restitution e_w (the calibration knobs) through an executor.
+
+    With ``--model-file`` the file's model replaces the config's.
+    """
     import tomllib
 
     from ..couette.config import load_config
@@ -152,7 +183,12 @@ def sweep_cmd(
     ews = parse_values(wall_restitution, "wall-restitution")
     check_range("specularity coefficient phi'", specs, low=0.0, high=1.0, low_open=True)
     check_range("wall restitution e_w", ews, low=0.0, high=1.0, low_open=True)
-    tasks = [(data, float(s), float(e)) for e in ews for s in specs]
+    if model_file is not None:
+        from ..calibration.model_file import load_model_file
+
+        load_model_file(model_file)  # check it once, with field names, before dispatching
+        model_file = model_file.resolve()
+    tasks = [(data, float(s), float(e), model_file) for e in ews for s in specs]
     with open_executor(workers, dask) as executor:
         rows = map_tasks(_sweep_task, tasks, executor=executor)
     emit(rows, fmt, title=f"Couette sweep ({config}): slip = |u_sl|/U at the bottom wall")

@@ -13,7 +13,7 @@ import typer
 from ..closures import PAPER_MODELS, get_model
 from ..errors import InputError
 from ..validation import check_positive, check_range
-from ._common import OutputFormat, emit, handle_errors, parse_values
+from ._common import OutputFormat, emit, handle_errors, model_file_option, parse_values, resolve_models
 
 hcs_app = typer.Typer(help="Homogeneous cooling state: Haff's law, linear stability, critical box sizes.",
                       no_args_is_help=True)
@@ -22,11 +22,8 @@ FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".eps", ".jpg", ".jpeg", ".tif", ".ti
 DEFAULT_MODELS = ",".join(PAPER_MODELS)
 
 
-def _models(text: str) -> list[Any]:
-    names = [n for n in (s.strip() for s in text.split(",")) if n]
-    if not names:
-        raise InputError(f"--model {text!r} names no model")
-    return [get_model(n) for n in names]
+def _models(text: str | None, model_file: Path | None = None) -> list[Any]:
+    return resolve_models(text, model_file)
 
 
 def _check_count(name: str, value: int, low: int) -> None:
@@ -46,6 +43,7 @@ def _kind_of_output(out: Path, allowed: tuple[str, ...]) -> str:
 @handle_errors
 def haff(
     model: str = typer.Option(DEFAULT_MODELS, "--model", "-m", help="Model name(s), comma-separated."),
+    model_file: Path = model_file_option(),
     phi: float = typer.Option(..., "--phi", help="Solid fraction, 0 < phi < packing limit."),
     e: float = typer.Option(..., "--e", help="Restitution coefficient, 0 < e <= 1."),
     theta0: float = typer.Option(..., "--theta0", help="Initial granular temperature theta0 [m^2/s^2] (> 0)."),
@@ -61,7 +59,7 @@ def haff(
     kind = _kind_of_output(out, (".nc", "figure")) if out is not None else None
     _check_count("--n", n, 2)
     check_positive("particle diameter d", d, "m")
-    models = _models(model)
+    models = _models(model, model_file)
     for m in models:
         m.check(phi, e, theta0)
     if t_end is not None:
@@ -92,7 +90,8 @@ def haff(
 
 @handle_errors
 def stability(
-    model: str = typer.Option(..., "--model", "-m", help="Model name(s) (see `ktgf models`), comma-separated."),
+    model: str = typer.Option(None, "--model", "-m", help="Model name(s) (see `ktgf models`), comma-separated."),
+    model_file: Path = model_file_option(),
     phi: str = typer.Option(..., "--phi", help="Solid fraction(s): value, list a,b,c or range start:stop:num."),
     e: str = typer.Option(..., "--e", help="Restitution coefficient(s), 0 < e <= 1."),
     box: float = typer.Option(None, "--box", help="Side L/d of a periodic cube: growth rates at its lowest mode 2 pi/L."),
@@ -112,7 +111,7 @@ def stability(
     phis, es = phis.ravel(), es.ravel()
     check_range("solid fraction phi", phis, low=0.0, low_open=True, why="L/d is infinite at phi = 0")
     rows = []
-    for m in _models(model):
+    for m in _models(model, model_file):
         r = m.reduced(phis, es)
         if method == "closed":
             k_perp, k_par = critical_wavenumbers(r)
@@ -158,6 +157,7 @@ def _verdict(s_perp: float, s_par: float) -> str:
 def map_cmd(
     out: Path = typer.Option(..., "--out", "-o", help="Output netCDF file (.nc)."),
     model: str = typer.Option(DEFAULT_MODELS, "--model", "-m", help="Model names, comma-separated."),
+    model_file: Path = model_file_option(),
     n_phi: int = typer.Option(200, "--n-phi", help="Number of solid fractions."),
     n_e: int = typer.Option(100, "--n-e", help="Number of restitution coefficients."),
     phi_min: float = typer.Option(0.005, "--phi-min", help="Smallest solid fraction (> 0)."),
@@ -180,7 +180,7 @@ def map_cmd(
     check_range("largest solid fraction phi-max", phi_max, low=phi_min, high=1.0, high_open=True)
     check_range("smallest restitution coefficient e-min", e_min, low=0.0, high=1.0, low_open=True)
     check_range("largest restitution coefficient e-max", e_max, low=e_min, high=1.0)
-    models = _models(model)
+    models = _models(model, model_file)
     phi = np.linspace(phi_min, phi_max, n_phi)
     e = np.linspace(e_min, e_max, n_e)
     start = time.perf_counter()
@@ -197,6 +197,7 @@ def plot_stability_map_cmd(
     out: Path = typer.Option(Path("stability_map.png"), "--out", "-o", help="Output figure (.png/.pdf/.svg)."),
     e: str = typer.Option("0.9,0.7", "--e", help="Restitution coefficients, one panel each."),
     model: str = typer.Option(DEFAULT_MODELS, "--model", "-m", help="Model names, comma-separated."),
+    model_file: Path = model_file_option(),
     phi_min: float = typer.Option(0.01, "--phi-min", help="Smallest solid fraction (> 0)."),
     phi_max: float = typer.Option(0.6, "--phi-max", help="Largest solid fraction (< 1)."),
     n_phi: int = typer.Option(300, "--n-phi", help="Number of solid fractions."),
@@ -219,13 +220,14 @@ def plot_stability_map_cmd(
         _check_count("--n-phi", n_phi, 2)
         check_range("smallest solid fraction phi-min", phi_min, low=0.0, high=1.0, low_open=True, high_open=True)
         check_range("largest solid fraction phi-max", phi_max, low=phi_min, high=1.0, high_open=True)
-        ds = stability_map(_models(model), np.linspace(phi_min, phi_max, n_phi), es)
+        ds = stability_map(_models(model, model_file), np.linspace(phi_min, phi_max, n_phi), es)
     typer.echo(f"wrote {plot_stability_map(ds, es, out)}")
 
 
 @handle_errors
 def plot_dispersion_cmd(
     model: str = typer.Option("ret", "--model", "-m", help="Model name."),
+    model_file: Path = model_file_option(),
     phi: float = typer.Option(..., "--phi", help="Solid fraction."),
     e: float = typer.Option(..., "--e", help="Restitution coefficient."),
     out: Path = typer.Option(Path("dispersion.png"), "--out", "-o", help="Output figure (.png/.pdf/.svg)."),
@@ -233,10 +235,11 @@ def plot_dispersion_cmd(
     box: float = typer.Option(None, "--box", help="Mark the lowest mode of a periodic cube of side L/d."),
 ) -> None:
     """Growth rates s(k*) of the shear and longitudinal modes, unstable bands shaded."""
+    from ..calibration.model_file import load_model_file
     from ..plotting.hcs import plot_dispersion
 
     _kind_of_output(out, ("figure",))
-    m = get_model(model)
+    m = load_model_file(model_file).model if model_file is not None else get_model(model)
     m.check(phi, e)
     check_range("solid fraction phi", phi, low=0.0, low_open=True)
     if k_max is not None:

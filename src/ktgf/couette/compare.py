@@ -1,93 +1,64 @@
-"""Four-model comparison and comparison with the DEM planar Couette profile.
+"""Model comparison with a DEM planar Couette profile, the case read from the DEM file's header.
 
-The DEM case (``shared/data/dem_couette_e0.9_phi0.50.csv``, README there): frictionless spheres
-(d = m = 1, ρ_s = 6/π), e = 0.9, bumpy walls with sphere centres at y = ±10 moving at ±U/2,
-U = 10, mean φ = 0.50 over the slab |y| ≤ 9.5 between the planes tangent to the wall spheres.
-The continuum cell is that slab: H = 19 d with walls at ±9.5 and the same inventory.
+The DEM format (``shared/data/dem_couette_e0.9_phi0.50.csv``, README there; read by
+:func:`ktgf.calibration.data.read_couette`): frictionless spheres (d = m = 1, ρ_s = 6/π), bumpy walls
+with sphere centres at y = ±H/2 moving at ±U/2; the header states e, the mean φ over the slab
+between the planes tangent to the wall spheres, H, U and the wall stresses.  The continuum cell is
+that slab: gap H − d with the same inventory.
 
-Wall calibration (stated in every output): Johnson–Jackson walls with e_w = e = 0.9 (the DEM's
+Wall calibration (stated in every output): Johnson–Jackson walls with e_w = e (the DEM's
 particle–wall restitution) and the specularity φ' fitted **per model** so that the model's
-velocity at the first occupied DEM bin (|y| = 9.25) equals the DEM value there (mean of both
-walls, 3.137).  One scalar per model is fitted to one number; the profiles (u, φ, √θ) and the
-stresses are predictions.
+velocity at the outermost occupied DEM bins (|y| = 9.25 in the shared file) equals the DEM value
+there (mean of both walls).  One scalar per model is fitted to one number; the profiles (u, φ, √θ)
+and the wall stresses are predictions.  A model read from a model file that holds walls
+(``ktgf calibrate`` on Couette data) keeps them instead.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..calibration.data import CouetteCase, CouetteData, read_couette
 from ..closures import PAPER_MODELS, get_model
-from ..errors import InputError
+from ..errors import ConvergenceError, InputError
 from .geometry import PlanarCell
 from .run import Material, run
 from .walls import Wall
 
 DEM_FILE = "dem_couette_e0.9_phi0.50.csv"
-DEM_CASE = {"gap": 19.0, "wall_speed": 10.0, "mean_phi": 0.50, "e": 0.9, "d": 1.0, "rho_s": 6.0 / math.pi,
-            "calibration_y": 9.25}
+
+#: The profile and case of a DEM Couette file (header fields checked, one-line errors).
+load_dem_couette = read_couette
+DemProfile = CouetteData
 
 
-@dataclass
-class DemProfile:
-    """DEM Couette profile (bins with particles) and the header's wall stresses."""
-
-    y: np.ndarray
-    phi: np.ndarray
-    u: np.ndarray
-    theta: np.ndarray
-    tau_wall: float
-    p_wall: float
-    path: Path
-
-
-def load_dem_couette(path: str | Path) -> DemProfile:
-    """Read the DEM Couette CSV (comment header with the wall stresses, then columns)."""
-    path = Path(path)
-    if not path.exists():
-        raise InputError(f"DEM data file {str(path)!r} does not exist")
-    header = [ln for ln in path.read_text().splitlines() if ln.startswith("#")]
-    tau = p = math.nan
-    for ln in header:
-        if "wall shear stress tau" in ln:
-            parts = ln.replace(";", " ").split()
-            tau = float(parts[parts.index("tau") + 2])
-            p = float(parts[parts.index("p_yy") + 2])
-    import io
-
-    body = "\n".join(ln for ln in path.read_text().splitlines() if not ln.startswith("#"))
-    data = np.genfromtxt(io.StringIO(body), delimiter=",", names=True)
-    keep = (data["phi"] > 0.05) & (data["theta"] > 0)
-    return DemProfile(data["y"][keep], data["phi"][keep], data["ux"][keep], data["theta"][keep], tau, p, path)
-
-
-def dem_cell(specularity: float, model: Any, *, n_cells: int = 200, stretch: float = 1.5, start=None):
-    """The continuum counterpart of the DEM cell with JJ walls of the given specularity."""
-    c = DEM_CASE
-    wall = Wall(specularity=specularity, restitution=c["e"])
-    return run(model, PlanarCell(c["gap"], c["wall_speed"]), wall, wall, c["mean_phi"],
-               Material(c["d"], c["rho_s"], c["e"]), n_cells=n_cells, stretch=stretch, start=start)
+def dem_cell(specularity: float, model: Any, case: CouetteCase, *, wall_restitution: float | None = None,
+             n_cells: int = 200, stretch: float = 1.5, start=None):
+    """The continuum counterpart of a DEM cell with JJ walls of the given specularity (e_w = e by default)."""
+    wall = Wall(specularity=specularity, restitution=case.e if wall_restitution is None else wall_restitution)
+    return run(model, PlanarCell(case.gap, case.wall_speed), wall, wall, case.mean_phi,
+               Material(case.d, case.rho_s, case.e), n_cells=n_cells, stretch=stretch, start=start)
 
 
 def _u_at(ds, y: float) -> float:
     return float(np.interp(y, ds["y"].values, ds["u"].values))
 
 
-def calibrate_specularity(model: Any, target_u: float, *, n_cells: int = 200, bounds=(1e-3, 1.0)) -> tuple[float, Any]:
-    """Specularity such that u(y = calibration_y) = target_u (bisection in ln φ'); returns (φ', Dataset)."""
+def calibrate_specularity(model: Any, dem: CouetteData, *, n_cells: int = 200, bounds=(1e-3, 1.0)) -> tuple[float, Any]:
+    """Specularity such that u(y = slip_y) = the DEM's (bisection in ln φ'); returns (φ', Dataset)."""
     from scipy.optimize import brentq
 
-    y = DEM_CASE["calibration_y"]
+    y, target = dem.slip_y, dem.slip_speed()
     cache: dict[float, Any] = {}
 
     def f(log_s: float) -> float:
-        ds = dem_cell(math.exp(log_s), model, n_cells=n_cells)
+        ds = dem_cell(math.exp(log_s), model, dem.case, n_cells=n_cells)
         cache[log_s] = ds
-        return _u_at(ds, y) - target_u
+        return _u_at(ds, y) - target
 
     lo, hi = math.log(bounds[0]), math.log(bounds[1])
     flo, fhi = f(lo), f(hi)
@@ -96,12 +67,12 @@ def calibrate_specularity(model: Any, target_u: float, *, n_cells: int = 200, bo
         return math.exp(best), cache[best]
     root = brentq(f, lo, hi, xtol=1e-4)
     ds = cache.get(root)
-    return math.exp(root), ds if ds is not None else dem_cell(math.exp(root), model, n_cells=n_cells)
+    return math.exp(root), ds if ds is not None else dem_cell(math.exp(root), model, dem.case, n_cells=n_cells)
 
 
-def profile_errors(ds, dem: DemProfile) -> dict[str, float]:
+def profile_errors(ds, dem: CouetteData) -> dict[str, float]:
     """RMS differences over the DEM bins of u/U, φ and √θ/U (model interpolated to the bin centres)."""
-    U = DEM_CASE["wall_speed"]
+    U = dem.case.wall_speed
     y = ds["y"].values
     out = {}
     for name, model_v, dem_v in (
@@ -113,33 +84,54 @@ def profile_errors(ds, dem: DemProfile) -> dict[str, float]:
     return out
 
 
-def compare_with_dem(dem_path: str | Path, models=PAPER_MODELS, *, n_cells: int = 200) -> tuple[list[dict[str, Any]], dict[str, Any]]:
-    """Calibrate each model's specularity on the DEM slip and report its profile errors.
+def wall_stresses(ds) -> tuple[float, float]:
+    """|wall shear stress| and pressure at the walls (means of both walls) of a planar Couette Dataset."""
+    return float(np.mean(np.abs(ds["wall_shear_stress"].values))), float(0.5 * (ds["p"].values[0] + ds["p"].values[-1]))
 
-    Returns (rows, datasets) with one row per model: fitted φ', RMS errors, wall shear stress,
-    wall normal stress and their DEM values, max φ and validity.
+
+def compare_with_dem(dem_path: str | Path, models=PAPER_MODELS, *, n_cells: int = 200,
+                     walls: dict[str, dict[str, float]] | None = None) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """Each model in the DEM file's case: specularity calibrated on the DEM slip (or ``walls[name]``), errors, wall stresses.
+
+    ``models`` are registry names or :class:`~ktgf.closures.Model` objects.  Returns (rows, extra)
+    with one row per model: φ', RMS profile errors, wall shear stress ``tau_wall`` and pressure
+    ``p`` with the DEM's ``tau_wall_dem``, ``p_dem`` and relative errors, max φ and ``valid``
+    (converged and max φ below φ_rcp).  A model whose solve fails gets a row saying so.
     """
-    dem = load_dem_couette(dem_path)
-    y0 = DEM_CASE["calibration_y"]
-    target = dem_slip_target(dem)
+    dem = read_couette(dem_path)
+    walls = walls or {}
     rows, datasets = [], {}
-    for name in models:
-        m = get_model(name)
-        spec, ds = calibrate_specularity(m, target, n_cells=n_cells)
-        ds.attrs["calibration"] = (
-            f"Johnson-Jackson walls, e_w = {DEM_CASE['e']}, specularity {spec:.4g} fitted so that u(|y| = {y0}) "
-            f"= {target:.4f} (DEM {dem.path.name})"
-        )
+    for item in models:
+        m = get_model(item)
+        row: dict[str, Any] = {"model": m.label or m.name}
+        try:
+            if m.name in walls:
+                w = walls[m.name]
+                spec = float(w.get("specularity", math.nan))
+                ds = dem_cell(spec, m, dem.case, wall_restitution=w.get("wall_restitution"), n_cells=n_cells)
+                how = f"Johnson-Jackson walls from the model file: specularity {spec:.4g}, e_w = {w.get('wall_restitution', dem.case.e):.4g}"
+            else:
+                spec, ds = calibrate_specularity(m, dem, n_cells=n_cells)
+                how = (f"Johnson-Jackson walls, e_w = {dem.case.e:g}, specularity {spec:.4g} fitted so that u(|y| = {dem.slip_y:g}) "
+                       f"= {dem.slip_speed():.4f} (DEM {dem.path.name})")
+        except ConvergenceError as exc:
+            rows.append({**row, "specularity": math.nan, "rms_u/U": math.nan, "rms_phi": math.nan, "rms_sqrt(theta)/U": math.nan,
+                         "tau_wall": math.nan, "tau_wall_dem": dem.tau_wall, "tau_error": math.nan, "p": math.nan,
+                         "p_dem": dem.p_wall, "p_error": math.nan, "max_phi": math.nan, "valid": False,
+                         "message": str(exc)[:120]})
+            continue
+        ds.attrs["calibration"] = how
         err = profile_errors(ds, dem)
+        tau, p = wall_stresses(ds)
         rows.append({
-            "model": m.label or m.name, "specularity": spec,
+            **row, "specularity": spec,
             "rms_u/U": err["u/U"], "rms_phi": err["phi"], "rms_sqrt(theta)/U": err["sqrt(theta)/U"],
-            "tau_wall": float(ds["wall_shear_stress"].values[0]), "tau_wall_dem": dem.tau_wall,
-            "p": float(ds["p"].values[0]), "p_dem": dem.p_wall,
-            "max_phi": float(ds.attrs["max_phi"]), "valid": bool(ds.attrs["physically_valid"]),
+            "tau_wall": tau, "tau_wall_dem": dem.tau_wall, "tau_error": tau / dem.tau_wall - 1.0,
+            "p": p, "p_dem": dem.p_wall, "p_error": p / dem.p_wall - 1.0,
+            "max_phi": float(ds.attrs["max_phi"]), "valid": bool(ds.attrs["physically_valid"]), "message": "",
         })
-        datasets[name] = ds
-    return rows, {"datasets": datasets, "dem": dem, "target_u": target}
+        datasets[m.name] = ds
+    return rows, {"datasets": datasets, "dem": dem, "target_u": dem.slip_speed(), "case": dem.case}
 
 
 def compare_uniform_shear(path: str | Path, models=PAPER_MODELS) -> list[dict[str, Any]]:
@@ -175,10 +167,9 @@ def compare_uniform_shear(path: str | Path, models=PAPER_MODELS) -> list[dict[st
     return rows
 
 
-def dem_slip_target(dem: DemProfile) -> float:
-    """|u| at |y| = calibration_y, averaged over both walls: the one DEM number the wall is fitted to."""
-    y0 = DEM_CASE["calibration_y"]
-    return 0.5 * (abs(np.interp(y0, dem.y, dem.u)) + abs(np.interp(-y0, dem.y, dem.u)))
+def dem_slip_target(dem: CouetteData) -> float:
+    """|u| at the outermost occupied bins, averaged over both walls: the one DEM number the wall is fitted to."""
+    return dem.slip_speed()
 
 
 def report_profiles(model: Any, *, phi_mean: float, e: float, height: float, wall_speed: float, d: float,
@@ -186,18 +177,19 @@ def report_profiles(model: Any, *, phi_mean: float, e: float, height: float, wal
                     specularity: float = 0.1) -> Any:
     """Steady planar profiles for the report's Couette section (entry point of :mod:`ktgf.report.couette`).
 
-    Johnson–Jackson walls with e_w = e.  With ``dem_path`` (the DEM Couette file) and the DEM case's
-    parameters, the specularity is fitted per model to the DEM slip as in :func:`compare_with_dem`;
-    otherwise ``specularity`` is used.  ``attrs['wall']`` says which, ``attrs['valid']`` is 1 when
-    max φ stays below φ_rcp.
+    Johnson–Jackson walls with e_w = e.  With ``dem_path`` (a DEM Couette file) whose header
+    describes this case, the specularity is fitted per model to the DEM slip as in
+    :func:`compare_with_dem`; otherwise ``specularity`` is used.  ``attrs['wall']`` says which,
+    ``attrs['valid']`` is 1 when max φ stays below φ_rcp.
     """
-    c = DEM_CASE
-    dem_case = (phi_mean, e, height, wall_speed, d, rho_s) == (c["mean_phi"], c["e"], c["gap"], c["wall_speed"], c["d"], c["rho_s"])
-    if dem_path is not None and dem_case:
-        target = dem_slip_target(load_dem_couette(dem_path))
-        spec, ds = calibrate_specularity(get_model(model), target, n_cells=n_cells)
-        wall = (f"Johnson–Jackson, e_w = {e:g}, specularity φ' = {spec:.3g} fitted so that u(|y| = {c['calibration_y']}) "
-                f"= {target:.3f} (the DEM slip)")
+    dem = read_couette(dem_path) if dem_path is not None else None
+    c = dem.case if dem is not None else None
+    same = c is not None and all(math.isclose(a, b, rel_tol=1e-9) for a, b in
+                                 ((phi_mean, c.mean_phi), (e, c.e), (height, c.gap), (wall_speed, c.wall_speed), (d, c.d), (rho_s, c.rho_s)))
+    if same:
+        spec, ds = calibrate_specularity(get_model(model), dem, n_cells=n_cells)
+        wall = (f"Johnson–Jackson, e_w = {e:g}, specularity φ' = {spec:.3g} fitted so that u(|y| = {dem.slip_y:g}) "
+                f"= {dem.slip_speed():.3f} (the DEM slip)")
     else:
         w = Wall(specularity=specularity, restitution=e)
         ds = run(model, PlanarCell(height, wall_speed), w, w, phi_mean, Material(d, rho_s, e), n_cells=n_cells, stretch=1.5)

@@ -216,13 +216,13 @@ def load_config(path: str | Path) -> CouetteConfig:
     return parse_config(data)
 
 
-def run_config(cfg: CouetteConfig, **overrides: Any):
-    """Run the cell described by ``cfg`` (see :func:`ktgf.couette.run.run`)."""
+def run_config(cfg: CouetteConfig, model: Any = None, **overrides: Any):
+    """Run the cell described by ``cfg`` (see :func:`ktgf.couette.run.run`), with ``model`` instead of the config's if given."""
     from .run import run
 
     bottom, top = cfg.walls.build_pair()
     return run(
-        cfg.build_model(), cfg.geometry.build(), bottom, top, cfg.mean_solid_fraction, cfg.material(),
+        cfg.build_model() if model is None else model, cfg.geometry.build(), bottom, top, cfg.mean_solid_fraction, cfg.material(),
         n_cells=cfg.numerics.n_cells, stretch=cfg.numerics.stretch, phi_rcp=cfg.output.phi_rcp,
         tol=cfg.numerics.tol, **overrides,
     )

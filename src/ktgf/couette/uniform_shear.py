@@ -24,6 +24,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from .._array import asarray, namespace
+
 #: η0 d²/√(mT) = 5/(16√π): converts η* = η/η0 to the DEM file's η d²/√(mT).
 ETA0_DEM = 5.0 / (16.0 * math.sqrt(math.pi))
 #: s = dγ̇/√θ = SHEAR_PER_ASTAR · φ · a*, from ν0 = (96/5)(φ/d)√(θ/π).
@@ -51,38 +53,42 @@ class ShearState(NamedTuple):
     L_over_d: Any
 
 
-def _solve(model: Any, phi: Any, e: Any) -> tuple[Any, Any, Any, Any]:
-    """(reduced coefficients without shear, a*, L/d, η*) of the steady uniform shear."""
-    phi = np.asarray(phi, dtype=float)
-    r = model.reduced(phi, e)
-    zeta0, eta = np.asarray(r.zeta0, dtype=float), np.asarray(r.eta, dtype=float)
-    a0 = np.sqrt(1.5 * zeta0 / eta)
-    lam = np.asarray(model.dissipation.coefficient(phi, np.asarray(e, dtype=float), model.chi(phi)), dtype=float)
+def _solve(model: Any, phi: Any, e: Any, check: bool = True) -> tuple[Any, Any, Any, Any]:
+    """(reduced coefficients without shear, a*, L/d, η*) of the steady uniform shear.
+
+    NumPy in, NumPy out; JAX values pass through, so with ``check=False`` (options that are JAX
+    tracers have no value to check) ``jax.jacfwd`` differentiates it exactly (used by calibration).
+    """
+    phi, e = asarray(phi), asarray(e)
+    xp = namespace(phi, e)
+    r = model.reduced(phi, e, check=check)
+    a0 = (1.5 * r.zeta0 / r.eta) ** 0.5
+    lam = model.dissipation.coefficient(phi, e, model.chi(phi))
     k = SHEAR_PER_ASTAR * phi
-    with np.errstate(invalid="ignore", divide="ignore"):
-        x = lam * k * a0
-        correlated = np.isfinite(x) & (x > 1.0)
-        a = np.where(correlated, np.cbrt(a0**2 / np.where(correlated, lam * k, 1.0)), a0)
-    length = np.where(correlated, lam * k * a, 1.0)
-    return r, a, length, eta
+    x = lam * k * a0
+    correlated = xp.isfinite(x) & (x > 1.0)
+    safe = xp.where(correlated, lam * k, 1.0)
+    a = xp.where(correlated, (a0**2 / safe) ** (1.0 / 3.0), a0)
+    length = xp.where(correlated, lam * k * a, 1.0)
+    return r, a, length, r.eta
 
 
-def uniform_shear(model: Any, phi: Any, e: Any) -> UniformShear:
+def uniform_shear(model: Any, phi: Any, e: Any, *, check: bool = True) -> UniformShear:
     """Closed-form uniform-shear state of ``model`` at solid fraction φ and restitution e < 1."""
-    r, a, _, eta = _solve(model, phi, e)
-    phi = np.asarray(phi, dtype=float)
+    r, a, _, eta = _solve(model, phi, e, check)
+    phi = asarray(phi)
     return UniformShear(
         shear_rate_ratio=a,
-        stress_ratio=eta * a / np.asarray(r.p, dtype=float),
+        stress_ratio=eta * a / r.p,
         temperature_ratio=25.0 * math.pi / (9216.0 * phi**2 * a**2),
     )
 
 
-def shear_state(model: Any, phi: Any, e: Any) -> ShearState:
+def shear_state(model: Any, phi: Any, e: Any, *, check: bool = True) -> ShearState:
     """Uniform-shear steady state of ``model`` in the DEM file's columns (module docstring)."""
-    r, a, length, eta = _solve(model, phi, e)
-    phi = np.asarray(phi, dtype=float)
-    p = np.asarray(r.p, dtype=float)
+    r, a, length, eta = _solve(model, phi, e, check)
+    phi = asarray(phi)
+    p = r.p
     return ShearState(
         phi=phi, T=25.0 * math.pi / (9216.0 * phi**2 * a**2), eta_star=ETA0_DEM * eta, eta_over_eta0=eta,
         p_over_nT=p, astar=a, stress_ratio=eta * a / p, L_over_d=length,

@@ -27,7 +27,7 @@ def plot_profiles(datasets: Mapping[str, Any], out: str | Path, *, dem: Any = No
         axes[1].plot(ds["phi"].values, x, style)
         axes[2].plot(np.sqrt(ds["theta"].values) / U, x, style)
     if dem is not None:
-        U = 10.0
+        U = dem.case.wall_speed  # the DEM file's own case (header)
         kw = dict(marker="o", ls="none", mfc="none", color="k", ms=4, label="DEM")
         axes[0].plot(dem.u / U, dem.y, **kw)
         axes[1].plot(dem.phi, dem.y, **{**kw, "label": None})

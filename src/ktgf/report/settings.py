@@ -68,9 +68,15 @@ class ReportSettings(BaseModel):
     cooling_t_end: float = Field(400.0, gt=0.0, description="End time in units of the initial collision time 1/ν0(θ0)")
     cooling_seed: int = Field(0, ge=0, description="Seed of the initial velocity perturbation")
 
-    @field_validator("models", "cooling_models")
+    # (5) dense regime: uniform shear and Couette wall stresses against DEM
+    dense_models: tuple[str, ...] | None = Field(None, description="Models of the dense-regime section (default: models plus 'dense' if registered)")
+    dense_points: int = Field(150, ge=10, le=20000, description="Points in φ of the dense-regime uniform-shear curves")
+
+    @field_validator("models", "cooling_models", "dense_models")
     @classmethod
-    def _known_models(cls, names: tuple[str, ...]) -> tuple[str, ...]:
+    def _known_models(cls, names: tuple[str, ...] | None) -> tuple[str, ...] | None:
+        if names is None:
+            return None
         try:
             return tuple(get_model(n).name for n in names)
         except UnknownModelError as exc:  # a KeyError, which pydantic would not attribute to the field
@@ -94,7 +100,7 @@ class ReportSettings(BaseModel):
         if quick:
             values.update(
                 coefficient_e=(0.9,), coefficient_points=80, stability_e=(0.7, 0.9), stability_points=59,
-                dispersion_points=120, couette_cells=40, cooling_cells=16, cooling_t_end=150.0,
+                dispersion_points=120, couette_cells=40, cooling_cells=16, cooling_t_end=150.0, dense_points=50,
             )
         values.update({k: v for k, v in overrides.items() if v is not None})
         try:
