@@ -117,10 +117,14 @@ class _EffectiveDissipation:
     restitution: Any
     mu: float
 
-    def reduced(self, phi: Any, e: Any):
-        r = self.model.reduced(phi, e)
+    def reduced(self, phi: Any, e: Any, *, check: bool = True):
+        r = self.model.reduced(phi, e, check=check)
         inel = self.restitution.inelasticity(np.asarray(e, dtype=float), self.mu)
         return r._replace(zeta0=modified_cooling_rate(r.zeta0, np.asarray(e, dtype=float), inel))
+
+    def __getattr__(self, name: str) -> Any:
+        # everything else (RDF, dissipation part, ...) is the wrapped model's
+        return getattr(self.model, name)
 
 
 def frictional_uniform_shear(parts: FrictionalShearParts, phi: Any, e: float, mu: float) -> FrictionalShear:
