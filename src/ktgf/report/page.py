@@ -23,6 +23,8 @@ from .framework import SectionResult, TableData, _atomic_write, sections
 from .settings import ReportSettings
 
 PAGE_NAME = "index.html"
+#: The page is meant to be shared: readable by everyone, like the figures beside it.
+PAGE_MODE = 0o644
 #: Marks pages written by ktgf, so that a report never overwrites someone else's index.html.
 GENERATOR = "ktgf reproduce"
 #: Sections every page has besides the registered ones (generated at page time, never cached).
@@ -196,4 +198,5 @@ viscosity divergence ("Proposed"). Each figure links the netCDF file with the nu
 """
     page = out / PAGE_NAME
     _atomic_write(page, doc)
+    page.chmod(PAGE_MODE)  # the temporary file behind the atomic write is private (0600); the page is for sharing
     return page

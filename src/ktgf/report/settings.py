@@ -55,7 +55,7 @@ class ReportSettings(BaseModel):
     couette_phi_mean: float = Field(0.5, gt=0.0, lt=0.64, description="Mean solid fraction of the Couette cell")
     couette_e: float = Field(0.9, gt=0.0, le=1.0, description="Restitution (particle-particle and particle-wall)")
     couette_height: float = Field(19.0, gt=0.0, description="Gap H [d] between the planes tangent to the wall spheres (DEM: 19)")
-    couette_wall_speed: float = Field(10.0, gt=0.0, description="Relative wall speed U [√(m/…) units of the DEM]")
+    couette_wall_speed: float = Field(10.0, gt=0.0, description="Relative wall speed U in the DEM units, d = m = 1 (the DEM run: U = 10)")
     couette_cells: int = Field(200, ge=8, le=100000, description="Grid cells across the Couette gap")
 
     # (4) 3D homogeneous cooling gas
