@@ -8,7 +8,8 @@ import numpy as np
 import typer
 
 from ..closures import get_model, list_models
-from ._common import OutputFormat, emit, handle_errors, parse_values
+from ..closures.models import PAPER_MODELS
+from ._common import MODEL_HELP, VALUES_HELP, OutputFormat, emit, handle_errors, parse_values
 
 REDUCED_NAMES = {
     "p": "p*", "eta": "eta*", "lambda_b": "lambda_b*", "kappa": "kappa*", "mu": "mu*",
@@ -44,27 +45,29 @@ def models(fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help
 
 @handle_errors
 def coefficients(
-    model: str = typer.Option(..., "--model", "-m", help="Model name (see `ktgf models`)."),
-    phi: str = typer.Option(..., "--phi", help="Solid fraction: value, list a,b,c or range start:stop:num."),
+    model: str = typer.Option(",".join(PAPER_MODELS), "--model", "--models", "-m", help=MODEL_HELP),
+    phi: str = typer.Option(..., "--phi", help="Solid fraction: " + VALUES_HELP + "."),
     e: str = typer.Option(..., "--e", help="Restitution coefficient(s), 0 < e <= 1."),
     theta: float = typer.Option(1e-2, "--theta", help="Granular temperature theta [m^2/s^2] for SI values."),
     d: float = typer.Option(1e-3, "--d", help="Particle diameter [m]."),
     rho_s: float = typer.Option(1500.0, "--rho-s", help="Material density [kg/m^3]."),
-    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
+    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
-    """Reduced and SI transport coefficients of one model at states (phi, e)."""
-    m = get_model(model)
+    """Reduced and SI transport coefficients of the models at states (phi, e)."""
+    names = [n.strip() for n in model.split(",") if n.strip()]
+    ms = [get_model(n) for n in names]
     phis, es = np.meshgrid(parse_values(phi, "phi"), parse_values(e, "e"), indexing="ij")
     phis, es = phis.ravel(), es.ravel()
-    red = m.reduced(phis, es)
-    si = m.coefficients(phis, es, theta, d=d, rho_s=rho_s)
     rows = []
-    for i in range(phis.size):
-        row: dict[str, float | str] = {"phi": float(phis[i]), "e": float(es[i])}
-        row.update({label: float(np.broadcast_to(getattr(red, k), phis.shape)[i]) for k, label in REDUCED_NAMES.items()})
-        row.update({label: float(np.broadcast_to(getattr(si, k), phis.shape)[i]) for k, label in SI_NAMES.items()})
-        rows.append(row)
-    emit(rows, fmt, title=f"{m.label}: theta={theta:g} m^2/s^2, d={d:g} m, rho_s={rho_s:g} kg/m^3")
+    for m in ms:
+        red = m.reduced(phis, es)
+        si = m.coefficients(phis, es, theta, d=d, rho_s=rho_s)
+        for i in range(phis.size):
+            row: dict[str, float | str] = {"model": m.name, "phi": float(phis[i]), "e": float(es[i])}
+            row.update({label: float(np.broadcast_to(getattr(red, k), phis.shape)[i]) for k, label in REDUCED_NAMES.items()})
+            row.update({label: float(np.broadcast_to(getattr(si, k), phis.shape)[i]) for k, label in SI_NAMES.items()})
+            rows.append(row)
+    emit(rows, fmt, title=f"{', '.join(m.label for m in ms)}: theta={theta:g} m^2/s^2, d={d:g} m, rho_s={rho_s:g} kg/m^3")
 
 
 @handle_errors
@@ -72,7 +75,7 @@ def plot_coefficients(
     e: float = typer.Option(0.9, "--e", help="Restitution coefficient."),
     out: Path = typer.Option(Path("coefficients.png"), "--out", "-o", help="Output figure file."),
     phi_max: float = typer.Option(0.6, "--phi-max", help="Largest solid fraction plotted."),
-    models: str = typer.Option("enskog,ret,visc-div,proposed", "--models", help="Comma-separated model names."),
+    models: str = typer.Option(",".join(PAPER_MODELS), "--model", "--models", "-m", help=MODEL_HELP),
 ) -> None:
     """Reduced p*, eta*, kappa*, mu*, zeta0* vs phi for several models on one figure."""
     from ..plotting.coefficients import plot_reduced_coefficients
