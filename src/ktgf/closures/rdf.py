@@ -8,7 +8,7 @@ does, at the public boundary.
 
 Glossary: ``phi`` solid volume fraction φ, ``phi_f`` freezing point φ_f,
 ``phi_c`` random-close-packing (divergence) point φ_c, ``beta`` divergence exponent β.
-Formulas: ``shared/theory/model.md`` §2.
+Formulas: ``docs/model.md`` §2.
 """
 
 from __future__ import annotations

@@ -180,6 +180,16 @@ def _dem_checks(ctx: SectionContext, names: tuple[str, ...]) -> None:
                   ["state", "DEM η/η0", "± DEM", *[get_model(n).label for n in names]], rows,
                   note="Navier–Stokes η* compared at the DEM's shear rate a* = γ̇/ν0 ≈ 0.2–0.3, where shear thinning "
                        "beyond Navier–Stokes order is expected; read as indicative.")
+        ctx.dataset(xr.Dataset(
+            {"eta_dem": (("state",), t["eta_over_eta0"], {"long_name": "DEM shear viscosity eta/eta0", "units": "1"}),
+             "eta_dem_sem": (("state",), t["deta_over_eta0"], {"long_name": "standard error of the DEM eta/eta0", "units": "1"}),
+             "eta_model": (("model", "state"), np.array([eta_err[n] + 1 for n in names]) * t["eta_over_eta0"],
+                           {"long_name": "model Navier-Stokes eta* = eta/eta0", "units": "1"}),
+             "error": (("model", "state"), np.array([eta_err[n] for n in names]), {"long_name": "eta_model/eta_dem - 1", "units": "1"})},
+            coords={"model": list(names), "phi": (("state",), t["phi"], {"long_name": "solid fraction", "units": "1"}),
+                    "e": (("state",), t["e"], {"long_name": "normal restitution coefficient", "units": "1"}),
+                    "astar": (("state",), t["astar"], {"long_name": "reduced shear rate a* = shear rate/nu0", "units": "1"})},
+            attrs=run_metadata(None, source=UNIFORM_SHEAR, quantity="eta* = eta/eta0")), "eta_vs_dem_uniform_shear")
         ctx.number("eta_shear_error", {n: {f"{p:g}": float(v) for p, v in zip(t["phi"], eta_err[n])} for n in names})
 
 
