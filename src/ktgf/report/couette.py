@@ -101,16 +101,15 @@ def plot_profiles(ds: xr.Dataset, out: Any) -> Any:
     from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
 
     from ..plotting import save
-    from ..plotting.hcs import MODEL_COLOURS
+    from ..plotting.hcs import LINESTYLES, MODEL_COLOURS
 
     U = float(ds["wall_speed"])
     scale = {"u": U, "phi": 1.0, "theta": U**2}
     labels = {"u": "velocity $u/U$", "phi": r"solid fraction $\phi$", "theta": r"temperature $\theta/U^2$ (log)"}
-    styles = ("-", "--", "-.", ":")
     fig, axes = plt.subplots(1, 3, figsize=(14, 4.4), constrained_layout=True)
     for ax, var in zip(axes, ("u", "phi", "theta")):
         for i in range(ds.sizes["model"]):
-            ax.plot(ds[var][i] / scale[var], ds.y, styles[i % 4], color=MODEL_COLOURS[i % len(MODEL_COLOURS)],
+            ax.plot(ds[var][i] / scale[var], ds.y, LINESTYLES[i % len(LINESTYLES)], color=MODEL_COLOURS[i % len(MODEL_COLOURS)],
                     label=str(ds.label[i].values))
         if f"{var}_dem" in ds:
             occupied = ds.phi_dem.values > 0.05  # bins inside the wall layers hold no flowing particles

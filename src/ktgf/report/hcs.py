@@ -184,7 +184,7 @@ def run(ctx: SectionContext) -> None:
     disp = dispersion(names, s.dispersion_phi, s.dispersion_e, s.dispersion_points)
     plot_dispersion(disp, ctx.figure_path("dispersion"))
     ctx.add_figure("dispersion", f"Growth rates of perturbations of the HCS against k* = kℓ at φ = {s.dispersion_phi:g}, "
-                   f"e = {s.dispersion_e:g} (model.md §8): modes with positive rate grow.", disp)
+                   f"e = {s.dispersion_e:g} (docs/model.md §8): modes with positive rate grow.", disp)
     check = np.abs(np.concatenate([disp.k_par_eigen.values / disp.k_par.values, disp.k_perp_eigen.values / disp.k_perp.values]) - 1.0)
     ctx.number("eigen_vs_closed_form_max_rel", float(np.nanmax(check)))
     ctx.table(f"Critical wavenumbers at φ = {s.dispersion_phi:g}, e = {s.dispersion_e:g}",
@@ -197,7 +197,7 @@ def run(ctx: SectionContext) -> None:
     ctx.step("stability map")
     smap = stability_map(names, np.linspace(*s.stability_phi, s.stability_points), np.asarray(s.stability_e))
     plot_stability_map(smap, s.stability_e, ctx.figure_path("stability_map"))
-    ctx.add_figure("stability_map", "Critical sizes of a periodic cube against φ for each e and model (model.md §8, closed form). "
+    ctx.add_figure("stability_map", "Critical sizes of a periodic cube against φ for each e and model (docs/model.md §8, closed form). "
                    "A cube smaller than L⊥ stays homogeneous, between L⊥ and L∥ it grows vortices, above L∥ also clusters.", smap)
     rows = []
     for i, n in enumerate(names):

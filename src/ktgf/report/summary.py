@@ -94,15 +94,28 @@ def _recommend(s: Summary, states: list[tuple[float, float]]) -> None:
         rows = [r for r in s.rows if r.regime == regime]
         if not rows:
             continue
+        telling = [r for r in rows if len(r.best) < len(r.errors)]  # a row where every model ties ranks nobody
+        same = [r.measure.split(":")[0] for r in rows if r not in telling]
+        tail = f"; all models equal in {', '.join(same)}" if same else ""
+        if not telling:
+            s.recommendations.append(f"{where}: no model is closer than another in these comparisons{tail}.")
+            continue
         wins: dict[str, int] = {}
-        for r in rows:
+        for r in telling:
             for n in r.best:
                 wins[n] = wins.get(n, 0) + 1
         top = max(wins.values())
         best = [n for n in rows[0].errors if wins.get(n, 0) == top]
+        groups = {tuple(r.best) for r in telling if set(r.best) <= set(best)}
+        if len(groups) > 1:  # e.g. one theory wins one comparison, the other another: say so, pick none
+            s.recommendations.append(
+                f"{where}: no single best model — " + "; ".join(
+                    f"{_join(r.best)} closest in {r.measure.split(':')[0]} ({_fmt(r.errors[r.best[0]], r.percent)})" for r in telling)
+                + f"{tail}.")
+            continue
         detail = "; ".join(f"{r.measure.split(':')[0]} {_fmt(r.errors[best[0]], r.percent)}" for r in rows)
         s.recommendations.append(
-            f"{where}: {_join(best)} — closest to the DEM in {top} of {len(rows)} comparisons "
+            f"{where}: {_join(best)} — closest to the DEM in {top} of {len(telling)} comparisons that tell the models apart "
             f"({'tied, identical there' if len(best) > 1 else 'its errors'}: {detail}).")
 
 
