@@ -1,6 +1,6 @@
 """Couette benchmark: one planar profile on 200 cells (target < 0.5 s) and the four-model comparison, cold and warm.
 
-Run: ``PYTHONPATH=src /work/venv/bin/python benchmarks/bench_couette.py``.
+Run: ``python benchmarks/bench_couette.py``.
 "Cold" is the first call in a fresh process (imports and first-use costs included); "warm"
 the best of repeated calls.  The solver is NumPy/SciPy (no JIT), so cold and warm differ only
 by import and cache effects.
@@ -54,12 +54,11 @@ def main() -> None:
     c4, _ = timed(four)
     w4, _ = timed(four, repeat=3)
     print(f"four-model comparison (200 cells each): cold {c4:.3f} s, warm {w4:.3f} s")
-    from pathlib import Path
+    from ktgf.data import locate_data_dir
 
-    dem = Path(__file__).resolve().parents[2] / "shared" / "data" / "dem_couette_e0.9_phi0.50.csv"
-    if not dem.exists():
-        dem = Path("/work/shared/data/dem_couette_e0.9_phi0.50.csv")
-    if dem.exists():
+    data_dir, _ = locate_data_dir(None)  # $KTGF_DATA or shared/data beside the repository
+    dem = data_dir / "dem_couette_e0.9_phi0.50.csv" if data_dir is not None else None
+    if dem is not None and dem.exists():
         from ktgf.couette.compare import compare_with_dem
 
         t, _ = timed(lambda: compare_with_dem(dem))

@@ -1,6 +1,6 @@
 """Benchmark of the HCS stability map (issue 3 speed targets).
 
-Run:  PYTHONPATH=src /work/venv/bin/python benchmarks/bench_hcs.py
+Run:  python benchmarks/bench_hcs.py
 
 Prints: the 4 models x 200 phi x 100 e map end to end (in-process, cold and warm; netCDF write;
 local process pool; Dask LocalCluster), the per-point cost, and its ratio to one closure

@@ -1,6 +1,6 @@
 """Run time of ``ktgf reproduce``: quick and full report from scratch, and a rerun served from the cache.
 
-Run as ``PYTHONPATH=src /work/venv/bin/python benchmarks/bench_report.py``.  The target is the
+Run as ``python benchmarks/bench_report.py``.  The target is the
 issue's: ``--quick`` under 5 minutes on 2 cores (Couette and 3D sections included once available).
 """
 

@@ -1,6 +1,6 @@
 """Speed of the JAX HCS solver: cell-steps per second on a 64³ RET box (model.md §9).
 
-Run:  PYTHONPATH=src /work/venv/bin/python benchmarks/bench_solver.py [--cells 64] [--steps 10] [--precision float64]
+Run:  python benchmarks/bench_solver.py [--cells 64] [--steps 10] [--precision float64]
 
 Prints the compile (jit) time separately from the stepping rate, and the ratio of the rate
 to a memory-bandwidth bound measured in the same run: one NumPy copy of the conservative

@@ -92,7 +92,7 @@ def test_run_config_dataset_contents(tmp_path):
     np.testing.assert_allclose(ds["theta"].values, ds["theta"].values[::-1], rtol=1e-8)
     # inventory is kept
     y, phi = ds["y"].values, ds["phi"].values
-    assert np.trapezoid(phi, y) / (y[-1] - y[0]) == pytest.approx(0.5, abs=1e-4)
+    assert np.trapezoid(phi, y) / (y[-1] - y[0]) == pytest.approx(cfg.mean_solid_fraction, abs=1e-4)
     out = tmp_path / "c.nc"
     ds.to_netcdf(out)
     back = xr.load_dataset(out)

@@ -36,7 +36,7 @@ def test_map_structure_and_metadata(in_process):
     assert ds["L_perp"].dims == ("model", "phi", "e")
     assert ds.sizes == {"model": 4, "phi": PHI.size, "e": E.size}
     assert list(ds["model"].values) == list(PAPER_MODELS)
-    assert ds["L_par"].attrs["units"] == "d"
+    assert ds["L_par"].attrs["units"] == "1" and "particle diameters" in ds["L_par"].attrs["long_name"]  # CF: "d" is a day
     assert ds.attrs["ktgf_version"]
     params = json.loads(ds.attrs["parameters"])
     assert params["phi"]["n"] == PHI.size and params["models"] == list(PAPER_MODELS)

@@ -48,15 +48,34 @@ def run_metadata(model: Any = None, **parameters: Any) -> dict[str, str]:
     return attrs
 
 
+#: The netCDF backend of every file ktgf writes and reads: netCDF4/HDF5 through h5py (a dependency),
+#: chosen explicitly so that xarray never falls back silently to netCDF3 through SciPy.
+NETCDF_ENGINE = "h5netcdf"
+#: Metadata convention of every file (CF 1.8: ``units`` are UDUNITS strings, ``"1"`` for ratios).
+CONVENTIONS = "CF-1.8"
+
+
 def write_netcdf(ds: Any, path: str | Path) -> Path:
-    """Write an xarray Dataset to ``path`` (parent folders created), raising a clear error if unwritable."""
+    """Write an xarray Dataset to ``path`` as netCDF4 (:data:`NETCDF_ENGINE`) with CF ``Conventions``.
+
+    Parent folders are created; an unwritable path raises :class:`InputError` in one line.
+    """
     path = Path(path)
+    ds = ds.copy(deep=False)
+    ds.attrs = {"Conventions": CONVENTIONS, **ds.attrs}
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        ds.to_netcdf(path)
+        ds.to_netcdf(path, engine=NETCDF_ENGINE, invalid_netcdf=False)
     except (PermissionError, OSError) as exc:
         raise InputError(f"cannot write output file {str(path)!r}: {exc.strerror or exc}") from exc
     return path
+
+
+def open_netcdf(path: str | Path) -> Any:
+    """Open a netCDF file written by :func:`write_netcdf` (lazily; use as a context manager)."""
+    import xarray as xr
+
+    return xr.open_dataset(path, engine=NETCDF_ENGINE)
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:

@@ -16,8 +16,9 @@ app = typer.Typer(
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     add_completion=False,
+    rich_markup_mode=None,  # help texts are plain: "[m]", "[s]" are units, not Rich markup tags
 )
-plot_app = typer.Typer(help="Figures (PNG/PDF/SVG by file extension).", no_args_is_help=True)
+plot_app = typer.Typer(help="Figures (PNG/PDF/SVG by file extension).", no_args_is_help=True, rich_markup_mode=None)
 app.add_typer(plot_app, name="plot")
 
 COMMAND_MODULES = ("closures", "shear", "hcs", "couette", "solver", "report", "calibrate")

@@ -45,24 +45,58 @@ def handle_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
     return wrapper
 
 
-def parse_values(text: str, name: str) -> np.ndarray:
-    """Parse ``"0.3"``, ``"0.1,0.2,0.3"`` or a range ``"start:stop:num"`` (inclusive, like linspace)."""
+#: Help of every ``--model`` option (comma-separated registry names; default: the paper's four models).
+MODEL_HELP = ("Model name(s) from `ktgf models`, comma-separated (default: the paper's four models, "
+              "or only the --model-file model when that is given).")
+#: Help of every ``--dask`` option (the one name for running on a Dask cluster).
+DASK_HELP = "Address of a Dask distributed scheduler to run on (e.g. tcp://host:8786)."
+
+
+def deprecated_alias(value: Any, old_value: Any, old: str, new: str) -> Any:
+    """The value of option ``new``, or of its hidden deprecated name ``old`` (with a warning on stderr)."""
     from ..errors import InputError
 
+    if old_value is None:
+        return value
+    if value is not None:
+        raise InputError(f"{old} is the deprecated name of {new}: give only {new}")
+    typer.echo(f"Warning: {old} is deprecated, use {new}.", err=True)
+    return old_value
+
+
+#: How every list-valued option is written (one sentence for all help texts).
+VALUES_HELP = "a value, a list a,b,c, a linear range start:stop:num or a log range log:start:stop:num"
+
+
+def parse_values(text: str, name: str) -> np.ndarray:
+    """Parse ``"0.3"``, ``"0.1,0.2,0.3"``, ``"start:stop:num"`` (linspace) or ``"log:start:stop:num"`` (geomspace).
+
+    Both ranges include their ends; a log range needs start, stop > 0.  Anything else raises
+    :class:`~ktgf.errors.InputError` naming the option.
+    """
+    from ..errors import InputError
+
+    text = text.strip()
     try:
         if ":" in text:
-            parts = text.split(":")
+            parts = [p.strip() for p in text.split(":")]
+            log = parts[0].lower() == "log"
+            if log:
+                parts = parts[1:]
             if len(parts) != 3:
                 raise ValueError
             start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
             if num < 1:
                 raise ValueError
-            return np.linspace(start, stop, num)
-        return np.array([float(v) for v in text.split(",") if v.strip()], dtype=float)
+        else:
+            return np.array([float(v) for v in text.split(",") if v.strip()], dtype=float)
     except ValueError:
-        raise InputError(
-            f"--{name} {text!r} is not a number, a comma-separated list or a range start:stop:num"
-        ) from None
+        raise InputError(f"--{name} {text!r} is not {VALUES_HELP}") from None
+    if not log:
+        return np.linspace(start, stop, num)
+    if start <= 0 or stop <= 0:
+        raise InputError(f"--{name} {text!r}: a log range needs start > 0 and stop > 0")
+    return np.geomspace(start, stop, num)
 
 
 def emit(rows: Sequence[dict[str, Any]], fmt: OutputFormat, title: str = "") -> None:
@@ -86,13 +120,19 @@ def emit(rows: Sequence[dict[str, Any]], fmt: OutputFormat, title: str = "") -> 
         return
     from rich.console import Console
     from rich.table import Table
+    from rich.text import Text
 
-    table = Table(title=title or None)
+    # Text objects, not strings: Rich would read "[s]" or "[kg/(m s)]" in a header as markup and drop it.
+    table = Table(title=Text(title) if title else None)
     for k in keys:
-        table.add_column(k, justify="right")
+        numeric = all(isinstance(r[k], (int, float)) and not isinstance(r[k], bool) for r in rows)
+        # wide enough for the longest word (a name such as "carnahan-starling()" is not split), fold beyond
+        word = max((len(w) for r in rows for w in str(r[k]).split()), default=1) if not numeric else None
+        table.add_column(Text(k), justify="right" if numeric else "left", overflow="fold", min_width=min(word, 40) if word else None)
     for r in rows:
-        table.add_row(*(f"{v:.6g}" if isinstance(v, float) else str(v) for v in r.values()))
-    Console(width=max(120, 14 * len(keys))).print(table)
+        table.add_row(*(Text(f"{v:.6g}" if isinstance(v, float) else str(v)) for v in r.values()))
+    need = sum(max(c.min_width or 0, 12) + 3 for c in table.columns) + 1  # never crop a column
+    Console(width=max(120, need)).print(table)
 
 
 MODEL_FILE_HELP = "Model file (TOML) written by `ktgf calibrate`: a registered model with changed options."
@@ -104,10 +144,15 @@ def model_file_option() -> Any:
 
 
 def resolve_models(names: str | None, model_file: Any = None, *, option: str = "--model") -> list[Any]:
-    """Models named by ``--model`` (comma-separated) followed by the one of ``--model-file``; at least one."""
-    from ..closures import get_model
+    """Models named by ``--model`` (comma-separated) followed by the one of ``--model-file``.
+
+    Neither given: the paper's four models.  Only ``--model-file``: just its model.
+    """
+    from ..closures import PAPER_MODELS, get_model
     from ..errors import InputError
 
+    if names is None and model_file is None:
+        names = ",".join(PAPER_MODELS)
     models = [get_model(n.strip()) for n in (names or "").split(",") if n.strip()]
     if model_file is not None:
         from ..calibration.model_file import load_model_file

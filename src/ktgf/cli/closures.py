@@ -8,7 +8,7 @@ import numpy as np
 import typer
 
 from ..closures import list_models
-from ._common import OutputFormat, emit, handle_errors, model_file_option, parse_values, resolve_models
+from ._common import MODEL_HELP, VALUES_HELP, OutputFormat, emit, handle_errors, model_file_option, parse_values, resolve_models
 
 REDUCED_NAMES = {
     "p": "p*", "eta": "eta*", "lambda_b": "lambda_b*", "kappa": "kappa*", "mu": "mu*",
@@ -64,32 +64,29 @@ def models(
 
 @handle_errors
 def coefficients(
-    model: str = typer.Option(None, "--model", "-m", help="Model name (see `ktgf models`)."),
+    model: str = typer.Option(None, "--model", "--models", "-m", help=MODEL_HELP),
     model_file: Path = model_file_option(),
-    phi: str = typer.Option(..., "--phi", help="Solid fraction: value, list a,b,c or range start:stop:num."),
+    phi: str = typer.Option(..., "--phi", help="Solid fraction: " + VALUES_HELP + "."),
     e: str = typer.Option(..., "--e", help="Restitution coefficient(s), 0 < e <= 1."),
     theta: float = typer.Option(1e-2, "--theta", help="Granular temperature theta [m^2/s^2] for SI values."),
     d: float = typer.Option(1e-3, "--d", help="Particle diameter [m]."),
     rho_s: float = typer.Option(1500.0, "--rho-s", help="Material density [kg/m^3]."),
-    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
+    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
-    """Reduced and SI transport coefficients of one model at states (phi, e)."""
-    if model is not None and model_file is not None:
-        from ..errors import InputError
-
-        raise InputError("give one of --model NAME or --model-file FILE, not both")
-    (m,) = resolve_models(model, model_file)
+    """Reduced and SI transport coefficients of the models at states (phi, e)."""
+    ms = resolve_models(model, model_file)
     phis, es = np.meshgrid(parse_values(phi, "phi"), parse_values(e, "e"), indexing="ij")
     phis, es = phis.ravel(), es.ravel()
-    red = m.reduced(phis, es)
-    si = m.coefficients(phis, es, theta, d=d, rho_s=rho_s)
     rows = []
-    for i in range(phis.size):
-        row: dict[str, float | str] = {"phi": float(phis[i]), "e": float(es[i])}
-        row.update({label: float(np.broadcast_to(getattr(red, k), phis.shape)[i]) for k, label in REDUCED_NAMES.items()})
-        row.update({label: float(np.broadcast_to(getattr(si, k), phis.shape)[i]) for k, label in SI_NAMES.items()})
-        rows.append(row)
-    emit(rows, fmt, title=f"{m.label}: theta={theta:g} m^2/s^2, d={d:g} m, rho_s={rho_s:g} kg/m^3")
+    for m in ms:
+        red = m.reduced(phis, es)
+        si = m.coefficients(phis, es, theta, d=d, rho_s=rho_s)
+        for i in range(phis.size):
+            row: dict[str, float | str] = {"model": m.name, "phi": float(phis[i]), "e": float(es[i])}
+            row.update({label: float(np.broadcast_to(getattr(red, k), phis.shape)[i]) for k, label in REDUCED_NAMES.items()})
+            row.update({label: float(np.broadcast_to(getattr(si, k), phis.shape)[i]) for k, label in SI_NAMES.items()})
+            rows.append(row)
+    emit(rows, fmt, title=f"{', '.join(m.label for m in ms)}: theta={theta:g} m^2/s^2, d={d:g} m, rho_s={rho_s:g} kg/m^3")
 
 
 @handle_errors
@@ -97,7 +94,7 @@ def plot_coefficients(
     e: float = typer.Option(0.9, "--e", help="Restitution coefficient."),
     out: Path = typer.Option(Path("coefficients.png"), "--out", "-o", help="Output figure file."),
     phi_max: float = typer.Option(0.6, "--phi-max", help="Largest solid fraction plotted."),
-    models: str = typer.Option("enskog,ret,visc-div,proposed", "--models", help="Comma-separated model names."),
+    models: str = typer.Option(None, "--model", "--models", "-m", help=MODEL_HELP),
     model_file: Path = model_file_option(),
 ) -> None:
     """Reduced p*, eta*, kappa*, mu*, zeta0* vs phi for several models on one figure."""

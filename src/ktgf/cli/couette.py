@@ -7,7 +7,7 @@ from typing import Any
 
 import typer
 
-from ._common import OutputFormat, emit, handle_errors, model_file_option, parse_values
+from ._common import DASK_HELP, MODEL_HELP, VALUES_HELP, OutputFormat, emit, handle_errors, model_file_option, parse_values
 
 
 def _default_dem() -> Path:
@@ -40,7 +40,7 @@ def run_cmd(
     config: Path = typer.Argument(..., help="TOML config (see examples/couette_planar.toml)."),
     out: Path = typer.Option(None, "--out", "-o", help="Output netCDF (default: output.path of the config)."),
     model_file: Path = model_file_option(),
-    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
+    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Solve one Couette cell described by a validated TOML config and write the profiles to netCDF.
 
@@ -68,10 +68,10 @@ def compare_cmd(
     config: Path = typer.Argument(None, help="TOML config run for all models (default: the DEM file's case with calibrated walls)."),
     dem: Path = typer.Option(DEFAULT_DEM, "--dem", help="DEM Couette CSV; its header gives the case (e, mean phi, gap, wall speed)."),
     out: Path = typer.Option(Path("couette_compare.png"), "--out", "-o", help="Figure file."),
-    models: str = typer.Option("enskog,ret,visc-div,proposed", "--models", help="Comma-separated model names ('' for none)."),
+    models: str = typer.Option(None, "--model", "--models", "-m", help=MODEL_HELP),
     model_file: Path = model_file_option(),
     n_cells: int = typer.Option(200, "--cells", help="Grid cells across the gap (DEM case)."),
-    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
+    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Models on one figure (u/U, phi, sqrt(theta)/U vs y/d) with DEM points, profile errors and wall stresses against the DEM."""
     from ..couette.compare import compare_with_dem, load_dem_couette
@@ -159,13 +159,13 @@ def _sweep_task(task: tuple[dict[str, Any], float, float]) -> dict[str, Any]:
 @handle_errors
 def sweep_cmd(
     config: Path = typer.Argument(..., help="TOML config of the base case."),
-    specularity: str = typer.Option("0.001,0.01,0.1,1", "--specularity", help="phi' values: list or start:stop:num."),
-    wall_restitution: str = typer.Option("0.9", "--wall-restitution", help="e_w values: list or start:stop:num."),
+    specularity: str = typer.Option("0.001,0.01,0.1,1", "--specularity", help="Specularity coefficients phi': " + VALUES_HELP + "."),
+    wall_restitution: str = typer.Option("0.9", "--wall-restitution", help="Wall restitution coefficients e_w: " + VALUES_HELP + "."),
     workers: int = typer.Option(0, "--workers", help="Processes (0: in-process)."),
-    dask: str = typer.Option("", "--dask", help="Address of a Dask scheduler to run the sweep on."),
+    dask: str = typer.Option(None, "--dask", help=DASK_HELP),
     out: Path = typer.Option(None, "--out", "-o", help="Optional figure of the slip vs phi'."),
     model_file: Path = model_file_option(),
-    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
+    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Sweep the specularity phi' and the wall restitution e_w (the calibration knobs) through an executor.
 

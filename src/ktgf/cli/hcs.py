@@ -13,7 +13,8 @@ import typer
 from ..closures import PAPER_MODELS, get_model
 from ..errors import InputError
 from ..validation import check_positive, check_range
-from ._common import OutputFormat, emit, handle_errors, model_file_option, parse_values, resolve_models
+from ._common import (DASK_HELP, MODEL_HELP, VALUES_HELP, OutputFormat, deprecated_alias, emit, handle_errors,
+                      model_file_option, parse_values, resolve_models)
 
 hcs_app = typer.Typer(help="Homogeneous cooling state: Haff's law, linear stability, critical box sizes.",
                       no_args_is_help=True)
@@ -42,7 +43,7 @@ def _kind_of_output(out: Path, allowed: tuple[str, ...]) -> str:
 
 @handle_errors
 def haff(
-    model: str = typer.Option(DEFAULT_MODELS, "--model", "-m", help="Model name(s), comma-separated."),
+    model: str = typer.Option(None, "--model", "--models", "-m", help=MODEL_HELP),
     model_file: Path = model_file_option(),
     phi: float = typer.Option(..., "--phi", help="Solid fraction, 0 < phi < packing limit."),
     e: float = typer.Option(..., "--e", help="Restitution coefficient, 0 < e <= 1."),
@@ -51,7 +52,7 @@ def haff(
     t_end: float = typer.Option(None, "--t-end", help="End time [s] (default 10 x the longest Haff time)."),
     n: int = typer.Option(200, "--n", help="Number of output times."),
     out: Path = typer.Option(None, "--out", "-o", help="Write the histories: .nc (netCDF) or a figure (.png/.pdf/.svg)."),
-    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
+    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Haff's law theta(t) = theta0/(1 + t/t0)^2 against the integrated ODE; cooling time t0 per model."""
     from ..hcs.haff import haff_history
@@ -90,13 +91,13 @@ def haff(
 
 @handle_errors
 def stability(
-    model: str = typer.Option(None, "--model", "-m", help="Model name(s) (see `ktgf models`), comma-separated."),
+    model: str = typer.Option(None, "--model", "--models", "-m", help=MODEL_HELP),
     model_file: Path = model_file_option(),
-    phi: str = typer.Option(..., "--phi", help="Solid fraction(s): value, list a,b,c or range start:stop:num."),
+    phi: str = typer.Option(..., "--phi", help="Solid fraction(s): " + VALUES_HELP + "."),
     e: str = typer.Option(..., "--e", help="Restitution coefficient(s), 0 < e <= 1."),
     box: float = typer.Option(None, "--box", help="Side L/d of a periodic cube: growth rates at its lowest mode 2 pi/L."),
     method: str = typer.Option("closed", "--method", help="closed (closed form) or eig (root-finding on the eigenvalues)."),
-    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
+    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Critical wavenumbers k_perp*, k_par* and box sizes L_perp/d, L_par/d (and growth rates in a box)."""
     from ..hcs.critical import NoCrossingWarning, critical_wavenumbers_eig
@@ -156,7 +157,7 @@ def _verdict(s_perp: float, s_par: float) -> str:
 @handle_errors
 def map_cmd(
     out: Path = typer.Option(..., "--out", "-o", help="Output netCDF file (.nc)."),
-    model: str = typer.Option(DEFAULT_MODELS, "--model", "-m", help="Model names, comma-separated."),
+    model: str = typer.Option(None, "--model", "--models", "-m", help=MODEL_HELP),
     model_file: Path = model_file_option(),
     n_phi: int = typer.Option(200, "--n-phi", help="Number of solid fractions."),
     n_e: int = typer.Option(100, "--n-e", help="Number of restitution coefficients."),
@@ -165,7 +166,8 @@ def map_cmd(
     e_min: float = typer.Option(0.5, "--e-min", help="Smallest restitution coefficient (> 0)."),
     e_max: float = typer.Option(0.99, "--e-max", help="Largest restitution coefficient (<= 1)."),
     workers: int = typer.Option(0, "--workers", help="Run on a local process pool of this size (0: in-process)."),
-    scheduler: str = typer.Option(None, "--scheduler", help="Address of a Dask distributed scheduler to run on."),
+    dask: str = typer.Option(None, "--dask", help=DASK_HELP),
+    scheduler: str = typer.Option(None, "--scheduler", hidden=True, help="Deprecated name of --dask."),
 ) -> None:
     """Stability map L_perp/d, L_par/d over (model, phi, e), written to netCDF with full metadata."""
     from ..hcs.stability_map import stability_map
@@ -186,7 +188,8 @@ def map_cmd(
     start = time.perf_counter()
     from ..sweep import open_executor
 
-    with open_executor(workers, scheduler) as executor, DelayedProgress("stability map") as bar:
+    dask = deprecated_alias(dask, scheduler, "--scheduler", "--dask")
+    with open_executor(workers, dask) as executor, DelayedProgress("stability map") as bar:
         ds = stability_map(models, phi, e, executor=executor, progress=bar)
     path = write_netcdf(ds, out)
     typer.echo(f"wrote {path}: {len(models)} models x {n_phi} phi x {n_e} e in {time.perf_counter() - start:.2f} s")
@@ -196,7 +199,7 @@ def map_cmd(
 def plot_stability_map_cmd(
     out: Path = typer.Option(Path("stability_map.png"), "--out", "-o", help="Output figure (.png/.pdf/.svg)."),
     e: str = typer.Option("0.9,0.7", "--e", help="Restitution coefficients, one panel each."),
-    model: str = typer.Option(DEFAULT_MODELS, "--model", "-m", help="Model names, comma-separated."),
+    model: str = typer.Option(None, "--model", "--models", "-m", help=MODEL_HELP),
     model_file: Path = model_file_option(),
     phi_min: float = typer.Option(0.01, "--phi-min", help="Smallest solid fraction (> 0)."),
     phi_max: float = typer.Option(0.6, "--phi-max", help="Largest solid fraction (< 1)."),

@@ -1,7 +1,7 @@
 """Revised Enskog theory (RET) for inelastic hard spheres — Garzó & Dufty (1999).
 
 Garzó & Dufty, Phys. Rev. E 59, 5895 (1999), 3D, first Sonine approximation, as restated in
-``shared/theory/model.md`` §3 (equation labels below refer to that section).  All functions
+``docs/model.md`` §3 (equation labels below refer to that section).  All functions
 are pure and vectorised over ``phi``, ``e`` and the RDF values; they run on NumPy and JAX
 arrays.
 

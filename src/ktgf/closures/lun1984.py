@@ -1,6 +1,6 @@
 """Enskog kinetic theory of Lun, Savage, Jeffrey & Chepurniy (1984) in reduced form.
 
-Lun et al., J. Fluid Mech. 140, 223 (1984), as restated in ``shared/theory/model.md`` §4,
+Lun et al., J. Fluid Mech. 140, 223 (1984), as restated in ``docs/model.md`` §4,
 divided by the reference scales of §1 (η0, κ0, ν0).  With η_L = (1 + e)/2:
 
     p*   = 1 + 4η_L φχ

@@ -8,7 +8,7 @@ does, at the public boundary.
 
 Glossary: ``phi`` solid volume fraction φ, ``phi_f`` freezing point φ_f,
 ``phi_c`` random-close-packing (divergence) point φ_c, ``beta`` divergence exponent β.
-Formulas: ``shared/theory/model.md`` §2.  The piecewise RDFs join their branches at φ_f with a
+Formulas: ``docs/model.md`` §2.  The piecewise RDFs join their branches at φ_f with a
 C¹ bridge by default (``junction="c1"``; ``junction="c0"`` is the plain switch of model.md §2;
 see :mod:`ktgf.closures.junction`).  Options are validated when an RDF is made
 (:mod:`ktgf.closures.options`).

@@ -1,7 +1,7 @@
 """Viscosity laws applied on top of a theory: none, or the Bocquet et al. divergence.
 
 Bocquet, Losert, Schalk, Lubensky & Gollub, Phys. Rev. E 65, 011307 (2001); used as a
-closure by Abrahamsson et al. (2014).  Reconstructed in ``shared/theory/model.md`` §5:
+closure by Abrahamsson et al. (2014).  Reconstructed in ``docs/model.md`` §5:
 
     η_vd = η(φ, θ) · ((φ_c − φ_f)/(φ_c − φ))^(β − 1)   for φ > φ_f,   η otherwise
 

@@ -125,7 +125,8 @@ def haff_history(
     zeta = np.array([float(cooling_rate(m, phi, e, theta0, d=d)) for m in models])
     t0 = np.array([float(cooling_time(m, phi, e, theta0, d=d)) for m in models])
     if t_end is None:
-        t_end = 10.0 * float(np.max(t0[np.isfinite(t0)], initial=1.0))
+        finite = t0[np.isfinite(t0)]
+        t_end = 10.0 * float(np.max(finite)) if finite.size else 10.0  # 10 × the longest Haff time
     check_positive("end time t_end", t_end, "s")
     check_range("number of output times n", n, low=2)
     t = np.concatenate([[0.0], np.geomspace(1e-3 * t_end, t_end, n - 1)])

@@ -23,8 +23,8 @@ from .stability import critical_box_size, critical_wavenumbers
 VARIABLES = {
     "k_perp": {"long_name": "critical reduced wavenumber of the transverse (vortex) mode, k_perp* = k ell", "units": "1"},
     "k_par": {"long_name": "critical reduced wavenumber of the longitudinal (cluster) mode, k_par* = k ell", "units": "1"},
-    "L_perp": {"long_name": "critical side of a periodic cube for vortices, L_perp/d", "units": "d"},
-    "L_par": {"long_name": "critical side of a periodic cube for clusters, L_par/d", "units": "d"},
+    "L_perp": {"long_name": "critical side of a periodic cube for vortices, L_perp/d, in particle diameters", "units": "1"},
+    "L_par": {"long_name": "critical side of a periodic cube for clusters, L_par/d, in particle diameters", "units": "1"},
 }
 
 

@@ -22,15 +22,19 @@ def plot_reduced_coefficients(
     """
     import matplotlib.pyplot as plt
 
+    from .hcs import LINESTYLES, MODEL_COLOURS
+
     fig, axes = plt.subplots(2, 3, figsize=(13, 7.5), constrained_layout=True)
-    for m in models:
+    for i, m in enumerate(models):
         top = min(phi_max, 0.995 * m.phi_max)
         phi = np.linspace(1e-3, top, n)
         r = m.reduced(phi, e)
+        # colour and dash per model: curves that coincide (below φ_f) stay visible under each other
+        style = {"color": MODEL_COLOURS[i % len(MODEL_COLOURS)], "ls": LINESTYLES[i % len(LINESTYLES)], "label": m.label or m.name}
         for ax, (key, label) in zip(axes.flat, PANELS):
-            ax.semilogy(phi, np.broadcast_to(getattr(r, key), phi.shape), label=m.label or m.name)
+            ax.semilogy(phi, np.broadcast_to(getattr(r, key), phi.shape), **style)
             ax.set_ylabel(label)
-        axes.flat[5].semilogy(phi, m.chi(phi), label=m.label or m.name)
+        axes.flat[5].semilogy(phi, m.chi(phi), **style)
     axes.flat[5].set_ylabel(r"$\chi = g_0(\phi)$")
     # μ* = 0 for Lun-based models by default (no ∇φ heat flux): say so rather than leave a blank.
     zero_mu = [m.label or m.name for m in models if not np.any(np.asarray(m.reduced(0.3, e).mu))]

@@ -12,6 +12,8 @@ from . import save
 
 #: Same colour for a model in every figure (paper order: Enskog, RET, Visc.div., Proposed).
 MODEL_COLOURS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000")
+#: Dash per model, so that models whose curves coincide remain visible on top of each other.
+LINESTYLES = ("-", "--", "-.", ":")
 
 
 def _style() -> dict[str, Any]:
@@ -27,12 +29,14 @@ def plot_haff(ds: Any, out: str | Path) -> Path:
         t = ds["t"].values
         theta0 = ds["theta_haff"].values[:, 0]
         every = max(1, t.size // 20)
+        reduced = ds["t"].attrs.get("units") == "1"  # d = θ0 = 1: time in units of d/√θ0
+        t_unit = r"$d/\sqrt{\theta_0}$" if reduced else "s"
         for i, name in enumerate(ds["model"].values):
             c = MODEL_COLOURS[i % len(MODEL_COLOURS)]
-            label = f"{ds['model_label'].values[i]} ($t_0$ = {float(ds['t0'].values[i]):.3g} s)"
-            ax.loglog(t[1:], ds["theta_haff"].values[i, 1:] / theta0[i], color=c, label=label)
+            label = f"{ds['model_label'].values[i]} ($t_0$ = {float(ds['t0'].values[i]):.3g} {t_unit})"
+            ax.loglog(t[1:], ds["theta_haff"].values[i, 1:] / theta0[i], LINESTYLES[i % len(LINESTYLES)], color=c, label=label)
             ax.loglog(t[1::every], ds["theta_numeric"].values[i, 1::every] / theta0[i], "o", color=c, ms=3, mfc="none")
-        ax.set_xlabel("time $t$ [s]")
+        ax.set_xlabel(r"time $t\sqrt{\theta_0}/d$" if reduced else "time $t$ [s]")
         ax.set_ylabel(r"$\theta/\theta_0$")
         ax.plot([], [], "k-", label="Haff's law")
         ax.plot([], [], "ko", ms=3, mfc="none", label=r"$d\theta/dt=-\zeta_0(\theta)\theta$ (numerical)")

@@ -65,6 +65,17 @@ class Report:
         return [r for r in self.results if r.status == "failed"]
 
 
+def empty_data_note(data_dir: Path | None, note: str) -> str:
+    """The data note, replaced by a warning when the folder holds none of the DEM files the sections read."""
+    if data_dir is None:
+        return note
+    wanted = sorted({f for s in sections() for f in s.data_files})
+    if wanted and not any((data_dir / f).is_file() for f in wanted):
+        return (f"WARNING: the DEM data folder {data_dir} holds none of the reference files ({', '.join(wanted)}): "
+                "comparisons with particle simulations are left out")
+    return note
+
+
 def build_report(settings: ReportSettings, *, progress: Progress | None = None, argv: list[str] | None = None) -> Report:
     """Build (or complete) the report described by ``settings`` in ``settings.out``.
 
@@ -75,6 +86,7 @@ def build_report(settings: ReportSettings, *, progress: Progress | None = None, 
     """
     out = prepare_out_dir(settings.out)
     data_dir, data_note = locate_data_dir(settings.data_dir)
+    data_note = empty_data_note(data_dir, data_note)
     tell = progress or (lambda *a: None)
     results: list[SectionResult] = []
     finished: list[str] = []

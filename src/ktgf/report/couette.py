@@ -37,6 +37,7 @@ from ..closures.models import get_model
 from ..io import run_metadata
 from .dem import COUETTE, read_table
 from .framework import Section, SectionContext, closest, join_labels, model_inputs, optional_entry, register_section
+from .overlap import overlap_sentence
 from .settings import ReportSettings
 
 #: module, function: the agreed entry point of the Couette solver.
@@ -44,6 +45,16 @@ ENTRY_POINT = ("ktgf.couette", "report_profiles")
 #: DEM units: d = 1, m = 1 → ρ_s = 6/π.
 RHO_S_DEM = 6.0 / math.pi
 
+
+#: Error metrics of the profile table: key of :func:`profile_errors` -> (column title, factor shown).
+#: Further columns (e.g. wall stresses against the DEM) are added by extending this mapping.
+ERROR_COLUMNS = {
+    "u_rms_over_U": ("RMS(u−u_DEM)/U", 1.0),
+    "phi_rms": ("RMS(φ−φ_DEM)", 1.0),
+    "theta_rms_rel": ("RMS(θ/θ_DEM−1) %", 100.0),
+}
+LONG_NAMES = {"u": "mean velocity along the walls in DEM units", "phi": "solid fraction",
+              "theta": "granular temperature per unit mass in DEM units"}
 
 _entry, available = optional_entry(*ENTRY_POINT, "the Couette solver", "(model, *, phi_mean, e, height, wall_speed, d, rho_s, n_cells)")
 
@@ -85,29 +96,38 @@ def profile_errors(y: np.ndarray, prof: dict[str, np.ndarray], dem: dict[str, np
 
 
 def plot_profiles(ds: xr.Dataset, out: Any) -> Any:
-    """u, φ and θ across the gap, one line per model, DEM points with error bars."""
+    """u/U, φ and θ/U² across the gap, one line per model, DEM points with error bars."""
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
 
     from ..plotting import save
-    from ..plotting.hcs import MODEL_COLOURS
+    from ..plotting.hcs import LINESTYLES, MODEL_COLOURS
 
+    U = float(ds["wall_speed"])
+    scale = {"u": U, "phi": 1.0, "theta": U**2}
+    labels = {"u": "velocity $u/U$", "phi": r"solid fraction $\phi$", "theta": r"temperature $\theta/U^2$ (log)"}
     fig, axes = plt.subplots(1, 3, figsize=(14, 4.4), constrained_layout=True)
-    for ax, var, lab in zip(axes, ("u", "phi", "theta"), ("velocity $u$", r"solid fraction $\phi$", r"temperature $\theta$")):
+    for ax, var in zip(axes, ("u", "phi", "theta")):
         for i in range(ds.sizes["model"]):
-            ax.plot(ds[var][i], ds.y, color=MODEL_COLOURS[i % len(MODEL_COLOURS)], label=str(ds.label[i].values))
+            ax.plot(ds[var][i] / scale[var], ds.y, LINESTYLES[i % len(LINESTYLES)], color=MODEL_COLOURS[i % len(MODEL_COLOURS)],
+                    label=str(ds.label[i].values))
         if f"{var}_dem" in ds:
             occupied = ds.phi_dem.values > 0.05  # bins inside the wall layers hold no flowing particles
-            ax.errorbar(ds[f"{var}_dem"].values[occupied], ds.y_dem.values[occupied], xerr=ds[f"{var}_dem_sem"].values[occupied],
-                        fmt="k.", ms=4, label="DEM")
-        ax.set_xlabel(lab)
+            ax.errorbar(ds[f"{var}_dem"].values[occupied] / scale[var], ds.y_dem.values[occupied],
+                        xerr=ds[f"{var}_dem_sem"].values[occupied] / scale[var], fmt="k.", ms=4, label="DEM")
+        ax.set_xlabel(labels[var])
         ax.set_ylabel("y / d")
-        ax.grid(True, alpha=0.3)
-    axes[2].set_xscale("log")
-    from matplotlib.ticker import NullFormatter
-
-    axes[2].xaxis.set_minor_formatter(NullFormatter())  # minor labels of a one-decade log axis overlap
+        ax.grid(True, which="both", alpha=0.3)
+    ax = axes[2]
+    ax.set_xscale("log")
+    # θ spans about one decade: label 1-2-5 steps so that the axis shows several readable numbers
+    ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    fmt = ScalarFormatter()
+    fmt.set_scientific(False)
+    ax.xaxis.set_major_formatter(fmt)
+    ax.xaxis.set_minor_formatter(NullFormatter())
     axes[0].legend(fontsize=8)
-    fig.suptitle("Planar Couette cell: profiles across the gap")
+    fig.suptitle(f"Planar Couette cell: profiles across the gap (walls at u/U = ±1/2, U = {U:g})")
     return save(fig, out)
 
 
@@ -122,19 +142,25 @@ def run(ctx: SectionContext) -> None:
     y = np.asarray(sols[s.models[0]].y, dtype=float)
     data: dict[str, Any] = {}
     for var in ("u", "phi", "theta"):
-        data[var] = (("model", "y"), np.array([np.interp(y, np.asarray(sols[n].y), np.asarray(sols[n][var])) for n in s.models]))
-    coords: dict[str, Any] = {"model": list(s.models), "label": ("model", [get_model(n).label for n in s.models]), "y": y}
+        data[var] = (("model", "y"), np.array([np.interp(y, np.asarray(sols[n].y), np.asarray(sols[n][var])) for n in s.models]),
+                     {"long_name": LONG_NAMES[var], "units": "1"})
+    dem_units = {"units": "1"}
+    coords: dict[str, Any] = {"model": list(s.models), "label": ("model", [get_model(n).label for n in s.models]),
+                              "y": ("y", y, {"long_name": "distance from the channel centre in particle diameters", "units": "1"}),
+                              "wall_speed": ((), s.couette_wall_speed, {"long_name": "relative wall speed U in DEM units", "units": "1"})}
     if dem is not None:
         for var, col in (("u", "ux"), ("phi", "phi"), ("theta", "theta")):
-            data[f"{var}_dem"] = (("y_dem",), dem[col], {"source": COUETTE})
-            data[f"{var}_dem_sem"] = (("y_dem",), dem[f"{col}_sem"])
-        coords["y_dem"] = dem["y"]
+            data[f"{var}_dem"] = (("y_dem",), dem[col], {"source": COUETTE, "long_name": "DEM " + LONG_NAMES[var], **dem_units})
+            data[f"{var}_dem_sem"] = (("y_dem",), dem[f"{col}_sem"], {"long_name": "standard error of the DEM " + var, **dem_units})
+        coords["y_dem"] = ("y_dem", dem["y"], {"long_name": "DEM bin centre, distance from the channel centre in diameters", "units": "1"})
     ds = xr.Dataset(data, coords=coords, attrs=run_metadata(None, **{k: v for k, v in inputs(s).items() if k != "models"},
                                                             models=list(s.models), units="d = m = 1"))
     plot_profiles(ds, ctx.figure_path("couette_profiles"))
-    ctx.add_figure("couette_profiles", f"Velocity, solid fraction and temperature across the Couette cell (H = {s.couette_height:g} d, "
-                   f"U = {s.couette_wall_speed:g}, mean φ = {s.couette_phi_mean:g}, e = {s.couette_e:g})"
-                   + (f", against the DEM ({COUETTE})." if dem is not None else "."), ds)
+    overlaps = "".join(overlap_sentence({n: ds[v].sel(model=n).values for n in s.models}, f"{v} profiles")
+                       for v in ("u", "phi", "theta"))
+    ctx.add_figure("couette_profiles", f"Velocity u/U, solid fraction and temperature θ/U² across the Couette cell (H = {s.couette_height:g} d, "
+                   f"U = {s.couette_wall_speed:g}, mean φ = {s.couette_phi_mean:g}, e = {s.couette_e:g}; DEM units d = m = 1)"
+                   + (f", against the DEM ({COUETTE})." if dem is not None else ".") + overlaps, ds)
     walls = {n: sols[n].attrs.get("wall", sols[n].attrs.get("boundary_condition", "")) for n in s.models}
     if any(walls.values()):
         ctx.paragraph("Wall conditions: " + "; ".join(f"{get_model(n).label}: {w}" for n, w in walls.items() if w) + ".")
@@ -147,14 +173,20 @@ def run(ctx: SectionContext) -> None:
         if dem is not None:
             errs[n] = profile_errors(np.asarray(sol.y), {k: np.asarray(sol[k]) for k in ("u", "phi", "theta")}, dem,
                                      s.couette_height, s.couette_wall_speed)
-            row += [errs[n]["u_rms_over_U"], errs[n]["phi_rms"], 100 * errs[n]["theta_rms_rel"]]
+            row += [errs[n][k] * f for k, (_, f) in ERROR_COLUMNS.items()]
         rows.append(row)
-    cols = ["model", "max φ", "physically valid"] + (["RMS(u−u_DEM)/U", "RMS(φ−φ_DEM)", "RMS(θ/θ_DEM−1) %"] if dem is not None else [])
-    ctx.table("Couette profiles: validity and error against DEM", cols, rows,
-              note="Errors over the DEM bins inside the slab |y| < H/2 − d/2. The wall condition is calibrated on this same DEM case "
-                   "(see the solver's attrs), so these errors measure the bulk closures, not a blind prediction.")
-    if errs:
+    cols = ["model", "max φ", "physically valid"]
+    if dem is not None:
+        cols += [title for title, _ in ERROR_COLUMNS.values()]
+        ctx.table("Couette profiles: validity and profile-shape error against DEM", cols, rows,
+                  note="Errors over the DEM bins inside the slab |y| < H/2 − d/2. The wall condition is calibrated on this same DEM case "
+                       "(see the solver's attrs), so these errors measure the bulk closures, not a blind prediction.")
         ctx.number("couette_errors", errs)
+    else:
+        ctx.table("Couette profiles: validity (no DEM data, so no error column)", cols, rows,
+                  note="Without the DEM file the wall condition is the solver's default (not calibrated); "
+                       "the profiles are predictions with nothing to compare them with.")
+    ctx.number("couette_max_phi", {n: float(r[1]) for n, r in zip(s.models, rows)})
 
 
 def discuss(nb: dict[str, Any]) -> list[str]:

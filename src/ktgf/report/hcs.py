@@ -25,6 +25,7 @@ from ..plotting.hcs import plot_haff, plot_stability_map
 from .dem import HCS_COOLING, read_table
 from .framework import Section, SectionContext, closest, join_labels, model_inputs, register_section
 from .hcs_plots import plot_cooling_errors, plot_dispersion
+from .overlap import overlap_sentence
 from .settings import ReportSettings
 
 #: Solid fractions of the critical-size table.
@@ -46,19 +47,36 @@ def _labels(names: tuple[str, ...]) -> list[str]:
 
 
 # -- Haff's law and DEM cooling rates ---------------------------------------------------------
+def reduced_haff(ds: xr.Dataset) -> xr.Dataset:
+    """A :func:`ktgf.hcs.haff_history` run at d = 1, θ0 = 1, relabelled in the reduced units it is in.
+
+    With d = 1 and θ0 = 1 every number is already reduced (time in d/√θ0, θ in θ0): only the
+    ``units`` attributes (``s`` and ``m2 s-2`` for SI runs) change, to ``1`` with a long name saying so.
+    """
+    ds = ds.copy()
+    ds["t"].attrs = {"long_name": "time t sqrt(theta0)/d", "units": "1"}
+    for v in ("theta_haff", "theta_numeric"):
+        ds[v].attrs = {"long_name": ds[v].attrs.get("long_name", v) + ", theta/theta0", "units": "1"}
+    ds["zeta0"].attrs = {"long_name": "cooling rate at theta0, zeta0 d/sqrt(theta0)", "units": "1"}
+    ds["t0"].attrs = {"long_name": "Haff time 2/zeta0(theta0) in units of d/sqrt(theta0)", "units": "1"}
+    return ds
+
+
 def cooling_comparison(names: tuple[str, ...], dem: dict[str, np.ndarray]) -> xr.Dataset:
     """Each model's cooling rate A = ζ0/√θ at the DEM states, and its relative error against both DEM fits."""
     a = np.array([np.asarray(cooling_rate(m, dem["phi"], dem["e"], 1.0, d=1.0), dtype=float) for m in names])
     return xr.Dataset(
         {
-            "A_model": (("model", "state"), a, {"long_name": "zeta0/sqrt(theta), d = m = 1"}),
-            "A_early": (("state",), dem["A_early"], {"long_name": "DEM fit T0 -> T0/2"}),
-            "A_main": (("state",), dem["A_main"], {"long_name": "DEM fit T0 -> T0/4"}),
-            "error_early": (("model", "state"), a / dem["A_early"] - 1.0),
-            "error_main": (("model", "state"), a / dem["A_main"] - 1.0),
-            "dem_rel_sem": (("state",), dem["A_main_sem"] / dem["A_main"]),
+            "A_model": (("model", "state"), a, {"long_name": "cooling rate zeta0/sqrt(theta) in DEM units d = m = 1", "units": "1"}),
+            "A_early": (("state",), dem["A_early"], {"long_name": "DEM cooling rate, fit T0 -> T0/2, in DEM units", "units": "1"}),
+            "A_main": (("state",), dem["A_main"], {"long_name": "DEM cooling rate, fit T0 -> T0/4, in DEM units", "units": "1"}),
+            "error_early": (("model", "state"), a / dem["A_early"] - 1.0, {"long_name": "A_model/A_early - 1", "units": "1"}),
+            "error_main": (("model", "state"), a / dem["A_main"] - 1.0, {"long_name": "A_model/A_main - 1", "units": "1"}),
+            "dem_rel_sem": (("state",), dem["A_main_sem"] / dem["A_main"], {"long_name": "relative standard error of A_main", "units": "1"}),
         },
-        coords={"model": list(names), "label": ("model", _labels(names)), "phi": ("state", dem["phi"]), "e": ("state", dem["e"])},
+        coords={"model": list(names), "label": ("model", _labels(names)),
+                "phi": ("state", dem["phi"], {"long_name": "solid fraction", "units": "1"}),
+                "e": ("state", dem["e"], {"long_name": "normal restitution coefficient", "units": "1"})},
         attrs=run_metadata(None, source=HCS_COOLING, models=list(names), comparison="A_model/A_DEM - 1, no fitted parameter"),
     )
 
@@ -76,18 +94,20 @@ def dispersion(names: tuple[str, ...], phi: float, e: float, n: int) -> xr.Datas
     eig = [critical_wavenumbers_eig(r) for r in red]
     return xr.Dataset(
         {
-            "s_perp": (("model", "kstar"), np.array([d.transverse for d in rel]), {"long_name": "transverse growth rate / nu0"}),
+            "s_perp": (("model", "kstar"), np.array([d.transverse for d in rel]), {"long_name": "transverse growth rate / nu0", "units": "1"}),
             "s_par_real": (("model", "kstar", "branch"), np.array([d.longitudinal.real for d in rel]),
-                           {"long_name": "Re longitudinal growth rates / nu0"}),
+                           {"long_name": "Re longitudinal growth rates / nu0", "units": "1"}),
             "s_par_imag": (("model", "kstar", "branch"), np.array([d.longitudinal.imag for d in rel]),
-                           {"long_name": "Im longitudinal growth rates / nu0"}),
-            "k_perp": (("model",), [float(c[0]) for c in crit], {"long_name": "closed-form critical k* (vortex)"}),
-            "k_par": (("model",), [float(c[1]) for c in crit], {"long_name": "closed-form critical k* (cluster)"}),
-            "k_perp_eigen": (("model",), [float(c[0]) for c in eig], {"long_name": "critical k* from the eigenvalues (vortex)"}),
-            "k_par_eigen": (("model",), [float(c[1]) for c in eig], {"long_name": "critical k* from the eigenvalues (cluster)"}),
+                           {"long_name": "Im longitudinal growth rates / nu0", "units": "1"}),
+            "k_perp": (("model",), [float(c[0]) for c in crit], {"long_name": "closed-form critical k* (vortex)", "units": "1"}),
+            "k_par": (("model",), [float(c[1]) for c in crit], {"long_name": "closed-form critical k* (cluster)", "units": "1"}),
+            "k_perp_eigen": (("model",), [float(c[0]) for c in eig], {"long_name": "critical k* from the eigenvalues (vortex)", "units": "1"}),
+            "k_par_eigen": (("model",), [float(c[1]) for c in eig], {"long_name": "critical k* from the eigenvalues (cluster)", "units": "1"}),
         },
-        coords={"model": list(names), "label": ("model", _labels(names)), "kstar": k, "branch": [0, 1, 2],
-                "phi": phi, "e": e},
+        coords={"model": list(names), "label": ("model", _labels(names)),
+                "kstar": ("kstar", k, {"long_name": "reduced wavenumber k ell", "units": "1"}), "branch": [0, 1, 2],
+                "phi": ((), phi, {"long_name": "solid fraction", "units": "1"}),
+                "e": ((), e, {"long_name": "normal restitution coefficient", "units": "1"})},
         attrs=run_metadata(None, models=list(names), phi=phi, e=e, points=n, equation="model.md section 8"),
     )
 
@@ -131,11 +151,12 @@ def run(ctx: SectionContext) -> None:
     )
     for phi, e in s.haff_states:
         ctx.step(f"Haff's law at φ = {phi:g}, e = {e:g}")
-        ds = haff_history(names, phi, e, 1.0, d=1.0)
+        ds = reduced_haff(haff_history(names, phi, e, 1.0, d=1.0))
         name = f"haff_phi{phi:g}_e{e:g}"
         plot_haff(ds, ctx.figure_path(name))
+        t0 = {n: float(ds.t0.sel(model=n)) for n in names}
         ctx.add_figure(name, f"Haff's law (lines) and the integrated cooling equation (markers) at φ = {phi:g}, e = {e:g}, "
-                       "in units d = 1, θ0 = 1 (time in units of d/√θ0).", ds)
+                       "in units d = 1, θ0 = 1 (time in units of d/√θ0)." + overlap_sentence(t0, "Haff time t0"), ds)
 
     if dem is not None:
         cmp = cooling_comparison(names, dem)
@@ -163,7 +184,7 @@ def run(ctx: SectionContext) -> None:
     disp = dispersion(names, s.dispersion_phi, s.dispersion_e, s.dispersion_points)
     plot_dispersion(disp, ctx.figure_path("dispersion"))
     ctx.add_figure("dispersion", f"Growth rates of perturbations of the HCS against k* = kℓ at φ = {s.dispersion_phi:g}, "
-                   f"e = {s.dispersion_e:g} (model.md §8): modes with positive rate grow.", disp)
+                   f"e = {s.dispersion_e:g} (docs/model.md §8): modes with positive rate grow.", disp)
     check = np.abs(np.concatenate([disp.k_par_eigen.values / disp.k_par.values, disp.k_perp_eigen.values / disp.k_perp.values]) - 1.0)
     ctx.number("eigen_vs_closed_form_max_rel", float(np.nanmax(check)))
     ctx.table(f"Critical wavenumbers at φ = {s.dispersion_phi:g}, e = {s.dispersion_e:g}",
@@ -176,7 +197,7 @@ def run(ctx: SectionContext) -> None:
     ctx.step("stability map")
     smap = stability_map(names, np.linspace(*s.stability_phi, s.stability_points), np.asarray(s.stability_e))
     plot_stability_map(smap, s.stability_e, ctx.figure_path("stability_map"))
-    ctx.add_figure("stability_map", "Critical sizes of a periodic cube against φ for each e and model (model.md §8, closed form). "
+    ctx.add_figure("stability_map", "Critical sizes of a periodic cube against φ for each e and model (docs/model.md §8, closed form). "
                    "A cube smaller than L⊥ stays homogeneous, between L⊥ and L∥ it grows vortices, above L∥ also clusters.", smap)
     rows = []
     for i, n in enumerate(names):

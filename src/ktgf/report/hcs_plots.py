@@ -8,9 +8,7 @@ import numpy as np
 import xarray as xr
 
 from ..plotting import save
-from ..plotting.hcs import MODEL_COLOURS
-
-LINESTYLES = ("-", "--", "-.", ":")
+from ..plotting.hcs import LINESTYLES, MODEL_COLOURS
 
 
 def _fig(nrows: int, ncols: int, w: float = 4.6, h: float = 3.6) -> tuple[Any, np.ndarray]:

@@ -21,12 +21,16 @@ from typing import Any
 from .. import __version__
 from .framework import SectionResult, TableData, _atomic_write, sections
 from .settings import ReportSettings
+from .summary import summary_html
 
 PAGE_NAME = "index.html"
+#: The page is meant to be shared: readable by everyone, like the figures beside it.
+PAGE_MODE = 0o644
 #: Marks pages written by ktgf, so that a report never overwrites someone else's index.html.
 GENERATOR = "ktgf reproduce"
 #: Sections every page has besides the registered ones (generated at page time, never cached).
-FIXED_SECTIONS = ("discussion", "rerun")
+FIXED_SECTIONS = ("summary", "discussion", "rerun")
+DISCUSSION = "5. Discussion"
 PACKAGES = ("numpy", "scipy", "xarray", "netCDF4", "h5netcdf", "matplotlib", "jax", "pydantic", "typer")
 
 _CSS = """
@@ -37,7 +41,7 @@ figure img{max-width:100%;height:auto;display:block;margin:auto}
 figcaption{font-size:.92em;color:#444;margin-top:.4em}
 table{border-collapse:collapse;margin:.8em 0;font-size:.9em}
 th,td{border:1px solid #ccc;padding:.25em .6em;text-align:right} th{background:#f3f3f3}
-td.l,th.l{text-align:left} caption{font-weight:600;text-align:left;padding:.3em 0}
+td.l,th.l{text-align:left} table.summary td b{color:#0a5} caption{font-weight:600;text-align:left;padding:.3em 0}
 .note{background:#fff7d6;border-left:4px solid #e0b000;padding:.5em .8em;margin:.6em 0}
 .na{background:#eef3fb;border-left:4px solid #5b8bd0;padding:.5em .8em;margin:.6em 0}
 .fail{background:#fde8e8;border-left:4px solid #c33;padding:.5em .8em;margin:.6em 0}
@@ -106,14 +110,16 @@ def _section(r: SectionResult) -> str:
 
 def _discussion(results: list[SectionResult]) -> str:
     by_key = {s.key: s for s in sections()}
-    parts = [f'<section id="{section_id("discussion")}"><h2>5. Discussion</h2>',
+    parts = [f'<section id="{section_id("discussion")}"><h2>{DISCUSSION}</h2>',
              "<p class=\"status\">Generated from the numbers of the sections above.</p>"]
+    sub = 0
     for r in results:
         sec = by_key.get(r.key)
         if r.status in ("computed", "cached") and sec is not None:
             sentences = sec.discuss(r.numbers)
             if sentences:
-                parts.append(f"<h3>{html.escape(r.title)}</h3>")
+                sub += 1  # numbered within the discussion (5.1, 5.2, ...), not with the section numbers again
+                parts.append(f"<h3>{DISCUSSION.split('.')[0]}.{sub} {html.escape(_unnumbered(r.title))}</h3>")
                 parts += [f"<p>{html.escape(s)}</p>" for s in sentences]
         elif r.status == "unavailable":
             parts.append(f"<p><b>{html.escape(r.title)}</b>: not available in this build, so not discussed.</p>")
@@ -121,6 +127,12 @@ def _discussion(results: list[SectionResult]) -> str:
             parts.append(f"<p><b>{html.escape(r.title)}</b>: failed in this run, so not discussed.</p>")
     parts.append("</section>")
     return "\n".join(parts)
+
+
+def _unnumbered(title: str) -> str:
+    """'2. Homogeneous cooling state' -> 'Homogeneous cooling state'."""
+    head, _, rest = title.partition(". ")
+    return rest if head.isdigit() and rest else title
 
 
 def _pkg_version(name: str) -> str:
@@ -172,9 +184,11 @@ def write_page(out: Path, results: list[SectionResult], settings: ReportSettings
                data_note: str, argv: list[str] | None = None) -> Path:
     """Write ``out/index.html`` for ``results`` and return its path."""
     now = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    data_empty = data_dir is not None and not any((data_dir / f).is_file() for s in sections() for f in s.data_files)
     kind = "quick (coarse) run" if settings.quick else "full run"
     toc = "".join(f'<li><a href="#{section_id(r.key)}">{html.escape(r.title)}</a></li>' for r in results)
-    toc += f'<li><a href="#{section_id("discussion")}">5. Discussion</a></li><li><a href="#{section_id("rerun")}">6. How to rerun</a></li>'
+    toc = f'<li><a href="#{section_id("summary")}">Summary</a></li>' + toc
+    toc += f'<li><a href="#{section_id("discussion")}">{DISCUSSION}</a></li><li><a href="#{section_id("rerun")}">6. How to rerun</a></li>'
     body = "\n".join(_section(r) for r in results)
     doc = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
@@ -183,11 +197,12 @@ def write_page(out: Path, results: list[SectionResult], settings: ReportSettings
 <body>
 <h1>Continuum models of dense inelastic granular flow: model comparison</h1>
 <p class="status">ktgf {html.escape(__version__)} · {kind} · written {now} · python {html.escape(sys.version.split()[0])}</p>
+{"" if data_dir is not None and not data_empty else f'<p class="note">{html.escape(data_note)}.</p>'}
+{summary_html(results)}
 <p>Four kinetic-theory closure models are compared: the classic Enskog/Lun et al. (1984) theory, the revised
 Enskog theory of Garzó &amp; Dufty (1999, "RET"), Lun's theory with a viscosity that diverges faster at random
 close packing ("Visc.div.", Bocquet et al. 2001) and RET with a radial distribution function derived from that
 viscosity divergence ("Proposed"). Each figure links the netCDF file with the numbers behind it.</p>
-{"" if data_dir is not None else f'<p class="note">{html.escape(data_note)}.</p>'}
 <nav><ul>{toc}</ul></nav>
 {body}
 {_discussion(results)}
@@ -196,4 +211,5 @@ viscosity divergence ("Proposed"). Each figure links the netCDF file with the nu
 """
     page = out / PAGE_NAME
     _atomic_write(page, doc)
+    page.chmod(PAGE_MODE)  # the temporary file behind the atomic write is private (0600); the page is for sharing
     return page

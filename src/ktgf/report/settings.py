@@ -8,6 +8,7 @@ cache key of the sections that use it.
 
 from __future__ import annotations
 
+import typing
 from pathlib import Path
 from typing import Any
 
@@ -55,7 +56,7 @@ class ReportSettings(BaseModel):
     couette_phi_mean: float = Field(0.5, gt=0.0, lt=0.64, description="Mean solid fraction of the Couette cell")
     couette_e: float = Field(0.9, gt=0.0, le=1.0, description="Restitution (particle-particle and particle-wall)")
     couette_height: float = Field(19.0, gt=0.0, description="Gap H [d] between the planes tangent to the wall spheres (DEM: 19)")
-    couette_wall_speed: float = Field(10.0, gt=0.0, description="Relative wall speed U [√(m/…) units of the DEM]")
+    couette_wall_speed: float = Field(10.0, gt=0.0, description="Relative wall speed U in the DEM units, d = m = 1 (the DEM run: U = 10)")
     couette_cells: int = Field(200, ge=8, le=100000, description="Grid cells across the Couette gap")
 
     # (4) 3D homogeneous cooling gas
@@ -90,6 +91,21 @@ class ReportSettings(BaseModel):
                 raise ValueError(f"restitution {v:g} is outside (0, 1]")
         return values
 
+    @field_validator("haff_states")
+    @classmethod
+    def _states(cls, states: tuple[tuple[float, float], ...]) -> tuple[tuple[float, float], ...]:
+        for phi, e in states:
+            if not 0.0 < phi < 0.64 or not 0.0 < e <= 1.0:
+                raise ValueError(f"state (φ, e) = ({phi:g}, {e:g}) needs 0 < φ < 0.64 and 0 < e <= 1")
+        return states
+
+    @field_validator("stability_phi")
+    @classmethod
+    def _phi_range(cls, r: tuple[float, float]) -> tuple[float, float]:
+        if not 0.0 < r[0] < r[1] < 1.0:
+            raise ValueError(f"φ range ({r[0]:g}, {r[1]:g}) needs 0 < low < high < 1")
+        return r
+
     @classmethod
     def preset(cls, *, quick: bool = False, **overrides: Any) -> ReportSettings:
         """The full report, or with ``quick=True`` the coarse one; ``overrides`` replace single fields.
@@ -112,6 +128,62 @@ class ReportSettings(BaseModel):
             raise InputError(
                 f"report setting {field} = {err.get('input')!r}: {err['msg']}" + (f" ({desc})" if desc else "")
             ) from None
+
+    @classmethod
+    def from_sources(cls, *, quick: bool = False, config: Path | None = None, sets: list[str] | tuple[str, ...] = (),
+                     **explicit: Any) -> ReportSettings:
+        """Settings from, in increasing priority: the preset, a TOML file, ``key=value`` overrides, explicit options.
+
+        ``config`` is a TOML file of ``setting = value`` lines (any field of this class; ``quick = true``
+        selects the quick preset); ``sets`` are ``"key=value"`` strings with TOML values (``0.5``,
+        ``[0.7, 0.9]``, ``"ret"``) or, for lists, comma-separated text (``models=ret,proposed``).
+        Raises :class:`~ktgf.errors.InputError` (one line, naming the key) for unknown keys and bad values.
+        """
+        values: dict[str, Any] = {}
+        if config is not None:
+            from ..io import read_toml
+
+            for key, v in read_toml(config).items():
+                values[cls._known(key, f"in {config}")] = v
+        for item in sets:
+            key, eq, text = item.partition("=")
+            key = key.strip()
+            if not eq or not key:
+                raise InputError(f"--set {item!r} is not key=value (e.g. --set cooling_phi=0.5)")
+            cls._known(key, "in --set")
+            value = cls._parse_value(key, text.strip())
+            if typing.get_origin(cls.model_fields[key].annotation) is tuple and not isinstance(value, list):
+                value = [value]  # one model, one restitution: a list of one
+            values[key] = value
+        quick = bool(values.pop("quick", False)) or quick
+        return cls.preset(quick=quick, **{**values, **{k: v for k, v in explicit.items() if v is not None}})
+
+    @classmethod
+    def _known(cls, key: str, where: str) -> str:
+        if key not in cls.model_fields:
+            import difflib
+
+            near = difflib.get_close_matches(key, list(cls.model_fields), n=1)
+            hint = f"; did you mean {near[0]!r}?" if near else f"; valid: {', '.join(cls.model_fields)}"
+            raise InputError(f"unknown report setting {key!r} {where}{hint}")
+        return key
+
+    @classmethod
+    def _parse_value(cls, key: str, text: str) -> Any:
+        import tomllib
+
+        try:
+            return tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            pass
+        if "," in text:  # a bare list: models=ret,proposed or stability_e=0.7,0.9
+            return [cls._parse_value(key, part.strip()) for part in text.split(",") if part.strip()]
+        return text  # a bare word (a model name, a path): pydantic validates it
+
+    @classmethod
+    def documented_keys(cls) -> list[str]:
+        """Every setting a config file or ``--set`` may name (the page's settings table lists them)."""
+        return list(cls.model_fields)
 
     def rerun_options(self) -> str:
         """The CLI options that reproduce this run."""

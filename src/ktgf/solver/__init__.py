@@ -15,9 +15,12 @@ Modules: :mod:`.grid` (periodic grid, a pytree), :mod:`.state` (variables), :mod
 PNG), :mod:`.config` (pydantic/TOML), :mod:`.run` (:class:`Simulation`).
 
 Precision
-    ``jax_enable_x64`` is switched on when this package is imported (float64 is needed for the
-    verification against linear theory); ``numerics.precision = "float32"`` runs the state in
-    single precision (≈1.6× faster on CPU).
+    Importing this package leaves JAX's global ``jax_enable_x64`` setting alone.  A run's precision
+    is part of its config: :class:`Simulation` runs inside ``jax.enable_x64(True)`` (see
+    :meth:`Simulation.precision`), with the state in ``numerics.precision`` — ``"float64"`` (the
+    default; needed for the verification against linear theory) or ``"float32"`` (≈1.6× faster
+    on CPU; the clock stays float64).  Calling the lower-level functions (:func:`advance`, ...) directly in
+    float64 needs the same context, or ``jax.config.update("jax_enable_x64", True)`` by the caller.
 
 Several devices (one host)
     ``parallel.devices = N`` shards the first grid axis over N devices with
@@ -45,15 +48,11 @@ GPU
 
 from __future__ import annotations
 
-import jax
-
-jax.config.update("jax_enable_x64", True)
-
-from .cases import report_cooling_run  # noqa: E402
-from .config import Config, load_config, parse_config  # noqa: E402
-from .grid import Grid  # noqa: E402
-from .physics import Physics  # noqa: E402
-from .run import Simulation  # noqa: E402
-from .stepping import Numerics, advance  # noqa: E402
+from .cases import report_cooling_run
+from .config import Config, load_config, parse_config
+from .grid import Grid
+from .physics import Physics
+from .run import Simulation
+from .stepping import Numerics, advance
 
 __all__ = ["Config", "Grid", "Numerics", "Physics", "Simulation", "advance", "load_config", "parse_config", "report_cooling_run"]

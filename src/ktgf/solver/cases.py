@@ -50,7 +50,8 @@ def report_cooling_run(model: Any, *, phi: float, e: float, box: float, n_cells:
     })
     sim = Simulation(cfg)
     hist = sim.run(progress=False, write_files=False)
-    W = np.asarray(primitive(sim.state))
+    with sim.precision():
+        W = np.asarray(primitive(sim.state))
     mid = n_cells // 2
     centres = (np.arange(n_cells) + 0.5) * box / n_cells
     ds = xr.Dataset(

@@ -13,6 +13,7 @@ from any checkpoint reproduces the uninterrupted run bit for bit.
 
 from __future__ import annotations
 
+import functools
 import json
 import time as _time
 from collections.abc import Callable
@@ -60,10 +61,43 @@ def box_lengths(cfg: Config) -> tuple[float, ...]:
     return per_axis(g.factor * BOX_CONSTANT / (phi0 * k), d)
 
 
+def _x64(enabled: bool) -> Any:
+    """Context in which JAX uses 64-bit types (``jax.enable_x64``; older JAX: ``jax.experimental``)."""
+    ctx = getattr(jax, "enable_x64", None)
+    if ctx is None or not callable(ctx):  # pragma: no cover - JAX < 0.5
+        from jax.experimental import enable_x64 as ctx
+    return ctx(enabled)
+
+
+def _precision(cfg: Config) -> Any:
+    # x64 mode in both cases: the clock (t, dt) is float64 even when the state is float32
+    # (numerics.precision), as the step loop of :func:`advance` expects.
+    return _x64(True)
+
+
+def _in_precision(method: Callable[..., Any]) -> Callable[..., Any]:
+    """Run a :class:`Simulation` method in the precision of its config (not the process-wide setting)."""
+
+    @functools.wraps(method)
+    def wrapper(self: Simulation, *args: Any, **kwargs: Any) -> Any:
+        with self.precision():
+            return method(self, *args, **kwargs)
+
+    return wrapper
+
+
 class Simulation:
     """An HCS run described by a config (everything validated here, before any compilation)."""
 
+    def precision(self) -> Any:
+        """Context manager of the run: JAX's x64 mode on inside it only (the state's dtype follows numerics.precision)."""
+        return _precision(self.cfg)
+
     def __init__(self, cfg: Config, directory: str | Path | None = None) -> None:
+        with _precision(cfg):  # the Haff time and output times are computed with JAX too
+            self._setup(cfg, directory)
+
+    def _setup(self, cfg: Config, directory: str | Path | None) -> None:
         self.cfg = cfg
         self.model = get_model(cfg.model.name, **cfg.model.options)
         phi_stop = cfg.numerics.phi_stop if cfg.numerics.phi_stop is not None else 0.99 * self.model.phi_max
@@ -100,6 +134,7 @@ class Simulation:
         return jax.sharding.NamedSharding(mesh, spec)
 
     # -- state -----------------------------------------------------------------------------
+    @_in_precision
     def initial_state(self) -> Any:
         """The configured HCS initial state (conservative, on the configured devices)."""
         ini = self.cfg.initial
@@ -113,6 +148,7 @@ class Simulation:
             U = conservative(*(jnp.asarray(f) for f in uniform_fields(self.grid, self.phys, self.phi0, self.theta0)))
         return self.place(U)
 
+    @_in_precision
     def place(self, U: Any) -> Any:
         U = jnp.asarray(U, dtype=self.dtype)
         return jax.device_put(U, self.sharding) if self.sharding is not None else U
@@ -121,6 +157,7 @@ class Simulation:
         return json.dumps(self.cfg.model_dump(mode="json"), sort_keys=True)
 
     # -- run -------------------------------------------------------------------------------
+    @_in_precision
     def run(
         self,
         resume: str | Path | None = None,
@@ -275,37 +312,58 @@ class Simulation:
 
 
 class _Progress:
-    """rich progress bar over simulated time, showing t, τ and the step rate (no-op if disabled)."""
+    """rich progress bar over simulated time, showing t, τ, the step rate and the time left (no-op if disabled).
 
-    def __init__(self, enabled: bool, t_end: float, t_haff: float, phys: Physics, phi0: float, theta0: float) -> None:
+    The time left is extrapolated in τ = ∫ν dt (the collision count), not in t: a cooling gas takes
+    about the same number of steps, hence wall time, per unit of τ, while its time step grows with t.
+    The first chunk is left out of every rate, because it includes the compilation.
+    """
+
+    def __init__(self, enabled: bool, t_end: float, t_haff: float, phys: Physics, phi0: float, theta0: float,
+                 clock: Callable[[], float] = _time.perf_counter) -> None:
         self.enabled, self.t_end = enabled, t_end
         self.args = (phys, phi0, theta0)
+        self.clock = clock
+        self.tau_end = float(tau_of_t(t_end, *self.args))
         self._steps, self._wall, self._first = 0, 0.0, True
+        self._start: tuple[float, float] | None = None  # (τ, clock) at the end of the first chunk
+        self.remaining: float | None = None  # seconds, once two chunks have run
 
     def __enter__(self) -> _Progress:
         if self.enabled:
-            from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+            from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
             self.bar = Progress(
                 TextColumn("[bold]HCS"), BarColumn(), TextColumn("t = {task.fields[t]}  τ = {task.fields[tau]}"),
-                TextColumn("{task.fields[rate]} steps/s"), TimeElapsedColumn(), TimeRemainingColumn(),
+                TextColumn("{task.fields[rate]} steps/s"), TimeElapsedColumn(), TextColumn("left {task.fields[eta]}"),
             )
             self.bar.__enter__()
-            self.task = self.bar.add_task("run", total=self.t_end, t="0", tau="0", rate="-")
+            self.task = self.bar.add_task("run", total=self.t_end, t="0", tau="0", rate="-", eta="-")
         return self
 
     def update(self, t: float, steps: int, wall: float) -> None:
-        if not self.enabled:
-            return
-        if self._first:  # the first chunk includes compilation: keep it out of the step rate
+        tau = float(tau_of_t(t, *self.args))
+        now = self.clock()
+        if self._first:  # the first chunk includes compilation: keep it out of the step rate and the ETA
             self._first = False
+            self._start = (tau, now)
         else:
             self._steps += steps
             self._wall += wall
+            tau0, c0 = self._start
+            if tau > tau0 and now > c0:
+                self.remaining = max(self.tau_end - tau, 0.0) * (now - c0) / (tau - tau0)
+        if not self.enabled:
+            return
         rate = f"{self._steps / self._wall:.1f}" if self._wall > 0 else "-"
-        tau = float(tau_of_t(t, *self.args))
-        self.bar.update(self.task, completed=t, t=f"{t:.4g} s", tau=f"{tau:.3g}", rate=rate)
+        eta = "-" if self.remaining is None else _format_seconds(self.remaining)
+        self.bar.update(self.task, completed=t, t=f"{t:.4g} s", tau=f"{tau:.3g}", rate=rate, eta=eta)
 
     def __exit__(self, *exc: object) -> None:
         if self.enabled:
             self.bar.__exit__(*exc)
+
+
+def _format_seconds(s: float) -> str:
+    s = int(round(s))
+    return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
