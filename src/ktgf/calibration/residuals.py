@@ -23,7 +23,6 @@ Couette
 
 from __future__ import annotations
 
-import math
 from typing import Any, Sequence
 
 import numpy as np

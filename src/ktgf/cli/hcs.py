@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import typer
 
-from ..closures import PAPER_MODELS, get_model
+from ..closures import get_model
 from ..errors import InputError
 from ..validation import check_positive, check_range
 from ._common import (DASK_HELP, MODEL_HELP, VALUES_HELP, OutputFormat, deprecated_alias, emit, handle_errors,
@@ -20,7 +20,6 @@ hcs_app = typer.Typer(help="Homogeneous cooling state: Haff's law, linear stabil
                       no_args_is_help=True)
 
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".eps", ".jpg", ".jpeg", ".tif", ".tiff")
-DEFAULT_MODELS = ",".join(PAPER_MODELS)
 
 
 def _models(text: str | None, model_file: Path | None = None) -> list[Any]:

@@ -9,7 +9,6 @@ models the table, the recommendations and the caveats change with the numbers.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
 
 from ..closures.models import get_model
 from .framework import SectionResult
