@@ -71,6 +71,20 @@ def test_coefficients_with_model_file_equal_the_model_with_those_options(fitted)
     assert rows[0]["eta*"] != pytest.approx(float(get_model("proposed").reduced(0.55, 0.9).eta), rel=1e-3)
 
 
+def test_shear_with_model_file_predicts_the_synthetic_data(fitted):
+    """`ktgf shear --model-file` reproduces the uniform-shear data the file was fitted on."""
+    out, data, _ = fitted
+    r = runner.invoke(app, ["shear", "--model-file", str(out), "--phi", "0.55,0.6", "--e", "0.9", "--format", "json"])
+    assert r.exit_code == 0, r.output
+    rows = json.loads(r.stdout)
+    assert {row["model"] for row in rows} == {"proposed-calibrated"}
+    from ktgf.couette.uniform_shear import shear_state
+
+    ref = shear_state(get_model("proposed", **TRUE), np.array([0.55, 0.6]), 0.9)
+    np.testing.assert_allclose([row["eta_over_eta0"] for row in rows], ref.eta_over_eta0, rtol=1e-6)
+    np.testing.assert_allclose([row["T"] for row in rows], ref.T, rtol=1e-6)
+
+
 def test_hcs_commands_take_the_model_file(fitted, tmp_path):
     out, _, _ = fitted
     r = runner.invoke(app, ["hcs", "stability", "--model-file", str(out), "--phi", "0.55", "--e", "0.9", "--format", "json"])

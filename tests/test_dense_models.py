@@ -134,7 +134,7 @@ def test_cli_shear_options_and_csv():
                                  "-O", "dissipation=jenkins-berzi-2010", "-O", "c=2"])
     assert result.exit_code == 0, result.output
     header, line = result.output.strip().splitlines()
-    assert header.split(",")[:6] == ["phi", "e", "T", "eta_star", "eta_over_eta0", "p_over_nT"]
+    assert header.split(",")[:7] == ["model", "phi", "e", "T", "eta_star", "eta_over_eta0", "p_over_nT"]
     assert float(dict(zip(header.split(","), line.split(",")))["L_over_d"]) > 1
 
 

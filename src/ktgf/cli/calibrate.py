@@ -63,7 +63,7 @@ def calibrate_cmd(
     errors: str = typer.Option(None, "--errors", help="scaled (by the residual variance; default) or stated (the data's errors)."),
     n_cells: int = typer.Option(100, "--cells", help="Grid cells of Couette cells."),
     max_evaluations: int = typer.Option(100, "--max-evaluations", help="Limit on residual evaluations."),
-    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
+    fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Fit chosen parameters of a model to DEM data (least squares, exact gradients) and write a model file."""
     from ..calibration.data import read_data

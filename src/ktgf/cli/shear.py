@@ -7,9 +7,10 @@ from typing import Any
 import numpy as np
 import typer
 
-from ..closures import get_model
+from pathlib import Path
+
 from ..errors import InputError
-from ._common import OutputFormat, emit, handle_errors, parse_values
+from ._common import MODEL_HELP, VALUES_HELP, OutputFormat, emit, handle_errors, model_file_option, parse_values, resolve_models
 
 
 def parse_options(items: list[str] | None) -> dict[str, Any]:
@@ -50,23 +51,26 @@ def shear_rows(model: Any, phi: np.ndarray, e: np.ndarray) -> list[dict[str, flo
 
 @handle_errors
 def shear(
-    model: str = typer.Option(..., "--model", "-m", help="Model name (see `ktgf models`)."),
-    phi: str = typer.Option(..., "--phi", help="Solid fraction: value, list a,b,c or range start:stop:num."),
+    model: str = typer.Option(None, "--model", "--models", "-m", help=MODEL_HELP),
+    model_file: Path = model_file_option(),
+    phi: str = typer.Option(..., "--phi", help="Solid fraction: " + VALUES_HELP + "."),
     e: str = typer.Option(..., "--e", help="Restitution coefficient(s), 0 < e < 1."),
     option: list[str] = typer.Option(
-        None, "--option", "-O", help="Model option KEY=VALUE (repeatable), e.g. phi_f=0.46."
+        None, "--option", "-O", help="Model option KEY=VALUE (repeatable, applied to every model), e.g. phi_f=0.46."
     ),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
-    """Steady uniform (Lees–Edwards) shear from the closed forms of model.md §9.
+    """Steady uniform (Lees–Edwards) shear from the closed forms of docs/model.md §9.
 
-    Columns as in shared/data/dem_uniform_shear.csv (d = m = 1): T = θ/(γ̇d)², eta_star = η d²/√(mT),
+    Columns as in the DEM file dem_uniform_shear.csv (d = m = 1): T = θ/(γ̇d)², eta_star = η d²/√(mT),
     eta_over_eta0 = η/η0, p_over_nT = p/(nT), astar = γ̇/ν0; tau_over_p = |P_xy|/p and L_over_d
     (extended-kinetic-theory correlation length, 1 without that option).
     """
-    m = get_model(model, **parse_options(option))
-    rows = shear_rows(m, parse_values(phi, "phi"), parse_values(e, "e"))
-    emit(rows, fmt, title=f"{m.label or m.name}: Navier–Stokes uniform shear (d = m = 1, shear rate 1)")
+    options = parse_options(option)
+    ms = [m.with_options(**options) if options else m for m in resolve_models(model, model_file)]
+    phis, es = parse_values(phi, "phi"), parse_values(e, "e")
+    rows = [{"model": m.name, **row} for m in ms for row in shear_rows(m, phis, es)]
+    emit(rows, fmt, title=f"{', '.join(m.label or m.name for m in ms)}: Navier–Stokes uniform shear (d = m = 1, shear rate 1)")
 
 
 def register(app: typer.Typer, plot_app: typer.Typer) -> None:
