@@ -103,25 +103,15 @@ def load_uniform_shear(path: Any, *, where: dict[str, float] | None = None) -> n
     """Rows of a uniform-shear DEM CSV (comment header, then named columns) as a record array.
 
     ``where`` keeps only rows whose columns equal the given values (e.g. ``{"mu": 0.0}`` for the
-    frictionless row of ``dem_uniform_shear_friction.csv``).  Raises
-    :class:`~ktgf.errors.InputError` for a missing file, missing columns or non-finite values.
+    frictionless row of ``dem_uniform_shear_friction.csv``).  The file is parsed and checked by
+    the calibration readers (:mod:`ktgf.calibration.data`): a missing file, missing columns or
+    non-finite values raise :class:`~ktgf.errors.InputError`.
     """
-    import io
-    from pathlib import Path
+    from ..calibration.data import _columns, _split
 
-    from ..errors import InputError
-
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"DEM data file {str(path)!r} does not exist")
-    body = "\n".join(ln for ln in path.read_text().splitlines() if not ln.startswith("#"))
-    data = np.atleast_1d(np.genfromtxt(io.StringIO(body), delimiter=",", names=True))
-    missing = [c for c in DEM_COLUMNS if c not in (data.dtype.names or ())]
-    if missing:
-        raise InputError(f"DEM file {path.name} lacks column(s) {', '.join(missing)}; needs {', '.join(DEM_COLUMNS)}")
+    _, names, table = _split(path)
+    keep = np.ones(table.shape[0], dtype=bool)
     for key, value in (where or {}).items():
-        data = data[data[key] == value]
-    for c in DEM_COLUMNS:
-        if not np.all(np.isfinite(data[c])):
-            raise InputError(f"DEM file {path.name} column {c} has non-finite values")
-    return data
+        keep &= _columns(path, names, table, (key,))[key] == value
+    cols = _columns(path, names, table, tuple(dict.fromkeys((*DEM_COLUMNS, *names))), np.flatnonzero(keep))
+    return np.rec.fromarrays(list(cols.values()), names=list(cols))

@@ -34,7 +34,6 @@ from .settings import ReportSettings
 FRICTION = "dem_uniform_shear_friction.csv"
 #: Restitution of the curves: the two DEM uniform-shear sets.
 CURVE_E = (0.9, 0.7)
-ETA_STAR_PER_ETA0 = 5.0 / (16.0 * math.sqrt(math.pi))
 QUANTITIES = {"T": "T = θ/(γ̇d)²", "eta_star": "η* = η d²/√(mT)", "p_star": "p* = p/(ρ_s d² γ̇²)", "p_over_nT": "p/(nT)"}
 
 _compare, couette_available = optional_entry("ktgf.couette.compare", "compare_with_dem", "the Couette solver", "(dem_path, models, *, n_cells)")
@@ -53,14 +52,13 @@ def inputs(s: ReportSettings) -> dict[str, Any]:
 
 
 def shear_state(model: Any, phi: np.ndarray, e: float) -> dict[str, np.ndarray]:
-    """The four DEM columns of the uniform-shear closed forms at (φ, e)."""
-    from ..couette.uniform_shear import uniform_shear
+    """The four DEM columns of the uniform-shear closed forms at (φ, e), p* = φ T p/(nT) added."""
+    from ..couette.uniform_shear import shear_state as closed_form
 
     phi = np.asarray(phi, dtype=float)
-    r = model.reduced(phi, e)
-    T = np.asarray(uniform_shear(model, phi, e).temperature_ratio, dtype=float)
-    p = np.broadcast_to(np.asarray(r.p, dtype=float), phi.shape)
-    return {"T": T, "eta_star": ETA_STAR_PER_ETA0 * np.asarray(r.eta, dtype=float), "p_star": phi * T * p, "p_over_nT": p}
+    s = closed_form(model, phi, e)
+    T, eta, p = (np.broadcast_to(np.asarray(v, dtype=float), phi.shape) for v in (s.T, s.eta_star, s.p_over_nT))
+    return {"T": T, "eta_star": eta, "p_star": phi * T * p, "p_over_nT": p}
 
 
 def shear_curves(names: tuple[str, ...], n: int) -> xr.Dataset:
@@ -85,6 +83,7 @@ def shear_curves(names: tuple[str, ...], n: int) -> xr.Dataset:
 def dem_points(ctx: SectionContext) -> dict[str, np.ndarray] | None:
     """The frictionless uniform-shear DEM states of both files (those present), in the four columns with errors."""
     from ..calibration.data import read_uniform_shear
+    from ..couette.uniform_shear import ETA0_DEM
 
     sets = [read_uniform_shear(p) for p in (ctx.data_file(UNIFORM_SHEAR), ctx.data_file(FRICTION)) if p is not None]
     if not sets:
@@ -97,8 +96,8 @@ def dem_points(ctx: SectionContext) -> dict[str, np.ndarray] | None:
     source = np.concatenate([[d.path.name] * d.phi.size for d in sets])
     # p* = φ T p/(nT): first-order propagation of the two (independent) standard errors
     pstar = phi * T * p
-    return {"phi": phi, "e": e, "source": source, "T": T, "dT": dT, "eta_star": ETA_STAR_PER_ETA0 * eta,
-            "deta_star": ETA_STAR_PER_ETA0 * deta, "p_star": pstar, "dp_star": pstar * np.hypot(dT / T, dp / p),
+    return {"phi": phi, "e": e, "source": source, "T": T, "dT": dT, "eta_star": ETA0_DEM * eta,
+            "deta_star": ETA0_DEM * deta, "p_star": pstar, "dp_star": pstar * np.hypot(dT / T, dp / p),
             "p_over_nT": p, "dp_over_nT": dp}
 
 
