@@ -21,7 +21,7 @@ def reproduce(
     quick: bool = typer.Option(False, "--quick", help="Coarse grids and fewer points (< 5 min on 2 cores; what CI runs)."),
     data: Optional[Path] = typer.Option(None, "--data", help="DEM reference data folder (default: $KTGF_DATA, else ../shared/data)."),
     config: Optional[Path] = typer.Option(None, "--config", "-c", help="TOML file of report settings (setting = value; see the page's Settings table)."),
-    set_: list[str] = typer.Option([], "--set", help="Override one setting, key=value (repeatable), e.g. --set cooling_phi=0.5 --set models=ret,proposed."),
+    set_: list[str] = typer.Option([], "--set", metavar="KEY=VALUE", help="Override one setting, key=value (repeatable), e.g. --set cooling_phi=0.5 --set models=ret,proposed."),
 ) -> None:
     """Run the model comparisons of the paper and write a self-contained HTML report.
 
