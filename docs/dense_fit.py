@@ -16,7 +16,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ktgf import PAPER_MODELS, get_model
-from ktgf.closures.dense import DENSE_PHI_F, fit_freezing_point, relative_errors
+from ktgf.closures.dense import DENSE_BETA, fit_rdf_option, relative_errors
 from ktgf.closures.dissipation import CorrelationLength
 from ktgf.closures.rdf import JammingPowerLaw, ViscosityDivergence
 from ktgf.couette.uniform_shear import load_uniform_shear, shear_state
@@ -43,17 +43,18 @@ def table(models):
                   f"{T:.4f} | {rec['T']:.4f} | {T / rec['T'] - 1:+.1%} |")
 
 
-print("## fit of dense: phi_f of the viscosity-divergence RDF with RET, on", data / "dem_uniform_shear.csv")
-phi_f, sol = fit_freezing_point(get_model("ret"), fit_rows)
+print("## fit of dense: beta of the viscosity-divergence RDF with RET, on", data / "dem_uniform_shear.csv")
+beta, sol = fit_rdf_option(get_model("ret"), fit_rows, "beta")
 J = sol.jac
 cov = np.linalg.inv(J.T @ J) * (2 * sol.cost / max(sol.fun.size - 1, 1))
-print(f"phi_f = {phi_f:.5f} ± {np.sqrt(cov[0, 0]):.5f} (registered {DENSE_PHI_F}); cost {sol.cost:.5f}; "
+print(f"beta = {beta:.5f} ± {np.sqrt(cov[0, 0]):.5f} (registered {DENSE_BETA}); cost {sol.cost:.5f}; "
       f"residuals {np.round(sol.fun, 4)}")
 print("held-out residuals [eta, p]:", np.round(relative_errors(get_model("dense"), held_rows), 4))
 
 print("\n## candidates tried (same fit set, same residuals; held-out = e = 0.7 row)")
 base = {"ret": get_model("ret"), "enskog": get_model("enskog")}
 candidates = [
+    ("beta (phi_f 0.49, phi_c 0.64)", lambda x: ViscosityDivergence(beta=x[0]), [1.75], ([1.0], [8.0])),
     ("phi_f", lambda x: ViscosityDivergence(phi_f=x[0]), [0.49], ([0.3], [0.6])),
     ("phi_f, beta", lambda x: ViscosityDivergence(phi_f=x[0], beta=x[1]), [0.49, 1.75], ([0.3, 0.1], [0.6, 5])),
     ("phi_c, beta (phi_f 0.49)", lambda x: ViscosityDivergence(phi_c=x[0], beta=x[1]), [0.64, 1.75],

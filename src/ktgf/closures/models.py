@@ -18,7 +18,7 @@ proposed    Garzó & Dufty (1999)  viscosity-divergence RDF   theory's own
 =========== ===================== ========================== ==========================
 
 and the recommended dense model ``dense`` (``docs/dense.md``): RET with the viscosity-divergence
-RDF whose freezing point φ_f is fitted to the DEM uniform shear (:mod:`ktgf.closures.dense`).
+RDF whose divergence exponent β is fitted to the DEM uniform shear (:mod:`ktgf.closures.dense`).
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from .coefficients import Dimensional, Reduced, to_dimensional
 from .garzo_dufty1999 import GarzoDufty1999
 from .lun1984 import Lun1984
 from .rdf import CarnahanStarling, RadialDistribution, Torquato, ViscosityDivergence
-from .dense import DENSE_PHI_F
+from .dense import DENSE_BETA
 from .dissipation import DISSIPATIONS, NoDissipationCorrection
 from .viscosity_divergence import NoViscosityCorrection, ViscosityDivergenceLaw
 
@@ -299,10 +299,10 @@ register_model(
     Model(
         "dense",
         GarzoDufty1999(),
-        ViscosityDivergence(phi_f=DENSE_PHI_F),
+        ViscosityDivergence(beta=DENSE_BETA),
         label="Dense",
         description=(
-            "Recommended for dense flows: RET with the viscosity-divergence RDF, phi_f fitted to "
+            "Recommended for dense flows: RET with the viscosity-divergence RDF, exponent beta fitted to "
             "DEM uniform shear (docs/dense.md)"
         ),
     ),
