@@ -74,7 +74,9 @@ def shear_curves(names: tuple[str, ...], n: int) -> xr.Dataset:
                 data[k][i, j, ok] = st[k]
     return xr.Dataset(
         {k: (("model", "e", "phi"), v, {"long_name": QUANTITIES[k], "units": "1"}) for k, v in data.items()},
-        coords={"model": list(names), "label": ("model", [get_model(n).label or n for n in names]), "e": list(CURVE_E), "phi": phi},
+        coords={"model": list(names), "label": ("model", [get_model(n).label or n for n in names]),
+                "e": ("e", list(CURVE_E), {"long_name": "restitution coefficient", "units": "1"}),
+                "phi": ("phi", phi, {"long_name": "solid fraction", "units": "1"})},
         attrs=run_metadata(None, models=list(names), points=n, figure="uniform shear, Navier-Stokes closed forms (model.md section 9)",
                            units="d = m = 1, shear rate 1"),
     )
@@ -154,9 +156,13 @@ def _shear_table(ctx: SectionContext, names: tuple[str, ...], dem: dict[str, np.
               note="Navier–Stokes closed forms at the DEM's (φ, e); the DEM's a* = γ̇/ν0 ≈ 0.2–0.3 is beyond Navier–Stokes order. "
                    "No parameter of the paper's models was fitted to these data.")
     ctx.dataset(xr.Dataset(
-        {**{f"{k}_dem": (("state",), dem[k]) for k in ("T", "eta_star", "p_star", "p_over_nT")},
-         **{f"{k}_error": (("model", "state"), np.array([errs[n][k] for n in names])) for k in ("T", "eta_star", "p_over_nT")}},
-        coords={"model": list(names), "phi": (("state",), dem["phi"]), "e": (("state",), dem["e"]),
+        {**{f"{k}_dem": (("state",), dem[k], {"long_name": f"DEM {QUANTITIES[k]}", "units": "1"})
+            for k in ("T", "eta_star", "p_star", "p_over_nT")},
+         **{f"{k}_error": (("model", "state"), np.array([errs[n][k] for n in names]),
+                           {"long_name": f"relative error of {QUANTITIES[k]}, model/DEM - 1", "units": "1"})
+            for k in ("T", "eta_star", "p_over_nT")}},
+        coords={"model": list(names), "phi": (("state",), dem["phi"], {"long_name": "solid fraction", "units": "1"}),
+                "e": (("state",), dem["e"], {"long_name": "restitution coefficient", "units": "1"}),
                 "source": (("state",), dem["source"].astype(str))},
         attrs=run_metadata(None, quantity="relative error model/DEM - 1", sources=sorted(set(dem["source"].tolist())))), "shear_errors")
     ctx.number("shear_errors", {n: {k: {f"{p:g}@{e:g}": v for p, e, v in zip(dem["phi"], dem["e"], errs[n][k])} for k in errs[n]}
@@ -184,11 +190,24 @@ def _couette_table(ctx: SectionContext, names: tuple[str, ...]) -> None:
               note=f"Johnson–Jackson walls, e_w = e, specularity fitted per model to the DEM slip at |y| = {extra['dem'].slip_y:g} d "
                    f"(one number); wall stresses are predictions. {ctx.settings.couette_cells} cells.", with_figure=False)
     ctx.dataset(xr.Dataset(
-        {k: (("model",), np.array([float(r[k]) for r in rows])) for k in ("specularity", "tau_wall", "tau_wall_dem", "p", "p_dem", "max_phi")}
-        | {"valid": (("model",), np.array([int(bool(r["valid"])) for r in rows]))},
+        {k: (("model",), np.array([float(r[k]) for r in rows]), {"long_name": WALL_NAMES[k], "units": "1"})
+         for k in ("specularity", "tau_wall", "tau_wall_dem", "p", "p_dem", "max_phi")}
+        | {"valid": (("model",), np.array([int(bool(r["valid"])) for r in rows]),
+                     {"long_name": "physically valid profile (1) or not (0)", "units": "1"})},
         coords={"model": list(names)},
         attrs=run_metadata(None, source=COUETTE, case=vars(c), cells=ctx.settings.couette_cells)), "couette_wall_stresses")
     ctx.number("couette_wall", nums)
+
+
+#: Long names of the Couette wall quantities (DEM units d = m = 1, so stresses are in m U²/d³ of the DEM).
+WALL_NAMES = {
+    "specularity": "specularity coefficient fitted to the DEM slip",
+    "tau_wall": "wall shear stress (DEM units d = m = 1)",
+    "tau_wall_dem": "DEM wall shear stress (d = m = 1)",
+    "p": "wall normal stress (DEM units d = m = 1)",
+    "p_dem": "DEM wall normal stress p_yy (d = m = 1)",
+    "max_phi": "largest solid fraction of the profile",
+}
 
 
 def run(ctx: SectionContext) -> None:
