@@ -9,7 +9,11 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
+import os
 import platform
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -48,12 +52,41 @@ def run_metadata(model: Any = None, **parameters: Any) -> dict[str, str]:
     return attrs
 
 
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+_UMASK = _umask()
+
+
+@contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """Yield a unique temporary name beside ``path``; on success it replaces ``path`` atomically.
+
+    Readers (and a resumed run) therefore see either the old file or the complete new one,
+    and two writers never share a temporary file.  The temporary name keeps the suffix of
+    ``path`` (writers that pick the format from it, like matplotlib, still work).
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp" + path.suffix)
+    os.close(fd)
+    os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; give the file the usual permissions
+    try:
+        yield Path(tmp)
+        os.replace(tmp, path)
+    finally:
+        Path(tmp).unlink(missing_ok=True)
+
+
 def write_netcdf(ds: Any, path: str | Path) -> Path:
-    """Write an xarray Dataset to ``path`` (parent folders created), raising a clear error if unwritable."""
+    """Write an xarray Dataset to ``path`` atomically (parent folders created); clear error if unwritable."""
     path = Path(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        ds.to_netcdf(path)
+        with atomic_path(path) as tmp:
+            ds.to_netcdf(tmp)
     except (PermissionError, OSError) as exc:
         raise InputError(f"cannot write output file {str(path)!r}: {exc.strerror or exc}") from exc
     return path
@@ -65,8 +98,21 @@ def read_toml(path: str | Path) -> dict[str, Any]:
 
     path = Path(path)
     try:
-        return tomllib.loads(path.read_text())
+        data = path.read_bytes()
     except FileNotFoundError:
         raise InputError(f"config file {str(path)!r} does not exist") from None
+    except IsADirectoryError:
+        raise InputError(f"config file {str(path)!r} is a directory, not a TOML file") from None
+    except OSError as exc:
+        raise InputError(f"config file {str(path)!r} cannot be read: {exc.strerror or exc}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(
+            f"config file {str(path)!r} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start}); "
+            "save it as UTF-8"
+        ) from None
+    try:
+        return tomllib.loads(text.removeprefix("\ufeff"))
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
