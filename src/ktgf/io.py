@@ -39,6 +39,18 @@ def _jsonable(x: Any) -> Any:
     return x if isinstance(x, (str, int, float, bool)) or x is None else repr(x)
 
 
+def plain(x: Any) -> Any:
+    """Config data from Python callers made TOML-like (NumPy scalars → Python, tuples → lists),
+    so that strict validation only refuses what a TOML file could not hold either."""
+    if isinstance(x, dict):
+        return {k: plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [plain(v) for v in x]
+    if isinstance(x, np.generic):
+        return x.item()
+    return x
+
+
 def run_metadata(model: Any = None, **parameters: Any) -> dict[str, str]:
     """netCDF-safe attributes: version, time, platform, model description and parameters (JSON)."""
     attrs = {

@@ -42,11 +42,11 @@ def run_cmd(
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
 ) -> None:
     """Solve one Couette cell described by a validated TOML config and write the profiles to netCDF."""
-    from ..couette.config import load_config, run_config
+    from ..couette.config import check_output_path, load_config, run_config
     from ..io import write_netcdf
 
     cfg = load_config(config)
-    path = Path(out or cfg.output.path)
+    path = check_output_path(out, "--out") if out is not None else Path(cfg.output.path)
     ds = run_config(cfg, failed_path=path.with_suffix(".failed.nc"))
     write_netcdf(ds, path)
     emit([_summary(ds)], fmt, title=f"Couette ({ds.attrs['geometry']}) -> {path}")
