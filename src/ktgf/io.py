@@ -104,6 +104,29 @@ def write_netcdf(ds: Any, path: str | Path) -> Path:
     return path
 
 
+def read_dataset(path: str | Path, needs: tuple[str, ...] = (), what: str = "netCDF file") -> Any:
+    """Load a netCDF file into memory, checking it holds the variables ``needs``.
+
+    Raises :class:`InputError` (one line) for a missing file, a file that is not netCDF and a
+    netCDF file of another kind (e.g. a Couette profile given to ``ktgf plot run``).
+    """
+    import xarray as xr
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{what} {str(path)!r} does not exist" + (" (it is a directory)" if path.is_dir() else ""))
+    try:
+        ds = xr.load_dataset(path)
+    except Exception as exc:  # engines raise ValueError, OSError, KeyError, ... for foreign files
+        text = str(exc).strip()
+        first = text.splitlines()[0].split(". ")[0][:160] if text else type(exc).__name__
+        raise InputError(f"{what} {str(path)!r} is not a readable netCDF file ({first})") from None
+    missing = [v for v in needs if v not in ds.variables]
+    if missing:
+        raise InputError(f"{str(path)!r} is not a {what}: it lacks {', '.join(missing)}")
+    return ds
+
+
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read a TOML config file, raising :class:`InputError` if it is missing or not valid TOML."""
     import tomllib

@@ -15,10 +15,19 @@ from ._array import is_tracer
 from .errors import InputError
 
 
-def _values(x: Any) -> np.ndarray | None:
-    if x is None or is_tracer(x):
+def _values(name: str, x: Any) -> np.ndarray | None:
+    """The values of ``x`` as floats, None for a tracer; InputError for anything that is not numbers."""
+    if is_tracer(x):
         return None
-    return np.asarray(x, dtype=float)
+    if x is None or isinstance(x, (str, bytes, bool, np.bool_)) or (isinstance(x, np.ndarray) and x.dtype == bool):
+        raise InputError(f"{name} = {x!r} is not a number")
+    try:
+        v = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} = {x!r:.60} is not a number or an array of numbers") from None
+    if v.size == 0:
+        raise InputError(f"{name} is empty: give at least one value")
+    return v
 
 
 def _first_bad(v: np.ndarray, ok: np.ndarray) -> str:
@@ -43,7 +52,7 @@ def check_range(
     The message names the quantity, the offending value and the valid range, e.g.
     ``solid fraction phi = 0.7 is out of range: valid 0 <= phi < 0.64 (packing limit of torquato)``.
     """
-    v = _values(x)
+    v = _values(name, x)
     if v is None:
         return
     ok = np.isfinite(v)

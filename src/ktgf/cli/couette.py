@@ -7,7 +7,7 @@ from typing import Any
 
 import typer
 
-from ._common import OutputFormat, emit, handle_errors, parse_values
+from ._common import OutputFormat, emit, handle_errors, parse_names, parse_values
 
 
 def _default_dem() -> Path:
@@ -67,7 +67,7 @@ def compare_cmd(
     from ..couette.compare import compare_with_dem, load_dem_couette
     from ..plotting.couette import plot_profiles
 
-    names = [n.strip() for n in models.split(",") if n.strip()]
+    names = parse_names(models, "models")
     for n in names:
         get_model(n)
     if config is None:
@@ -168,16 +168,12 @@ def plot_cmd(
     out: Path = typer.Option(Path("couette.png"), "--out", "-o", help="Figure file."),
 ) -> None:
     """Plot u/U, phi and sqrt(theta)/U of saved Couette runs on one figure."""
-    import xarray as xr
-
-    from ..errors import InputError
+    from ..io import read_dataset
     from ..plotting.couette import plot_profiles
 
     datasets = {}
     for f in files:
-        if not f.exists():
-            raise InputError(f"file {str(f)!r} does not exist")
-        ds = xr.load_dataset(f)
+        ds = read_dataset(f, ("u", "phi", "theta"), "Couette profile written by `ktgf couette run`")
         datasets[f"{ds.attrs.get('model_label', f.stem)} ({f.name})"] = ds
     typer.echo(f"wrote {plot_profiles(datasets, out)}")
 

@@ -13,7 +13,7 @@ import typer
 from ..closures import PAPER_MODELS, get_model
 from ..errors import InputError
 from ..validation import check_positive, check_range
-from ._common import OutputFormat, emit, handle_errors, parse_values
+from ._common import OutputFormat, check_points, emit, handle_errors, parse_names, parse_values
 
 hcs_app = typer.Typer(help="Homogeneous cooling state: Haff's law, linear stability, critical box sizes.",
                       no_args_is_help=True)
@@ -23,14 +23,17 @@ DEFAULT_MODELS = ",".join(PAPER_MODELS)
 
 
 def _models(text: str) -> list[Any]:
-    names = [n for n in (s.strip() for s in text.split(",")) if n]
-    if not names:
-        raise InputError(f"--model {text!r} names no model")
-    return [get_model(n) for n in names]
+    return [get_model(n) for n in parse_names(text, "model")]
 
 
 def _check_count(name: str, value: int, low: int) -> None:
     check_range(f"number of points {name}", value, low=low)
+    check_points(value, name)
+
+
+def _check_box(box: float) -> None:
+    # below one particle diameter the box's lowest mode is no continuum wave (and 2 pi/L overflows)
+    check_range("box side --box", box, low=1.0, why="L/d: at least one particle diameter")
 
 
 def _kind_of_output(out: Path, allowed: tuple[str, ...]) -> str:
@@ -107,8 +110,10 @@ def stability(
     if method not in ("closed", "eig"):
         raise InputError(f"--method {method!r} is not valid: choose closed or eig")
     if box is not None:
-        check_positive("box side --box", box, "L/d")
-    phis, es = np.meshgrid(parse_values(phi, "phi"), parse_values(e, "e"), indexing="ij")
+        _check_box(box)
+    phi_values, e_values = parse_values(phi, "phi"), parse_values(e, "e")
+    check_points(phi_values.size * e_values.size, "--phi x --e")
+    phis, es = np.meshgrid(phi_values, e_values, indexing="ij")
     phis, es = phis.ravel(), es.ravel()
     check_range("solid fraction phi", phis, low=0.0, low_open=True, why="L/d is infinite at phi = 0")
     rows = []
@@ -175,6 +180,7 @@ def map_cmd(
     _kind_of_output(out, (".nc",))
     _check_count("--n-phi", n_phi, 1)
     _check_count("--n-e", n_e, 1)
+    check_points(n_phi * n_e, "--n-phi x --n-e")
     check_range("--workers", workers, low=0)
     check_range("smallest solid fraction phi-min", phi_min, low=0.0, high=1.0, low_open=True, high_open=True)
     check_range("largest solid fraction phi-max", phi_max, low=phi_min, high=1.0, high_open=True)
@@ -210,11 +216,9 @@ def plot_stability_map_cmd(
     es = parse_values(e, "e")
     check_range("restitution coefficient e", es, low=0.0, high=1.0, low_open=True)
     if source is not None:
-        import xarray as xr
+        from ..io import read_dataset
 
-        if not source.is_file():
-            raise InputError(f"--from {str(source)!r}: no such file")
-        ds = xr.load_dataset(source)
+        ds = read_dataset(source, ("phi", "e", "L_perp", "L_par"), "stability map written by `ktgf hcs map`")
     else:
         _check_count("--n-phi", n_phi, 2)
         check_range("smallest solid fraction phi-min", phi_min, low=0.0, high=1.0, low_open=True, high_open=True)
@@ -240,9 +244,10 @@ def plot_dispersion_cmd(
     m.check(phi, e)
     check_range("solid fraction phi", phi, low=0.0, low_open=True)
     if k_max is not None:
-        check_positive("largest wavenumber k-max", k_max)
+        # k* = k ell: hydrodynamics holds for k ell below ~1; far above, k*^2 overflows
+        check_range("largest wavenumber k-max", k_max, low=0.0, high=1e3, low_open=True, why="k* = k ell")
     if box is not None:
-        check_positive("box side --box", box, "L/d")
+        _check_box(box)
     typer.echo(f"wrote {plot_dispersion(m, phi, e, out, k_max=k_max, box=box)}")
 
 

@@ -55,14 +55,12 @@ def plot_run(
 ) -> None:
     """Plot θ/θ_Haff, transverse and longitudinal kinetic energy / θ and density variance against τ."""
     import matplotlib.pyplot as plt
-    import xarray as xr
 
-    from ..errors import InputError
+    from ..io import read_dataset
     from ..plotting import save
 
-    if not timeseries.is_file():
-        raise InputError(f"time series {str(timeseries)!r} does not exist")
-    ds = xr.open_dataset(timeseries)
+    ds = read_dataset(timeseries, ("tau", "theta_mean", "theta_haff", "ke_transverse", "ke_longitudinal",
+                                   "density_variance"), "time series written by `ktgf run`")
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
     ax[0].plot(ds.tau, ds.theta_mean / ds.theta_haff)
     ax[0].set_xlabel("τ")
