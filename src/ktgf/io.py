@@ -114,7 +114,7 @@ def read_dataset(path: str | Path, needs: tuple[str, ...] = (), what: str = "net
 
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"{what} {str(path)!r} does not exist" + (" (it is a directory)" if path.is_dir() else ""))
+        raise InputError(f"{what} {str(path)!r}: no such file" + (" (it is a directory)" if path.is_dir() else ""))
     try:
         ds = xr.load_dataset(path)
     except Exception as exc:  # engines raise ValueError, OSError, KeyError, ... for foreign files

@@ -53,7 +53,10 @@ def coefficients(
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
 ) -> None:
     """Reduced and SI transport coefficients of one model at states (phi, e)."""
+    from ..validation import check_material
+
     m = get_model(model)
+    check_material(d=d, theta=theta, rho_s=rho_s)
     phis, es = np.meshgrid(parse_values(phi, "phi"), parse_values(e, "e"), indexing="ij")
     phis, es = phis.ravel(), es.ravel()
     red = m.reduced(phis, es)

@@ -12,12 +12,14 @@ import typer
 
 from ..closures import PAPER_MODELS, get_model
 from ..errors import InputError
-from ..validation import check_positive, check_range
+from ..validation import check_material, check_positive, check_range
 from ._common import OutputFormat, check_points, emit, handle_errors, parse_names, parse_values
 
 hcs_app = typer.Typer(help="Homogeneous cooling state: Haff's law, linear stability, critical box sizes.",
                       no_args_is_help=True)
 
+#: Smallest solid fraction of the stability commands (L/d ~ 1/phi would overflow far below).
+PHI_MIN = 1e-10
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".eps", ".jpg", ".jpeg", ".tif", ".tiff")
 DEFAULT_MODELS = ",".join(PAPER_MODELS)
 
@@ -63,7 +65,8 @@ def haff(
 
     kind = _kind_of_output(out, (".nc", "figure")) if out is not None else None
     _check_count("--n", n, 2)
-    check_positive("particle diameter d", d, "m")
+    check_material(d=d, theta=theta0)
+    check_range("solid fraction phi", phi, low=0.0, low_open=True, why="no collisions, no cooling at phi = 0")
     models = _models(model)
     for m in models:
         m.check(phi, e, theta0)
@@ -115,7 +118,7 @@ def stability(
     check_points(phi_values.size * e_values.size, "--phi x --e")
     phis, es = np.meshgrid(phi_values, e_values, indexing="ij")
     phis, es = phis.ravel(), es.ravel()
-    check_range("solid fraction phi", phis, low=0.0, low_open=True, why="L/d is infinite at phi = 0")
+    check_range("solid fraction phi", phis, low=PHI_MIN, why="L/d grows like 1/phi: it overflows in the dilute limit")
     rows = []
     for m in _models(model):
         r = m.reduced(phis, es)
@@ -131,6 +134,9 @@ def stability(
         l_perp, l_par = critical_box_size(phis, k_perp), critical_box_size(phis, k_par)
         if box is not None:
             kb = box_wavenumber(phis, box)
+            # k* = k ell: the hydrodynamic equations hold for k ell below ~1; far above, rates overflow
+            check_range("reduced wavenumber of the box's lowest mode k_box*", kb, high=1e3,
+                        why="k* = 0.82/(phi L/d): give a larger --box or phi")
             disp = dispersion_relation(r, kb)
         for i in range(phis.size):
             row: dict[str, Any] = {
@@ -182,7 +188,7 @@ def map_cmd(
     _check_count("--n-e", n_e, 1)
     check_points(n_phi * n_e, "--n-phi x --n-e")
     check_range("--workers", workers, low=0)
-    check_range("smallest solid fraction phi-min", phi_min, low=0.0, high=1.0, low_open=True, high_open=True)
+    check_range("smallest solid fraction phi-min", phi_min, low=PHI_MIN, high=1.0, high_open=True)
     check_range("largest solid fraction phi-max", phi_max, low=phi_min, high=1.0, high_open=True)
     check_range("smallest restitution coefficient e-min", e_min, low=0.0, high=1.0, low_open=True)
     check_range("largest restitution coefficient e-max", e_max, low=e_min, high=1.0)
@@ -242,7 +248,7 @@ def plot_dispersion_cmd(
     _kind_of_output(out, ("figure",))
     m = get_model(model)
     m.check(phi, e)
-    check_range("solid fraction phi", phi, low=0.0, low_open=True)
+    check_range("solid fraction phi", phi, low=PHI_MIN)
     if k_max is not None:
         # k* = k ell: hydrodynamics holds for k ell below ~1; far above, k*^2 overflows
         check_range("largest wavenumber k-max", k_max, low=0.0, high=1e3, low_open=True, why="k* = k ell")

@@ -144,11 +144,22 @@ class Simulation:
         self.t_haff = haff_time(self.phys, self.phi0, self.theta0)
         end, n_out = cfg.time.end, cfg.time.outputs
         if cfg.time.unit == "tau":  # equal steps in τ: the natural clock of a cooling gas
-            self.output_times = np.asarray(t_of_tau(np.linspace(0.0, end, n_out + 1), self.phys, self.phi0, self.theta0))
+            with np.errstate(over="ignore"):  # an overflow (end too far along Haff's law) is refused below
+                self.output_times = np.asarray(t_of_tau(np.linspace(0.0, end, n_out + 1), self.phys, self.phi0,
+                                                        self.theta0))
         else:
             t_end = end if cfg.time.unit == "s" else end * self.t_haff
             self.output_times = np.linspace(0.0, t_end, n_out + 1)
         self.output_times[0] = 0.0
+        t = self.output_times
+        if not (np.isfinite(t).all() and np.all(np.diff(t) > 0)):
+            limit = float(tau_of_t(1e300, self.phys, self.phi0, self.theta0)) if cfg.time.unit == "tau" else (
+                1e300 / self.t_haff if cfg.time.unit == "haff" else 1e300)
+            raise InputError(
+                f"field time.end = {end:g} ({cfg.time.unit}) gives output times that overflow or coincide "
+                f"(t_end = {t[-1]:g} s): valid time.end <= {limit:.4g} {cfg.time.unit} and enough room for "
+                f"time.outputs = {n_out} distinct outputs"
+            )
         self.sharding = self._sharding(cfg.parallel.devices)
 
     def _sharding(self, ndev: int) -> Any:
