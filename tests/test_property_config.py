@@ -6,6 +6,7 @@ InputError — never another exception, never a non-finite value in an accepted 
 from __future__ import annotations
 
 import copy
+import itertools
 import math
 import tomllib
 from pathlib import Path
@@ -46,7 +47,9 @@ def _mutate(base: dict, path: tuple, value) -> dict:
     data = copy.deepcopy(base)
     node = data
     for k in path[:-1]:
-        node = node.setdefault(k, {}) if isinstance(node.get(k), dict) else node.setdefault(k, {})
+        if not isinstance(node.get(k), dict):
+            node[k] = {}
+        node = node[k]
     if value is _DELETE:
         node.pop(path[-1], None)
     else:
@@ -90,7 +93,7 @@ def _hcs_case(changes: list) -> None:
         assert "\n" not in str(exc)
         return
     t = sim.output_times
-    assert all(math.isfinite(x) for x in t) and all(b > a for a, b in zip(t, t[1:]))
+    assert all(math.isfinite(x) for x in t) and all(b > a for a, b in itertools.pairwise(t))
 
 
 def _couette_case(changes: list) -> None:

@@ -15,7 +15,6 @@ def save(fig: Any, out: str | Path) -> Path:
     import matplotlib.pyplot as plt
 
     from ..errors import InputError
-
     from ..io import atomic_path
 
     out = Path(out)

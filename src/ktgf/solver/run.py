@@ -33,10 +33,10 @@ from ..closures import get_model
 from ..closures.coefficients import mean_free_path
 from ..errors import DivergenceError, InputError, KtgfError
 from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
+from ..io import write_netcdf
 from .config import Config
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
 from .grid import Grid
-from ..io import write_netcdf
 from .initial import haff_time, random_velocity, single_mode, t_of_tau, tau_of_t, uniform_fields
 from .interrupt import STOP, Interrupted, fault_hook
 from .io import load_checkpoint, save_checkpoint, save_slices, write_vti
