@@ -187,7 +187,7 @@ def map_cmd(
     _check_count("--n-phi", n_phi, 1)
     _check_count("--n-e", n_e, 1)
     check_points(n_phi * n_e, "--n-phi x --n-e")
-    check_range("--workers", workers, low=0)
+    check_range("--workers", workers, low=0, high=256, why="local processes")
     check_range("smallest solid fraction phi-min", phi_min, low=PHI_MIN, high=1.0, high_open=True)
     check_range("largest solid fraction phi-max", phi_max, low=phi_min, high=1.0, high_open=True)
     check_range("smallest restitution coefficient e-min", e_min, low=0.0, high=1.0, low_open=True)
