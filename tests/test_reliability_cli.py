@@ -62,6 +62,8 @@ def test_figure_extension_is_checked(files: dict[str, Path], tmp_path: Path) -> 
     (["hcs", "map", "-o", "m.nc", "--n-phi", "100000", "--n-e", "100000"], ["1e+10 points", "80 GB"]),
     (["hcs", "haff", "--phi", "0.3", "--e", "0.9", "--theta0", "1", "--d", "1e-3", "--n", "1000000000"], ["1e+09 points"]),
     (["hcs", "haff", "--phi", "0.3", "--e", "0.9", "--theta0", "1e122", "--d", "1e-3"], ["theta = 1e+122"]),
+    (["hcs", "haff", "--phi", "5e-324", "--e", "0.5", "--theta0", "1", "--d", "1"], ["phi = 4.94066e-324"]),
+    (["coefficients", "-m", "ret", "--phi", "5e-324", "--e", "0.5"], ["phi = 4.94066e-324", "1e-10"]),
     (["coefficients", "-m", "ret", "--phi", "", "--e", "0.9"], ["gives no value"]),
     (["couette", "compare", "--models", ","], ["--models ','", "names nothing"]),
     (["plot", "dispersion", "--phi", "0.3", "--e", "0.9", "--k-max", "1e300"], ["k-max = 1e+300"]),

@@ -53,12 +53,16 @@ def coefficients(
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json or csv."),
 ) -> None:
     """Reduced and SI transport coefficients of one model at states (phi, e)."""
+    from ..errors import InputError
     from ..validation import check_material
 
     m = get_model(model)
     check_material(d=d, theta=theta, rho_s=rho_s)
     phis, es = np.meshgrid(parse_values(phi, "phi"), parse_values(e, "e"), indexing="ij")
     phis, es = phis.ravel(), es.ravel()
+    tiny = (phis > 0) & (phis < 1e-10)
+    if tiny.any():  # the SI coefficients scale with 1/phi: they overflow between 0 and 1e-10
+        raise InputError(f"solid fraction phi = {phis[tiny][0]:g} is out of range: valid phi = 0 or phi >= 1e-10")
     red = m.reduced(phis, es)
     si = m.coefficients(phis, es, theta, d=d, rho_s=rho_s)
     rows = []

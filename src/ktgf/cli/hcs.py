@@ -66,7 +66,7 @@ def haff(
     kind = _kind_of_output(out, (".nc", "figure")) if out is not None else None
     _check_count("--n", n, 2)
     check_material(d=d, theta=theta0)
-    check_range("solid fraction phi", phi, low=0.0, low_open=True, why="no collisions, no cooling at phi = 0")
+    check_range("solid fraction phi", phi, low=PHI_MIN, why="no collisions, no cooling at phi = 0")
     models = _models(model)
     for m in models:
         m.check(phi, e, theta0)
