@@ -5,7 +5,11 @@ the Proposed model), the homogeneous cooling state and its stability, the Couett
 and a 3D JAX flow solver.  Start with :func:`get_model`.
 """
 
-from importlib.metadata import PackageNotFoundError, version
+from ._startup import quit_on_interrupt_outside_the_run_loop
+
+quit_on_interrupt_outside_the_run_loop()  # before the slow imports below
+
+from importlib.metadata import PackageNotFoundError, version  # noqa: E402
 
 try:
     __version__ = version("ktgf")

@@ -41,4 +41,9 @@ def asarray(x: Any) -> Any:
     """Pass JAX values through; turn anything else into a float NumPy array."""
     if is_jax(x):
         return x
-    return np.asarray(x, dtype=float)
+    try:
+        return np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        from .errors import InputError
+
+        raise InputError(f"{x!r:.60} is not a number or an array of numbers") from None

@@ -85,7 +85,12 @@ def open_executor(workers: int = 0, scheduler: str | None = None) -> Iterator[An
     if scheduler:
         from distributed import Client
 
-        client = Client(scheduler)
+        from .errors import InputError
+
+        try:
+            client = Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
+            raise InputError(f"Dask scheduler {scheduler!r} is unreachable: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
         try:
             yield client
         finally:

@@ -15,10 +15,19 @@ from ._array import is_tracer
 from .errors import InputError
 
 
-def _values(x: Any) -> np.ndarray | None:
-    if x is None or is_tracer(x):
+def _values(name: str, x: Any) -> np.ndarray | None:
+    """The values of ``x`` as floats, None for a tracer; InputError for anything that is not numbers."""
+    if is_tracer(x):
         return None
-    return np.asarray(x, dtype=float)
+    if x is None or isinstance(x, (str, bytes, bool, np.bool_)) or (isinstance(x, np.ndarray) and x.dtype == bool):
+        raise InputError(f"{name} = {x!r} is not a number")
+    try:
+        v = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} = {x!r:.60} is not a number or an array of numbers") from None
+    if v.size == 0:
+        raise InputError(f"{name} is empty: give at least one value")
+    return v
 
 
 def _first_bad(v: np.ndarray, ok: np.ndarray) -> str:
@@ -43,7 +52,7 @@ def check_range(
     The message names the quantity, the offending value and the valid range, e.g.
     ``solid fraction phi = 0.7 is out of range: valid 0 <= phi < 0.64 (packing limit of torquato)``.
     """
-    v = _values(x)
+    v = _values(name, x)
     if v is None:
         return
     ok = np.isfinite(v)
@@ -73,3 +82,18 @@ def check_state(phi: Any, e: Any, theta: Any = None, *, phi_max: float = 1.0, rd
 def check_positive(name: str, x: Any, unit: str = "") -> None:
     """Check that ``x`` is finite and > 0 (a diameter, a density, a length)."""
     check_range(name, x, low=0.0, low_open=True, why=unit)
+
+
+#: Physical bounds of SI inputs at the command line (beyond them products overflow or underflow and
+#: the numbers describe no granular material): particles of 1 nm to 1 m, thermal speeds of 1e-10 m/s to
+#: 10 km/s, material densities of 1e-3 to 1e5 kg/m^3 (osmium: 2.26e4).
+DIAMETER_RANGE, TEMPERATURE_RANGE, DENSITY_RANGE = (1e-9, 1.0), (1e-20, 1e8), (1e-3, 1e5)
+
+
+def check_material(d: Any = None, theta: Any = None, rho_s: Any = None) -> None:
+    """Check d, theta and rho_s (those given) against the physical ranges above."""
+    for name, x, (lo, hi), unit in (("particle diameter d", d, DIAMETER_RANGE, "m"),
+                                    ("granular temperature theta", theta, TEMPERATURE_RANGE, "m^2/s^2"),
+                                    ("material density rho_s", rho_s, DENSITY_RANGE, "kg/m^3")):
+        if x is not None:
+            check_range(name, x, low=lo, high=hi, why=unit)

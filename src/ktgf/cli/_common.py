@@ -14,6 +14,8 @@ import typer
 from ..errors import KtgfError
 
 EXIT_USAGE = 2
+#: Most points one option or sweep may ask for (a float64 array of them is 80 MB).
+MAX_POINTS = 10_000_000
 
 
 class OutputFormat(str, Enum):
@@ -41,8 +43,21 @@ def handle_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
         except KtgfError as exc:
             typer.echo(f"Error: {exc}", err=True)
             raise typer.Exit(EXIT_USAGE) from None
+        except MemoryError as exc:  # a request the checks below did not foresee: refuse, do not crash
+            typer.echo(f"Error: not enough memory for this request ({exc or 'MemoryError'}); ask for fewer points",
+                       err=True)
+            raise typer.Exit(EXIT_USAGE) from None
 
     return wrapper
+
+
+def check_points(n: int, what: str) -> None:
+    """Refuse a request of more than :data:`MAX_POINTS` points, with its memory estimate."""
+    from ..errors import InputError
+
+    if n > MAX_POINTS:
+        raise InputError(f"{what} asks for {n:.3g} points (one float64 array of them is {8 * n / 1e9:.3g} GB): "
+                         f"valid at most {MAX_POINTS:.0e} points")
 
 
 #: Help of every ``--model`` option (comma-separated registry names; default: the paper's four models).
@@ -88,21 +103,54 @@ def parse_values(text: str, name: str) -> np.ndarray:
             start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
             if num < 1:
                 raise ValueError
+            values = None  # built below, once its size is checked
         else:
-            return np.array([float(v) for v in text.split(",") if v.strip()], dtype=float)
+            values = np.array([float(v) for v in text.split(",") if v.strip()], dtype=float)
     except ValueError:
         raise InputError(f"--{name} {text!r} is not {VALUES_HELP}") from None
-    if not log:
-        return np.linspace(start, stop, num)
-    if start <= 0 or stop <= 0:
-        raise InputError(f"--{name} {text!r}: a log range needs start > 0 and stop > 0")
-    return np.geomspace(start, stop, num)
+    if values is None:
+        check_points(num, f"--{name} {text!r}")
+        if log and (start <= 0 or stop <= 0):
+            raise InputError(f"--{name} {text!r}: a log range needs start > 0 and stop > 0")
+        values = np.geomspace(start, stop, num) if log else np.linspace(start, stop, num)
+    if values.size == 0:
+        raise InputError(f"--{name} {text!r} gives no value: give {VALUES_HELP}")
+    if not np.isfinite(values).all():
+        raise InputError(f"--{name} {text!r} holds a non-finite value ({values[~np.isfinite(values)][0]:g})")
+    return values
+
+
+def parse_names(text: str, name: str) -> list[str]:
+    """Comma-separated names (blanks dropped); an empty list is refused."""
+    from ..errors import InputError
+
+    names = [n for n in (s.strip() for s in text.split(",")) if n]
+    if not names:
+        raise InputError(f"--{name} {text!r} names nothing: give one or more comma-separated names")
+    return names
+
+
+def _strict_json(x: Any) -> Any:
+    """JSON has no infinities or NaN: NaN becomes null, ±inf the strings "inf" / "-inf"."""
+    if isinstance(x, dict):
+        return {k: _strict_json(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_strict_json(v) for v in x]
+    if isinstance(x, (np.generic, np.ndarray)):
+        return _strict_json(x.tolist())
+    if isinstance(x, float) and not np.isfinite(x):
+        return None if np.isnan(x) else ("inf" if x > 0 else "-inf")
+    return x
 
 
 def emit(rows: Sequence[dict[str, Any]], fmt: OutputFormat, title: str = "") -> None:
-    """Print rows (dicts with the same keys) as a rich table, JSON, CSV or Markdown on stdout."""
+    """Print rows (dicts with the same keys) as a rich table, JSON, CSV or Markdown on stdout.
+
+    JSON is strict (RFC 8259): NaN is written as ``null`` and ±infinity as the strings
+    ``"inf"`` / ``"-inf"`` (e.g. the critical size of a stable state).
+    """
     if fmt == OutputFormat.json:
-        typer.echo(json.dumps(list(rows), indent=2, default=float))
+        typer.echo(json.dumps(_strict_json(list(rows)), indent=2, allow_nan=False, default=str))
         return
     if not rows:
         return
@@ -153,7 +201,7 @@ def resolve_models(names: str | None, model_file: Any = None, *, option: str = "
 
     if names is None and model_file is None:
         names = ",".join(PAPER_MODELS)
-    models = [get_model(n.strip()) for n in (names or "").split(",") if n.strip()]
+    models = [get_model(n) for n in parse_names(names, option.lstrip("-"))] if names is not None else []
     if model_file is not None:
         from ..calibration.model_file import load_model_file
 

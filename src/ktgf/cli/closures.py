@@ -74,9 +74,16 @@ def coefficients(
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Reduced and SI transport coefficients of the models at states (phi, e)."""
+    from ..errors import InputError
+    from ..validation import check_material
+
     ms = resolve_models(model, model_file)
+    check_material(d=d, theta=theta, rho_s=rho_s)
     phis, es = np.meshgrid(parse_values(phi, "phi"), parse_values(e, "e"), indexing="ij")
     phis, es = phis.ravel(), es.ravel()
+    tiny = (phis > 0) & (phis < 1e-10)
+    if tiny.any():  # the SI coefficients scale with 1/phi: they overflow between 0 and 1e-10
+        raise InputError(f"solid fraction phi = {phis[tiny][0]:g} is out of range: valid phi = 0 or phi >= 1e-10")
     rows = []
     for m in ms:
         red = m.reduced(phis, es)

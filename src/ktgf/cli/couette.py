@@ -46,7 +46,7 @@ def run_cmd(
 
     With ``--model-file`` the file's model replaces the config's ``model`` (the config's walls stay).
     """
-    from ..couette.config import load_config, run_config
+    from ..couette.config import check_output_path, load_config, run_config
     from ..io import write_netcdf
 
     cfg = load_config(config)
@@ -55,7 +55,7 @@ def run_cmd(
         from ..calibration.model_file import load_model_file
 
         model = load_model_file(model_file).model
-    path = Path(out or cfg.output.path)
+    path = check_output_path(out, "--out") if out is not None else Path(cfg.output.path)
     ds = run_config(cfg, model, failed_path=path.with_suffix(".failed.nc"))
     write_netcdf(ds, path)
     emit([_summary(ds)], fmt, title=f"Couette ({ds.attrs['geometry']}) -> {path}")
@@ -204,16 +204,12 @@ def plot_cmd(
     out: Path = typer.Option(Path("couette.png"), "--out", "-o", help="Figure file."),
 ) -> None:
     """Plot u/U, phi and sqrt(theta)/U of saved Couette runs on one figure."""
-    import xarray as xr
-
-    from ..errors import InputError
+    from ..io import read_dataset
     from ..plotting.couette import plot_profiles
 
     datasets = {}
     for f in files:
-        if not f.exists():
-            raise InputError(f"file {str(f)!r} does not exist")
-        ds = xr.load_dataset(f)
+        ds = read_dataset(f, ("u", "phi", "theta"), "Couette profile written by `ktgf couette run`")
         datasets[f"{ds.attrs.get('model_label', f.stem)} ({f.name})"] = ds
     typer.echo(f"wrote {plot_profiles(datasets, out)}")
 

@@ -12,13 +12,15 @@ import typer
 
 from ..closures import get_model
 from ..errors import InputError
-from ..validation import check_positive, check_range
-from ._common import (DASK_HELP, MODEL_HELP, VALUES_HELP, OutputFormat, deprecated_alias, emit, handle_errors,
-                      model_file_option, parse_values, resolve_models)
+from ..validation import check_material, check_positive, check_range
+from ._common import (DASK_HELP, MODEL_HELP, VALUES_HELP, OutputFormat, check_points, deprecated_alias, emit,
+                      handle_errors, model_file_option, parse_values, resolve_models)
 
 hcs_app = typer.Typer(help="Homogeneous cooling state: Haff's law, linear stability, critical box sizes.",
                       no_args_is_help=True)
 
+#: Smallest solid fraction of the stability commands (L/d ~ 1/phi would overflow far below).
+PHI_MIN = 1e-10
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".eps", ".jpg", ".jpeg", ".tif", ".tiff")
 
 
@@ -28,6 +30,12 @@ def _models(text: str | None, model_file: Path | None = None) -> list[Any]:
 
 def _check_count(name: str, value: int, low: int) -> None:
     check_range(f"number of points {name}", value, low=low)
+    check_points(value, name)
+
+
+def _check_box(box: float) -> None:
+    # below one particle diameter the box's lowest mode is no continuum wave (and 2 pi/L overflows)
+    check_range("box side --box", box, low=1.0, why="L/d: at least one particle diameter")
 
 
 def _kind_of_output(out: Path, allowed: tuple[str, ...]) -> str:
@@ -58,7 +66,8 @@ def haff(
 
     kind = _kind_of_output(out, (".nc", "figure")) if out is not None else None
     _check_count("--n", n, 2)
-    check_positive("particle diameter d", d, "m")
+    check_material(d=d, theta=theta0)
+    check_range("solid fraction phi", phi, low=PHI_MIN, why="no collisions, no cooling at phi = 0")
     models = _models(model, model_file)
     for m in models:
         m.check(phi, e, theta0)
@@ -106,10 +115,12 @@ def stability(
     if method not in ("closed", "eig"):
         raise InputError(f"--method {method!r} is not valid: choose closed or eig")
     if box is not None:
-        check_positive("box side --box", box, "L/d")
-    phis, es = np.meshgrid(parse_values(phi, "phi"), parse_values(e, "e"), indexing="ij")
+        _check_box(box)
+    phi_values, e_values = parse_values(phi, "phi"), parse_values(e, "e")
+    check_points(phi_values.size * e_values.size, "--phi x --e")
+    phis, es = np.meshgrid(phi_values, e_values, indexing="ij")
     phis, es = phis.ravel(), es.ravel()
-    check_range("solid fraction phi", phis, low=0.0, low_open=True, why="L/d is infinite at phi = 0")
+    check_range("solid fraction phi", phis, low=PHI_MIN, why="L/d grows like 1/phi: it overflows in the dilute limit")
     rows = []
     for m in _models(model, model_file):
         r = m.reduced(phis, es)
@@ -125,6 +136,9 @@ def stability(
         l_perp, l_par = critical_box_size(phis, k_perp), critical_box_size(phis, k_par)
         if box is not None:
             kb = box_wavenumber(phis, box)
+            # k* = k ell: the hydrodynamic equations hold for k ell below ~1; far above, rates overflow
+            check_range("reduced wavenumber of the box's lowest mode k_box*", kb, high=1e3,
+                        why="k* = 0.82/(phi L/d): give a larger --box or phi")
             disp = dispersion_relation(r, kb)
         for i in range(phis.size):
             row: dict[str, Any] = {
@@ -176,8 +190,9 @@ def map_cmd(
     _kind_of_output(out, (".nc",))
     _check_count("--n-phi", n_phi, 1)
     _check_count("--n-e", n_e, 1)
-    check_range("--workers", workers, low=0)
-    check_range("smallest solid fraction phi-min", phi_min, low=0.0, high=1.0, low_open=True, high_open=True)
+    check_points(n_phi * n_e, "--n-phi x --n-e")
+    check_range("--workers", workers, low=0, high=256, why="local processes")
+    check_range("smallest solid fraction phi-min", phi_min, low=PHI_MIN, high=1.0, high_open=True)
     check_range("largest solid fraction phi-max", phi_max, low=phi_min, high=1.0, high_open=True)
     check_range("smallest restitution coefficient e-min", e_min, low=0.0, high=1.0, low_open=True)
     check_range("largest restitution coefficient e-max", e_max, low=e_min, high=1.0)
@@ -213,11 +228,9 @@ def plot_stability_map_cmd(
     es = parse_values(e, "e")
     check_range("restitution coefficient e", es, low=0.0, high=1.0, low_open=True)
     if source is not None:
-        import xarray as xr
+        from ..io import read_dataset
 
-        if not source.is_file():
-            raise InputError(f"--from {str(source)!r}: no such file")
-        ds = xr.load_dataset(source)
+        ds = read_dataset(source, ("phi", "e", "L_perp", "L_par"), "stability map written by `ktgf hcs map`")
     else:
         _check_count("--n-phi", n_phi, 2)
         check_range("smallest solid fraction phi-min", phi_min, low=0.0, high=1.0, low_open=True, high_open=True)
@@ -243,11 +256,12 @@ def plot_dispersion_cmd(
     _kind_of_output(out, ("figure",))
     m = load_model_file(model_file).model if model_file is not None else get_model(model)
     m.check(phi, e)
-    check_range("solid fraction phi", phi, low=0.0, low_open=True)
+    check_range("solid fraction phi", phi, low=PHI_MIN)
     if k_max is not None:
-        check_positive("largest wavenumber k-max", k_max)
+        # k* = k ell: hydrodynamics holds for k ell below ~1; far above, k*^2 overflows
+        check_range("largest wavenumber k-max", k_max, low=0.0, high=1e3, low_open=True, why="k* = k ell")
     if box is not None:
-        check_positive("box side --box", box, "L/d")
+        _check_box(box)
     typer.echo(f"wrote {plot_dispersion(m, phi, e, out, k_max=k_max, box=box)}")
 
 

@@ -15,20 +15,30 @@ def run(
     resume: Path = typer.Option(None, "--resume", help="Continue from this checkpoint (same config)."),
     output_dir: Path = typer.Option(None, "--output-dir", "-o", help="Override output.directory."),
     progress: bool = typer.Option(True, "--progress/--no-progress", help="Show the progress bar."),
+    overwrite: bool = typer.Option(False, "--overwrite", help="Delete the files of an earlier run in the output folder first."),
 ) -> None:
-    """Run a homogeneous-cooling-gas case; writes hcs.nc, checkpoint.npz, .vti and .png files."""
-    from ..solver.config import load_config
-    from ..solver.run import CHECKPOINT, TIMESERIES, Simulation
+    """Run a homogeneous-cooling-gas case; writes hcs.nc, checkpoint.npz, .vti and .png files.
 
-    cfg = load_config(case)
-    sim = Simulation(cfg, output_dir)
-    try:
-        ds = sim.run(resume=resume, progress=progress)
-    except KeyboardInterrupt:
-        ck = sim.directory / CHECKPOINT
-        typer.echo(f"Interrupted at t = {sim.time:.6g} s after {sim.steps} steps; checkpoint written to {ck}.\n"
-                   f"Resume with: ktgf run {case} --resume {ck}", err=True)
-        raise typer.Exit(130) from None
+    Ctrl-C stops after the current chunk with a checkpoint that matches the files written
+    (exit code 130); `--resume` continues bit for bit.
+    """
+    from ..solver.interrupt import STOP, Interrupted
+
+    with STOP:  # from here on Ctrl-C is a flag, also during imports and the first compilation
+        try:
+            from ..solver.config import load_config
+            from ..solver.run import TIMESERIES, Simulation
+
+            cfg = load_config(case)
+            sim = Simulation(cfg, output_dir)
+            ds = sim.run(resume=resume, progress=progress, overwrite=overwrite)
+        except Interrupted as exc:
+            tail = f"\nResume with: ktgf run {case} --resume {exc.checkpoint}" if exc.checkpoint else ""
+            typer.echo(f"{exc}{tail}", err=True)
+            raise typer.Exit(exc.exit_code) from None
+        except KeyboardInterrupt:  # before the handler was installed
+            typer.echo("interrupted; nothing written", err=True)
+            raise typer.Exit(130) from None
     last = ds.isel(time=-1)
     typer.echo(
         f"done: {sim.steps} steps, t = {float(last.time):.6g} s (tau = {float(last.tau):.4g}); "
@@ -45,14 +55,12 @@ def plot_run(
 ) -> None:
     """Plot θ/θ_Haff, transverse and longitudinal kinetic energy / θ and density variance against τ."""
     import matplotlib.pyplot as plt
-    import xarray as xr
 
-    from ..errors import InputError
+    from ..io import read_dataset
     from ..plotting import save
 
-    if not timeseries.is_file():
-        raise InputError(f"time series {str(timeseries)!r} does not exist")
-    ds = xr.open_dataset(timeseries)
+    ds = read_dataset(timeseries, ("tau", "theta_mean", "theta_haff", "ke_transverse", "ke_longitudinal",
+                                   "density_variance"), "time series written by `ktgf run`")
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
     ax[0].plot(ds.tau, ds.theta_mean / ds.theta_haff)
     ax[0].set_xlabel("τ")

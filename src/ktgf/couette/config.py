@@ -36,14 +36,15 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from ..closures import get_model
 from ..errors import InputError, KtgfError
-from ..io import read_toml
+from ..io import plain, read_toml
 from .geometry import AnnularCell, PlanarCell
 from .run import Material
 from .walls import ENERGY_CONDITIONS, MOMENTUM_CONDITIONS, WALL_TYPES, Wall
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # strict: ``restitution = true`` must not become e = 1; no inf/NaN anywhere
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
 
 
 class PlanarConfig(_Strict):
@@ -134,9 +135,28 @@ class NumericsConfig(_Strict):
     tol: float = Field(1e-10, gt=0, lt=1e-3)
 
 
+def check_output_path(path: str | Path, what: str = "output.path") -> Path:
+    """A netCDF file name (``.nc``) that is not a folder; raise :class:`InputError` otherwise."""
+    p = Path(path)
+    if p.name in ("", ".", "..") or p.is_dir():
+        raise InputError(f"{what} = {str(path)!r} is a folder: give a netCDF file name such as 'couette.nc'")
+    if p.suffix.lower() != ".nc":
+        raise InputError(f"{what} = {str(path)!r} has extension {p.suffix or '(none)'!r}: valid .nc (netCDF)")
+    return p
+
+
 class OutputConfig(_Strict):
     path: str = "couette.nc"
     phi_rcp: float = Field(0.64, gt=0, lt=1, description="random close packing used to flag invalid runs")
+
+    @field_validator("path")
+    @classmethod
+    def _path(cls, v: str) -> str:
+        try:
+            check_output_path(v, "path")
+        except InputError as exc:
+            raise ValueError(str(exc)) from None
+        return v
 
 
 class CouetteConfig(_Strict):
@@ -205,7 +225,7 @@ def _format(exc: ValidationError) -> str:
 def parse_config(data: dict[str, Any]) -> CouetteConfig:
     """Validate a config mapping; raise :class:`InputError` naming the offending field(s)."""
     try:
-        return CouetteConfig.model_validate(data)
+        return CouetteConfig.model_validate(plain(data))
     except ValidationError as exc:
         raise InputError(_format(exc)) from None
 

@@ -4,7 +4,7 @@ Glossary of the Dataset (coordinate ``y`` [m] for the planar cell, ``r`` [m] for
 ``u`` tangential velocity, ``phi`` solid fraction, ``theta`` granular temperature, ``p`` pressure,
 ``shear_rate``, ``shear_stress`` (η × shear rate at the nodes), ``heat_flux`` (q_x on the faces),
 ``wall_*`` per wall (bottom = y = −H/2 or r = R_i; top = y = +H/2 or r = R_o), the energy budget
-and the validity flag (max φ against φ_rcp, model.md §9).
+and the validity flag (:func:`validity`: max φ against φ_rcp and the model's packing limit, θ collapse).
 """
 
 from __future__ import annotations
@@ -27,6 +27,34 @@ from .solver import CouetteConvergenceError, solve
 from .walls import Wall
 
 WALLS = ("bottom", "top")
+#: A core is jammed when max φ is within this fraction of the model's own packing limit ...
+JAM_TOLERANCE = 0.01
+#: ... or when θ has collapsed: min θ below this fraction of max θ, or below this fraction of U².
+THETA_COLLAPSE_RATIO = 1e-4
+THETA_COLLAPSE_U2 = 1e-10
+
+
+def validity(max_phi: float, phi_rcp: float, phi_max_model: float, theta: np.ndarray, v_scale: float,
+             model_name: str = "", jam_tolerance: float = JAM_TOLERANCE) -> str:
+    """``"ok"`` or why a Couette solution is not physical (model.md §9 and issue 11).
+
+    Three tests, for every model: max φ above random close packing φ_rcp; max φ within
+    ``jam_tolerance`` (relative) of the model's own packing limit, where its pressure and
+    viscosity diverge and the "solution" is a jammed plug (models whose limit is φ_rcp could
+    never trip the first test); and a collapsed temperature (min θ < 1e-4 max θ or < 1e-10 U²:
+    a frozen core, e.g. θ ≈ 1e-17 U²).
+    """
+    reasons = []
+    if max_phi > phi_rcp:
+        reasons.append(f"max phi = {max_phi:.4f} exceeds phi_rcp = {phi_rcp:g}")
+    if phi_max_model < 1.0 and max_phi >= (1.0 - jam_tolerance) * phi_max_model:
+        reasons.append(f"jammed core: max phi = {max_phi:.4f} is within {jam_tolerance:.0%} of the packing limit "
+                       f"{phi_max_model:g} of {model_name or 'the model'}")
+    t_min, t_max = float(np.min(theta)), float(np.max(theta))
+    if not (np.isfinite(t_min) and t_min >= THETA_COLLAPSE_RATIO * t_max and t_min >= THETA_COLLAPSE_U2 * v_scale**2):
+        reasons.append(f"collapsed temperature: min theta = {t_min / v_scale**2:.3g} U^2 "
+                       f"({t_min / t_max if t_max > 0 else float('nan'):.3g} of max theta)")
+    return "ok" if not reasons else "invalid: " + "; ".join(reasons) + " (model.md section 9)"
 
 
 @dataclass(frozen=True)
@@ -89,7 +117,9 @@ def to_dataset(problem: Problem, X: np.ndarray, material: Material, *, phi_rcp: 
     dissipation = float(problem.V @ t["gamma"])
     budget = power_in - dissipation + float(np.sum(Bw * (heat_in - slip_work)))
     max_phi = float(phi.max())
-    valid = max_phi <= phi_rcp
+    verdict = validity(max_phi, phi_rcp, float(problem.model.phi_max), theta * V**2, V,
+                       problem.model.label or problem.model.name)
+    valid = verdict == "ok"
 
     ds = xr.Dataset(
         {
@@ -131,7 +161,9 @@ def to_dataset(problem: Problem, X: np.ndarray, material: Material, *, phi_rcp: 
         "max_phi": max_phi,
         "phi_rcp": phi_rcp,
         "physically_valid": int(valid),
-        "validity": "ok" if valid else f"invalid: max phi = {max_phi:.4f} exceeds phi_rcp = {phi_rcp:g} (model.md section 9)",
+        "validity": verdict,
+        "model_packing_limit": float(problem.model.phi_max),
+        "theta_min_over_U2": float(theta.min()),
         "power_in": power_in * flux_scale,
         "bulk_dissipation": dissipation * flux_scale,
         "energy_budget_relative_error": abs(budget) / abs(power_in) if power_in else np.nan,

@@ -23,9 +23,10 @@ from ..validation import check_positive, check_range
 def cooling_rate(model: Model | str, phi: Any, e: Any, theta0: Any, *, d: float) -> Any:
     """ζ0(θ0) = ν0(φ, θ0) ζ0*(φ, e) [1/s] for particles of diameter ``d`` [m]."""
     model = get_model(model)
-    phi, e, theta0 = asarray(phi), asarray(e), asarray(theta0)
-    model.check(phi, e, theta0)
+    check_positive("granular temperature theta0", theta0, "m^2/s^2")  # required here (None is not "no theta")
+    model.check(phi, e, theta0)  # on the values as given, so that the error names them
     check_positive("particle diameter d", d, "m")
+    phi, e, theta0 = asarray(phi), asarray(e), asarray(theta0)
     return nu0(phi, theta0, d) * model.reduced(phi, e, check=False).zeta0
 
 

@@ -15,11 +15,17 @@ def save(fig: Any, out: str | Path) -> Path:
     import matplotlib.pyplot as plt
 
     from ..errors import InputError
+    from ..io import atomic_path
 
     out = Path(out)
+    formats = fig.canvas.get_supported_filetypes()
+    if out.suffix.lower().lstrip(".") not in formats:
+        plt.close(fig)
+        raise InputError(f"figure file {str(out)!r} has extension {out.suffix or '(none)'!r}: "
+                         f"valid {', '.join('.' + f for f in sorted(formats))}")
     try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(out, dpi=150, bbox_inches="tight")
+        with atomic_path(out) as tmp:  # a figure is complete or absent, never half-written
+            fig.savefig(tmp, dpi=150, bbox_inches="tight")
     except (PermissionError, OSError) as exc:
         raise InputError(f"cannot write figure {str(out)!r}: {exc.strerror or exc}") from exc
     finally:

@@ -22,7 +22,7 @@ def plot_profiles(datasets: Mapping[str, Any], out: str | Path, *, dem: Any = No
         U = float(params.get("velocity_scale", 1.0))
         x = ds[coord].values / d
         style = "--" if not int(params.get("physically_valid", 1)) else "-"
-        tag = "" if int(params.get("physically_valid", 1)) else " (invalid: max φ > φ_rcp)"
+        tag = "" if int(params.get("physically_valid", 1)) else " (invalid: not physical)"
         axes[0].plot(ds["u"].values / U, x, style, label=f"{label}{tag}")
         axes[1].plot(ds["phi"].values, x, style)
         axes[2].plot(np.sqrt(ds["theta"].values) / U, x, style)

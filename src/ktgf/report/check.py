@@ -1,18 +1,20 @@
 """Browser-free completeness check of a written report.
 
 A report is complete when every image and data file the page references exists in the output
-folder, every figure and netCDF file there is referenced, every figure links the data behind
-it, no reference leaves the folder (the page is self-contained) and every expected section is
-on the page.
+folder and is whole (a PNG ends with its IEND chunk, a netCDF file starts with its signature,
+and each file matches the size and SHA-256 its section's cache entry recorded), every figure and
+netCDF file there is referenced, every figure links the data behind it, no reference leaves the
+folder (the page is self-contained) and every expected section is on the page.
 """
 
 from __future__ import annotations
 
+import json
 from html.parser import HTMLParser
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
-from .framework import DATA_DIR, FIGURE_DIR
+from .framework import CACHE_DIR, DATA_DIR, FIGURE_DIR, damaged_files
 from .page import FIXED_SECTIONS, PAGE_NAME, section_id
 
 
@@ -51,6 +53,40 @@ class _Refs(HTMLParser):
                 self.figures_without_data += 1
 
 
+_PNG_START, _PNG_END = b"\x89PNG\r\n\x1a\n", b"IEND\xaeB`\x82"
+_NC_STARTS = (b"CDF\x01", b"CDF\x02", b"CDF\x05", b"\x89HDF\r\n\x1a\n")
+
+
+def _broken(path: Path) -> str | None:
+    """Why a figure or data file is not whole (None if it looks whole)."""
+    try:
+        size = path.stat().st_size
+        with open(path, "rb") as fh:
+            head = fh.read(8)
+            fh.seek(max(0, size - 8))
+            tail = fh.read(8)
+    except OSError as exc:
+        return f"unreadable ({exc.strerror or exc})"
+    if path.suffix == ".png" and not (head == _PNG_START and tail == _PNG_END):
+        return "not a complete PNG (truncated or damaged)"
+    if path.suffix == ".nc" and not (size > 32 and head.startswith(_NC_STARTS)):
+        return "not a complete netCDF file (empty, truncated or damaged)"
+    return None
+
+
+def _cache_manifests(out: Path) -> dict[str, dict]:
+    """File manifests of the cache entries (file -> recorded size and hash)."""
+    files: dict[str, dict] = {}
+    for entry in sorted((out / CACHE_DIR).glob("*.json")):
+        try:
+            manifest = json.loads(entry.read_text(encoding="utf-8")).get("files", {})
+        except (OSError, ValueError, AttributeError):
+            continue
+        if isinstance(manifest, dict):
+            files.update({k: v for k, v in manifest.items() if isinstance(v, dict)})
+    return files
+
+
 def check_report(out: str | Path, expected_sections: list[str] | None = None) -> list[str]:
     """Problems that make the report at ``out`` incomplete (an empty list means complete).
 
@@ -72,9 +108,14 @@ def check_report(out: str | Path, expected_sections: list[str] | None = None) ->
     parser.feed(page.read_text(encoding="utf-8"))
     problems: list[str] = []
     problems += [f"reference leaves the report folder: {ref}" for ref in parser.external]
+    manifests = _cache_manifests(out)
     for ref in parser.images + parser.links:
         if not (out / ref).is_file():
             problems.append(f"referenced file is missing: {ref}")
+            continue
+        why = _broken(out / ref) or (damaged_files(out, {ref: manifests[ref]}) if ref in manifests else None)
+        if why:
+            problems.append(f"referenced file is damaged: {ref}: {why if isinstance(why, str) else why[0]}")
     referenced = {Path(r).as_posix() for r in parser.images + parser.links}
     for sub, pattern in ((FIGURE_DIR, "*.png"), (DATA_DIR, "*.nc")):
         for f in sorted((out / sub).rglob(pattern)):

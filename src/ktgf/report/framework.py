@@ -295,24 +295,50 @@ def _atomic_write(path: Path, text: str) -> None:
         raise
 
 
+def file_digest(path: Path) -> dict[str, Any]:
+    """Size and SHA-256 of a file (what the cache records of every file a section wrote)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return {"size": path.stat().st_size, "sha256": h.hexdigest()}
+
+
+def damaged_files(out: Path, manifest: dict[str, Any]) -> list[str]:
+    """Files of a cache entry's manifest that are missing or differ (size or hash) from what was written."""
+    bad = []
+    for rel, want in manifest.items():
+        f = out / rel
+        try:
+            if f.stat().st_size != want.get("size") or file_digest(f)["sha256"] != want.get("sha256"):
+                bad.append(f"{rel} (size or SHA-256 differs from what its section wrote)")
+        except OSError:
+            bad.append(f"{rel} (missing)")
+    return bad
+
+
 def load_cached(out: Path, key: str, digest: str) -> SectionResult | None:
-    """The cached result of section ``key`` if its hash matches and all its files still exist."""
+    """The cached result of section ``key`` if its hash matches and every file it wrote is still
+    there with the size and SHA-256 recorded when it was written (a truncated figure or an
+    emptied netCDF file makes the section run again)."""
     path = out / CACHE_DIR / f"{key}.json"
     try:
         entry = json.loads(path.read_text(encoding="utf-8"))
         if entry.get("hash") != digest:
             return None
         result = SectionResult.from_json(entry["result"])
-    except (OSError, ValueError, KeyError, TypeError):
+        manifest = entry["files"]
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return None
-    if not all((out / f).is_file() for f in result.files()):
+    if not isinstance(manifest, dict) or set(manifest) != set(result.files()) or damaged_files(out, manifest):
         return None
     result.status = "cached"
     return result
 
 
 def store_cached(out: Path, result: SectionResult, digest: str, record: dict[str, Any]) -> None:
-    entry = {"hash": digest, "record": record, "result": result.to_json()}
+    files = {f: file_digest(out / f) for f in result.files() if (out / f).is_file()}
+    entry = {"hash": digest, "record": record, "result": result.to_json(), "files": files}
     _atomic_write(out / CACHE_DIR / f"{result.key}.json", json.dumps(entry, indent=1, default=str))
 
 

@@ -34,13 +34,15 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from ..errors import InputError, KtgfError
-from ..io import read_toml
+from ..io import plain, read_toml
 from .fluxes import LIMITERS, RIEMANN_SOLVERS
 from .grid import MIN_CELLS
 
 
 class _Section(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # strict: ``restitution = true`` must not become e = 1, nor ``cells = [8.5]`` 8;
+    # allow_inf_nan=False: ``time.end = inf`` would run for ever
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
 
 
 class ModelSection(_Section):
@@ -59,7 +61,7 @@ class InitialSection(_Section):
     temperature: float = Field(..., gt=0.0, description="theta0 [m^2/s^2]")
     perturbation: Literal["random", "mode", "none"] = "random"
     amplitude: float = Field(1e-2, ge=0.0, le=0.5)
-    seed: int = 0
+    seed: int = Field(0, ge=0, le=2**63 - 1, description="seed of NumPy's default_rng")
     max_mode: int = Field(2, ge=1, description="random field: Fourier modes |n| <= max_mode")
     mode: list[int] | None = None
     kind: Literal["transverse", "longitudinal"] = "transverse"
@@ -103,7 +105,7 @@ class NumericsSection(_Section):
     limiter: str = "vanleer"
     riemann: str = "hll"
     precision: Literal["float64", "float32"] = "float64"
-    phi_stop: float | None = Field(None, gt=0.0, description="stop when max phi reaches this (default 0.99 phi_max)")
+    phi_stop: float | None = Field(None, gt=0.0, lt=1.0, description="stop when max phi reaches this (default 0.99 phi_max)")
 
     @field_validator("limiter")
     @classmethod
@@ -124,11 +126,11 @@ class TimeSection(_Section):
     end: float = Field(..., gt=0.0)
     unit: Literal["tau", "haff", "s"] = "tau"
     outputs: int = Field(50, ge=1, le=100000)
-    max_steps_per_call: int = Field(200, ge=1, description="steps per compiled call (progress granularity)")
+    max_steps_per_call: int = Field(200, ge=1, le=2**31 - 1, description="steps per compiled call (progress granularity)")
 
 
 class OutputSection(_Section):
-    directory: str = "ktgf-run"
+    directory: str = Field("ktgf-run", min_length=1)
     checkpoint_every: int = Field(10, ge=1, description="outputs between checkpoints")
     vtk_every: int = Field(0, ge=0, description="outputs between VTK files (0: first and last only)")
     vtk: bool = True
@@ -161,7 +163,7 @@ def _fmt_error(err: dict[str, Any]) -> str:
 def parse_config(data: dict[str, Any], source: str = "config") -> Config:
     """Validate a config dict; raise :class:`InputError` naming every bad field, then check the physics."""
     try:
-        cfg = Config.model_validate(data)
+        cfg = Config.model_validate(plain(data))
     except ValidationError as exc:
         raise InputError(f"{source}: " + "; ".join(_fmt_error(e) for e in exc.errors())) from None
     check_physics(cfg, source)
@@ -191,11 +193,17 @@ def check_physics(cfg: Config, source: str = "config") -> None:
         )
     if phi0 >= stop:
         raise InputError(f"{source}: field initial.solid_fraction = {phi0:g} is at or above numerics.phi_stop = {stop:g}")
-    mode = cfg.initial.mode
-    if cfg.initial.perturbation == "mode" and (mode is None or len(mode) != len(cfg.grid.cells) or not any(mode)):
+    mode, cells = cfg.initial.mode, cfg.grid.cells
+    if cfg.initial.perturbation == "mode" and (mode is None or len(mode) != len(cells) or not any(mode)):
         raise InputError(
-            f"{source}: field initial.mode = {mode} must have {len(cfg.grid.cells)} integers, not all 0"
+            f"{source}: field initial.mode = {mode} must have {len(cells)} integers, not all 0"
         )
+    if mode is not None and any(abs(n) > c // 2 for n, c in zip(mode, cells)):
+        raise InputError(f"{source}: field initial.mode = {mode} is out of range: valid |mode[a]| <= cells[a]/2 = "
+                         f"{[c // 2 for c in cells]} (the grid resolves no shorter wave)")
+    if cfg.initial.max_mode > max(cells) // 2:
+        raise InputError(f"{source}: field initial.max_mode = {cfg.initial.max_mode} is out of range: valid "
+                         f"1 <= max_mode <= {max(cells) // 2} (half the largest cell count)")
     if cfg.grid.relative_to is not None:
         from ..hcs.stability import critical_wavenumbers
 

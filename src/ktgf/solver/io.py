@@ -2,15 +2,16 @@
 
 The VTK writer is a small XML ImageData writer (VTK file format 1.0, base64 "binary" data
 with a UInt64 byte-count header) that ParaView opens directly; fields are cell data.
-Checkpoints are ``.npz`` files written atomically (write to a temporary name, then rename),
-so an interrupted write never destroys the previous one.
+Every file is written atomically (a unique temporary name, then ``os.replace``), so an
+interrupted write never destroys the previous version and two writers never share a file.
+Checkpoints are ``.npz`` files with a format version and a SHA-256 of their contents.
 """
 
 from __future__ import annotations
 
 import base64
+import hashlib
 import json
-import os
 from pathlib import Path
 from typing import Any
 
@@ -83,40 +84,92 @@ def read_vti(path: str | Path) -> dict[str, np.ndarray]:
 
 
 def _write_text(path: Path, text: str) -> None:
+    from ..io import atomic_path
+
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text)
+        with atomic_path(path) as tmp:
+            tmp.write_text(text, encoding="ascii")
     except (PermissionError, OSError) as exc:
         raise InputError(f"cannot write file {str(path)!r}: {exc.strerror or exc}") from exc
 
 
+#: Version of the checkpoint layout; :func:`load_checkpoint` refuses any other.
+CHECKPOINT_FORMAT = 2
+_CHECKPOINT_KEYS = ("format", "hash", "U", "t", "steps", "output_index", "history", "config")
+
+
+def _content_hash(U: np.ndarray, t: float, steps: int, output_index: int, history: str, config: str) -> str:
+    """SHA-256 of everything a checkpoint holds (state bytes, shape, dtype, counters, history, config)."""
+    h = hashlib.sha256()
+    head = {"format": CHECKPOINT_FORMAT, "shape": list(U.shape), "dtype": U.dtype.str, "t": float(t).hex(),
+            "steps": int(steps), "output_index": int(output_index)}
+    h.update(json.dumps(head, sort_keys=True).encode())
+    h.update(np.ascontiguousarray(U).tobytes())
+    h.update(history.encode())
+    h.update(config.encode())
+    return h.hexdigest()
+
+
 def save_checkpoint(path: str | Path, U: np.ndarray, t: float, steps: int, output_index: int,
                     history: dict[str, list], config_json: str) -> Path:
-    """Write a checkpoint atomically: state, time, counters, diagnostics so far and the config."""
+    """Write a checkpoint atomically: state, time, counters, diagnostics so far, the config, a format
+    version and a SHA-256 of all of it (checked by :func:`load_checkpoint`)."""
+    from ..io import atomic_path
+
     path = Path(path)
-    tmp = path.with_name(path.name + ".tmp.npz")
+    U = np.asarray(U)
+    hist = json.dumps({k: np.asarray(v).tolist() for k, v in history.items()})
+    digest = _content_hash(U, t, steps, output_index, hist, config_json)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        np.savez(
-            tmp, U=np.asarray(U), t=np.float64(t), steps=np.int64(steps), output_index=np.int64(output_index),
-            history=json.dumps({k: np.asarray(v).tolist() for k, v in history.items()}), config=config_json,
-        )
-        os.replace(tmp, path)
+        with atomic_path(path) as tmp, open(tmp, "wb") as f:
+            np.savez(f, format=np.int64(CHECKPOINT_FORMAT), hash=digest, U=U, t=np.float64(t), steps=np.int64(steps),
+                     output_index=np.int64(output_index), history=hist, config=config_json)
     except (PermissionError, OSError) as exc:
         raise InputError(f"cannot write checkpoint {str(path)!r}: {exc.strerror or exc}") from exc
     return path
 
 
 def load_checkpoint(path: str | Path) -> dict[str, Any]:
-    """Read a checkpoint written by :func:`save_checkpoint`."""
+    """Read a checkpoint written by :func:`save_checkpoint`, checking its format version and hash.
+
+    Raises :class:`InputError` with one line naming what is wrong: a missing, unreadable or
+    truncated file, a missing field, another format version or content that does not match its
+    hash.  Whether the contents fit a run is checked by the run (:meth:`Simulation.run`).
+    """
     path = Path(path)
+    name = repr(str(path))
     if not path.is_file():
-        raise InputError(f"checkpoint {str(path)!r} does not exist")
-    with np.load(path) as z:
-        return {
-            "U": z["U"], "t": float(z["t"]), "steps": int(z["steps"]), "output_index": int(z["output_index"]),
-            "history": {k: list(v) for k, v in json.loads(str(z["history"])).items()}, "config": str(z["config"]),
-        }
+        raise InputError(f"checkpoint {name} does not exist" + (" (it is a directory)" if path.is_dir() else ""))
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            missing = [k for k in _CHECKPOINT_KEYS if k not in z.files]
+            if missing == list(_CHECKPOINT_KEYS[:2]):
+                raise InputError(f"checkpoint {name} has no format version or hash (written by an older ktgf?); "
+                                 "start the run again with --overwrite")
+            if missing:
+                raise InputError(f"checkpoint {name} lacks the field(s) {', '.join(missing)}: not a ktgf checkpoint")
+            fmt = int(z["format"])
+            if fmt != CHECKPOINT_FORMAT:
+                raise InputError(f"checkpoint {name} has format version {fmt}; this ktgf reads version {CHECKPOINT_FORMAT}")
+            raw = {k: z[k] for k in _CHECKPOINT_KEYS}
+    except InputError:
+        raise
+    except Exception as exc:  # zip, CRC, npy header, decode errors: all mean "damaged"
+        raise InputError(f"checkpoint {name} is unreadable (truncated or not a ktgf checkpoint: "
+                         f"{type(exc).__name__}: {exc})".replace("\n", " ")) from None
+    try:
+        U, hist, config = raw["U"], str(raw["history"]), str(raw["config"])
+        t, steps, k = float(raw["t"]), int(raw["steps"]), int(raw["output_index"])
+        ok = _content_hash(U, t, steps, k, hist, config) == str(raw["hash"])
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"checkpoint {name} has a field of the wrong type ({exc})") from None
+    if not ok:
+        raise InputError(f"checkpoint {name} is corrupt: its contents do not match their SHA-256 (file altered or damaged)")
+    try:
+        history = {key: list(v) for key, v in json.loads(hist).items()}
+    except (ValueError, AttributeError, TypeError) as exc:
+        raise InputError(f"checkpoint {name}: field history is not a JSON table ({exc})") from None
+    return {"U": U, "t": t, "steps": steps, "output_index": k, "history": history, "config": config}
 
 
 def save_slices(path: str | Path, grid: Grid, fields: dict[str, np.ndarray], title: str = "") -> Path:

@@ -5,7 +5,11 @@ time in chunks of ``time.max_steps_per_call`` steps.  The step sequence depends 
 state and the next output time (a chunk boundary never shortens a step), so a run resumed
 from any checkpoint reproduces the uninterrupted run bit for bit.
 
-* Ctrl-C (KeyboardInterrupt) between chunks writes ``checkpoint.npz`` and re-raises.
+* Ctrl-C / SIGTERM set a flag (:mod:`.interrupt`) polled between chunks; the run then writes
+  ``checkpoint.npz`` and ``hcs.nc`` for the outputs recorded so far and raises
+  :class:`~.interrupt.Interrupted`.  The time series is also written at every checkpoint.
+* The output folder is locked for the run (:mod:`.outdir`); a fresh run will not start over
+  another run's files without ``overwrite``.
 * A step that leaves the physical state space is rejected; the last good state is written
   to ``checkpoint.npz`` and :class:`~ktgf.errors.DivergenceError` names the field, the cell,
   its position and the time.
@@ -15,6 +19,8 @@ from __future__ import annotations
 
 import functools
 import json
+import math
+import os
 import time as _time
 from collections.abc import Callable
 from pathlib import Path
@@ -26,12 +32,14 @@ import numpy as np
 
 from ..closures import get_model
 from ..closures.coefficients import mean_free_path
-from ..errors import DivergenceError, InputError
+from ..errors import DivergenceError, InputError, KtgfError
 from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
+from ..io import write_netcdf
 from .config import Config
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
 from .grid import Grid
 from .initial import haff_time, random_velocity, single_mode, t_of_tau, tau_of_t, uniform_fields
+from .interrupt import STOP, Interrupted, fault_hook
 from .io import load_checkpoint, save_checkpoint, save_slices, write_vti
 from .physics import Physics
 from .state import PRIMITIVE_NAMES, conservative, primitive
@@ -39,6 +47,64 @@ from .stepping import STATUS_MESSAGES, Numerics, advance, state_status, step
 
 CHECKPOINT = "checkpoint.npz"
 TIMESERIES = "hcs.nc"
+HISTORY_KEYS = ("time", *SCALARS, *PER_AXIS)
+#: Config fields that may differ between a checkpoint and the run resuming it: where and how
+#: often files are written, the chunk size (the step sequence does not depend on it) and the
+#: end time / output count (outputs after the last one recorded follow the new schedule).
+RESUMABLE_CHANGES = ("output.directory", "output.checkpoint_every", "output.vtk_every", "output.vtk",
+                     "output.png", "time.max_steps_per_call", "time.end", "time.outputs")
+
+
+#: Peak memory of a run ≈ MEMORY_FACTOR × the state (5 fields); measured as the peak RSS of one
+#: compiled chunk at 32³, 64³ and 96³ (float64, CPU): +578 MB for +32.5 MB of state, i.e. 18×.
+MEMORY_FACTOR = 20
+
+
+def machine_memory() -> int | None:
+    """Physical memory of this machine [bytes] (None if unknown)."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def _bytes(n: float) -> str:
+    for unit in ("B", "kB", "MB", "GB", "TB", "PB"):
+        if n < 1000 or unit == "PB":
+            return f"{n:.3g} {unit}"
+        n /= 1000
+    return f"{n:.3g} PB"
+
+
+def check_memory(cells: tuple[int, ...], precision: str, available: int | None = None) -> int:
+    """Estimate the memory of a run and refuse (:class:`InputError`) one that exceeds the machine's."""
+    itemsize = 8 if precision == "float64" else 4
+    state = 5 * math.prod(cells) * itemsize
+    need = MEMORY_FACTOR * state
+    have = machine_memory() if available is None else available
+    if have is not None and need > have:
+        raise InputError(
+            f"field grid.cells = {list(cells)} needs about {_bytes(need)} of memory ({MEMORY_FACTOR} x the "
+            f"{_bytes(state)} state in {precision}); this machine has {_bytes(have)}: use fewer cells"
+            + (" or numerics.precision = 'float32'" if precision == "float64" else "")
+        )
+    return need
+
+
+def _diff(a: Any, b: Any, prefix: str = "") -> list[str]:
+    """Dotted names of the leaves that differ between two JSON-like dicts."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        out = []
+        for key in sorted(set(a) | set(b)):
+            out += _diff(a.get(key), b.get(key), f"{prefix}{key}.")
+        return out
+    return [] if a == b else [prefix.rstrip(".") or "config"]
+
+
+def _get(d: Any, dotted: str) -> Any:
+    for key in dotted.split("."):
+        d = d.get(key) if isinstance(d, dict) else None
+    return d
 
 
 def box_lengths(cfg: Config) -> tuple[float, ...]:
@@ -99,6 +165,7 @@ class Simulation:
 
     def _setup(self, cfg: Config, directory: str | Path | None) -> None:
         self.cfg = cfg
+        check_memory(tuple(cfg.grid.cells), cfg.numerics.precision)
         self.model = get_model(cfg.model.name, **cfg.model.options)
         phi_stop = cfg.numerics.phi_stop if cfg.numerics.phi_stop is not None else 0.99 * self.model.phi_max
         self.phys = Physics(self.model, cfg.model.restitution, cfg.particles.diameter, cfg.particles.density, phi_stop)
@@ -111,11 +178,22 @@ class Simulation:
         self.t_haff = haff_time(self.phys, self.phi0, self.theta0)
         end, n_out = cfg.time.end, cfg.time.outputs
         if cfg.time.unit == "tau":  # equal steps in τ: the natural clock of a cooling gas
-            self.output_times = np.asarray(t_of_tau(np.linspace(0.0, end, n_out + 1), self.phys, self.phi0, self.theta0))
+            with np.errstate(over="ignore"):  # an overflow (end too far along Haff's law) is refused below
+                self.output_times = np.asarray(t_of_tau(np.linspace(0.0, end, n_out + 1), self.phys, self.phi0,
+                                                        self.theta0))
         else:
             t_end = end if cfg.time.unit == "s" else end * self.t_haff
             self.output_times = np.linspace(0.0, t_end, n_out + 1)
         self.output_times[0] = 0.0
+        t = self.output_times
+        if not (np.isfinite(t).all() and np.all(np.diff(t) > 0)):
+            limit = float(tau_of_t(1e300, self.phys, self.phi0, self.theta0)) if cfg.time.unit == "tau" else (
+                1e300 / self.t_haff if cfg.time.unit == "haff" else 1e300)
+            raise InputError(
+                f"field time.end = {end:g} ({cfg.time.unit}) gives output times that overflow or coincide "
+                f"(t_end = {t[-1]:g} s): valid time.end <= {limit:.4g} {cfg.time.unit} and enough room for "
+                f"time.outputs = {n_out} distinct outputs"
+            )
         self.sharding = self._sharding(cfg.parallel.devices)
 
     def _sharding(self, ndev: int) -> Any:
@@ -164,18 +242,44 @@ class Simulation:
         progress: bool = True,
         on_chunk: Callable[[dict[str, Any]], None] | None = None,
         write_files: bool = True,
+        overwrite: bool = False,
     ) -> Any:
         """Integrate to the end time; return the diagnostics as an xarray Dataset.
 
         ``on_chunk`` is called after every compiled chunk with the loop's counters (tests use
-        it to simulate Ctrl-C).  ``resume`` is a checkpoint of the same config.
+        it to simulate Ctrl-C).  ``resume`` is a checkpoint of the same config (harmless
+        changes allowed: see :data:`RESUMABLE_CHANGES`).  With ``write_files`` the output folder
+        is locked for the run; a fresh run refuses a folder holding another run's files unless
+        ``overwrite`` (which deletes them).
+
+        SIGINT/SIGTERM stop the run between compiled chunks: the checkpoint then written
+        matches the outputs on disk, and :class:`~ktgf.solver.interrupt.Interrupted` (a
+        KeyboardInterrupt) is raised.
         """
+        from .outdir import RunLock
+
+        if resume is not None and overwrite:
+            raise InputError("--resume and --overwrite exclude each other: resume continues the run, overwrite deletes it")
+        with STOP:
+            if STOP.requested:
+                raise Interrupted("interrupted before the run started; nothing written", exit_code=STOP.exit_code)
+            lock = RunLock(self.directory) if write_files else None
+            if lock is not None:
+                lock.acquire()
+            try:
+                return self._run(resume, progress, on_chunk, write_files, overwrite)
+            finally:
+                if lock is not None:
+                    lock.release()
+
+    def _run(self, resume: str | Path | None, progress: bool, on_chunk: Callable[[dict[str, Any]], None] | None,
+             write_files: bool, overwrite: bool) -> Any:
+        n_out = len(self.output_times)
         if resume is not None:
-            ck = load_checkpoint(resume)
-            if ck["config"] != self.config_json():
-                raise InputError(f"checkpoint {str(resume)!r} was written by a different configuration")
-            U, t, steps, k, history = self.place(ck["U"]), ck["t"], ck["steps"], ck["output_index"], ck["history"]
+            U, t, steps, k, history = self._resume_from(resume)
         else:
+            if write_files:
+                self._claim_folder(overwrite)
             U, t, steps, k = self.initial_state(), 0.0, 0, 0
             status = int(state_status(tuple(U), self.phys))
             if status:
@@ -183,16 +287,19 @@ class Simulation:
                     f"initial state: {STATUS_MESSAGES[status]} (phi_stop = {self.phys.phi_stop:g}); "
                     "reduce initial.amplitude or raise numerics.phi_stop"
                 )
-            history = {name: [] for name in ("time", *SCALARS, *PER_AXIS)}
+            history = {name: [] for name in HISTORY_KEYS}
         self.history = history
         ckpt = self.directory / CHECKPOINT
-        n_out = len(self.output_times)
         bar = _Progress(progress, self.output_times[-1], self.t_haff, self.phys, self.phi0, self.theta0)
+        chunks = 0
         try:
             with bar:
                 while k < n_out:
                     target = float(self.output_times[k])
                     while t < target:
+                        self._poll()
+                        if chunks == 0:
+                            fault_hook("compile")
                         wall = _time.perf_counter()
                         U_new, t_new, n, status, dt = advance(
                             U, t, target, self.cfg.time.max_steps_per_call, self.grid, self.phys, self.num
@@ -202,27 +309,138 @@ class Simulation:
                             U, t, steps = U_new, float(t_new), steps + n
                             self._fail(U, t, float(dt), steps, status, k, history, ckpt, write_files)
                         U, t, steps = U_new, float(t_new), steps + n
+                        chunks += 1
                         bar.update(t, n, _time.perf_counter() - wall)
                         if on_chunk is not None:
                             on_chunk({"t": t, "steps": steps, "output_index": k})
+                        fault_hook("chunk", chunks)
+                    self._poll()
                     self._record(U, t, history)
                     if write_files:
+                        fault_hook("output", k)
                         self._write_fields(U, t, k)
                         if k % self.cfg.output.checkpoint_every == 0 or k == n_out - 1:
-                            save_checkpoint(ckpt, np.asarray(U), t, steps, k + 1, history, self.config_json())
+                            self._save(ckpt, U, t, steps, k + 1, history)
+                            fault_hook("checkpoint", k)
                     k += 1
-        except KeyboardInterrupt:
-            if write_files:
-                save_checkpoint(ckpt, np.asarray(U), t, steps, k, history, self.config_json())
+                self._poll()
+        except KeyboardInterrupt as exc:
+            # Whatever was under way, (U, t, steps, k) and the first k rows of the history form a
+            # consistent state: output k has not been recorded yet, or is recorded again on resume
+            # (its files are rewritten identically).
             self.state, self.time, self.steps = U, t, steps
-            raise
+            if not write_files:
+                raise
+            self._save(ckpt, U, t, steps, k, history)
+            done = "the run is complete" if k >= n_out else f"{k} of {n_out} outputs written"
+            raise Interrupted(
+                f"interrupted at t = {t:.6g} s after {steps} steps ({done}); checkpoint written to {ckpt}",
+                checkpoint=ckpt, t=t, steps=steps, exit_code=STOP.exit_code if STOP.requested else 130,
+            ) from (None if isinstance(exc, Interrupted) else exc)
         self.state, self.time, self.steps = U, t, steps
         ds = self.dataset(history)
         if write_files:
-            from ..io import write_netcdf
-
+            ds.attrs["run_complete"] = 1
             write_netcdf(ds, self.directory / TIMESERIES)
         return ds
+
+    @staticmethod
+    def _poll() -> None:
+        if STOP.requested:
+            raise Interrupted("interrupted")
+
+    def _save(self, ckpt: Path, U: Any, t: float, steps: int, k: int, history: dict[str, list]) -> None:
+        """Checkpoint and time series of the first ``k`` outputs (the time series first: a resume
+        rewrites it from the checkpoint, so a kill between the two writes loses nothing)."""
+        rows = {name: list(v[:k]) for name, v in history.items()}
+        if k > 0:
+            ds = self.dataset(rows, steps=steps)
+            ds.attrs["run_complete"] = 0
+            write_netcdf(ds, self.directory / TIMESERIES)
+        save_checkpoint(ckpt, np.asarray(U), t, steps, k, rows, self.config_json())
+
+    def _claim_folder(self, overwrite: bool) -> None:
+        """Refuse to start afresh over another run's files (or delete them with ``overwrite``)."""
+        from .outdir import clear_run_files, run_files
+
+        files = run_files(self.directory)
+        if not files:
+            return
+        if overwrite:
+            clear_run_files(self.directory)
+            return
+        where = repr(str(self.directory))
+        ckpt = self.directory / CHECKPOINT
+        state = ""
+        if ckpt.is_file():
+            try:
+                ck = load_checkpoint(ckpt)
+                total = int(json.loads(ck["config"])["time"]["outputs"]) + 1
+                if ck["output_index"] < total:
+                    state = f"an unfinished run (t = {ck['t']:.6g} s, {ck['output_index']} of {total} outputs)"
+            except (KtgfError, ValueError, KeyError, TypeError):
+                state = "an unfinished run (its checkpoint is unreadable)"
+        if state:
+            raise InputError(f"output folder {where} holds {state}: continue it with --resume {ckpt}, "
+                             "or start again with --overwrite (deletes its files)")
+        raise InputError(f"output folder {where} already holds the files of a run ({len(files)} files, e.g. "
+                         f"{files[0].name}): use --overwrite to replace them or choose another --output-dir")
+
+    def _resume_from(self, resume: str | Path) -> tuple:
+        """Load a checkpoint and check that it fits this run; return (U, t, steps, k, history)."""
+        ck = load_checkpoint(resume)
+        name = f"checkpoint {str(resume)!r}"
+        try:
+            old = json.loads(ck["config"])
+        except ValueError:
+            raise InputError(f"{name}: field config is not JSON") from None
+        new = self.cfg.model_dump(mode="json")
+        changed = [f for f in _diff(old, new) if f not in RESUMABLE_CHANGES]
+        if changed:
+            f = changed[0]
+            raise InputError(
+                f"{name} was written by a different configuration: field {f} = {_get(old, f)!r} in the checkpoint, "
+                f"{_get(new, f)!r} now (on resume only {', '.join(RESUMABLE_CHANGES)} may change)"
+            )
+        U, t, steps, k, history = ck["U"], ck["t"], ck["steps"], ck["output_index"], ck["history"]
+        shape = (5, *self.grid.cells)
+        if U.shape != shape:
+            raise InputError(f"{name}: field U has shape {U.shape}; this run needs {shape}")
+        if U.dtype != np.dtype(self.dtype):
+            raise InputError(f"{name}: field U has dtype {U.dtype}; this run needs {np.dtype(self.dtype)}")
+        if not np.isfinite(U).all():
+            raise InputError(f"{name}: field U holds NaN or infinite values")
+        t_end = float(self.output_times[-1])
+        if not (math.isfinite(t) and 0.0 <= t <= t_end):
+            raise InputError(f"{name}: field t = {t:g} s is out of range: valid 0 <= t <= {t_end:g} s (the end time)")
+        if steps < 0 or (steps == 0 and t > 0):
+            raise InputError(f"{name}: field steps = {steps} does not fit t = {t:g} s")
+        n_out = len(self.output_times)
+        if not 0 <= k <= n_out:
+            raise InputError(f"{name}: field output_index = {k} is out of range: valid 0 <= output_index <= {n_out}")
+        if sorted(history) != sorted(HISTORY_KEYS):
+            raise InputError(f"{name}: field history has the columns {sorted(history)}; expected {sorted(HISTORY_KEYS)}")
+        bad = [c for c in HISTORY_KEYS if len(history[c]) != k]
+        if bad:
+            raise InputError(f"{name}: field history.{bad[0]} has {len(history[bad[0]])} rows; output_index = {k}")
+        try:
+            rows = {c: np.asarray(history[c], dtype=float) for c in HISTORY_KEYS}
+        except (TypeError, ValueError):
+            raise InputError(f"{name}: field history holds non-numbers") from None
+        times = rows["time"]
+        if k and (np.any(np.diff(times) <= 0) or times[-1] > t or times[0] != 0.0):
+            raise InputError(f"{name}: field history.time is not increasing from 0 to at most t = {t:g} s")
+        if {"time.end", "time.outputs"} & set(_diff(old, new)):
+            # another output schedule: continue with its outputs after the last one recorded
+            after = self.output_times[(self.output_times >= t) & (self.output_times > (times[-1] if k else -1.0))]
+            k = n_out - len(after)
+        elif k and not np.array_equal(times, self.output_times[:k]):
+            raise InputError(f"{name}: field history.time does not match the output times of the config")
+        elif k < n_out and not ((k == 0 or self.output_times[k - 1] <= t) and t <= self.output_times[k]):
+            raise InputError(f"{name}: field t = {t:.9g} s does not lie between output {k - 1} and output {k}")
+        elif k == n_out and t != t_end:
+            raise InputError(f"{name}: field output_index = {k} (all outputs written) but t = {t:g} s < end time")
+        return self.place(U), t, steps, k, history
 
     def _record(self, U: Any, t: float, history: dict[str, list]) -> None:
         d = diagnostics(U, self.grid, self.phys.material_density)
@@ -253,7 +471,7 @@ class Simulation:
               history: dict[str, list], ckpt: Path, write_files: bool) -> None:
         """Save the last good state, reproduce the rejected step and raise a located diagnosis."""
         if write_files:
-            save_checkpoint(ckpt, np.asarray(U), t, steps, k, history, self.config_json())
+            self._save(ckpt, U, t, steps, k, history)
         bad = np.asarray(step(U, dt, self.grid, self.phys, self.num)) if dt > 0 else np.asarray(U)
         W = np.asarray(primitive(jnp.asarray(bad)))
         phi = W[0] / self.phys.material_density
@@ -284,7 +502,7 @@ class Simulation:
         err.field, err.cell, err.time, err.status, err.value = field, where, t, status, float(value)
         raise err
 
-    def dataset(self, history: dict[str, list]) -> Any:
+    def dataset(self, history: dict[str, list], steps: int | None = None) -> Any:
         """Diagnostics history as an xarray Dataset with full run metadata (SI units)."""
         import xarray as xr
 
@@ -306,7 +524,7 @@ class Simulation:
         ds.attrs.update(run_metadata(
             self.model, config=self.cfg.model_dump(mode="json"), box_lengths_m=list(self.grid.lengths),
             haff_time_s=self.t_haff, mean_free_path_m=float(mean_free_path(self.phi0, self.phys.diameter)),
-            steps=getattr(self, "steps", None),
+            steps=steps if steps is not None else getattr(self, "steps", None),
         ))
         return ds
 
