@@ -17,7 +17,7 @@ from ktgf.cli import app
 
 FAST = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow,
                                                                        HealthCheck.function_scoped_fixture])
-LONG = settings(max_examples=600, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+LONG = settings(max_examples=2000, deadline=None, suppress_health_check=[HealthCheck.too_slow,
                                                                          HealthCheck.function_scoped_fixture])
 
 MODELS = st.sampled_from(["ret", "enskog", "visc-div", "proposed", "ret,enskog", "nonsense", "", ",", " ret "])
