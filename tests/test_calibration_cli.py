@@ -113,7 +113,7 @@ def test_couette_run_and_compare_take_the_model_file(fitted, tmp_path):
     with xr.open_dataset(nc) as ds:
         assert ds.attrs["model"] == "proposed-calibrated"
         assert "phi_c=0.625" in ds.attrs["rdf"]
-    r = runner.invoke(app, ["couette", "compare", str(ROOT / "examples" / "couette_planar.toml"), "--models", "",
+    r = runner.invoke(app, ["couette", "compare", str(ROOT / "examples" / "couette_planar.toml"),  
                             "--model-file", str(out), "-o", str(tmp_path / "c.png"), "--format", "json"])
     assert r.exit_code == 0, r.output
     assert json.loads(r.stdout)[0]["model"] == "proposed-calibrated"
@@ -220,7 +220,7 @@ def test_couette_calibration_round_trip_walls_through_compare(tmp_path, data_dir
     assert r.exit_code == 0, r.output
     f = tomllib.loads(out.read_text())
     assert f["walls"] == pytest.approx({"specularity": 0.2, "wall_restitution": 0.9}, rel=1e-4)
-    r = runner.invoke(app, ["couette", "compare", "--dem", str(data), "--models", "", "--model-file", str(out), "--cells", "60",
+    r = runner.invoke(app, ["couette", "compare", "--dem", str(data), "--model-file", str(out), "--cells", "60",
                             "-o", str(tmp_path / "c.png"), "--format", "json"])
     assert r.exit_code == 0, r.output
     (row,) = json.loads(r.stdout)

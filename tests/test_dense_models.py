@@ -142,7 +142,7 @@ def test_cli_shear_options_and_csv():
     "args, fragment",
     [
         (["--model", "ret", "--phi", "0.5", "--e", "1"], "0 < e < 1"),
-        (["--model", "ret", "--phi", "", "--e", "0.9"], "at least one value"),
+        (["--model", "ret", "--phi", "", "--e", "0.9"], "gives no value"),
         (["--model", "ret", "--phi", "1.2", "--e", "0.9"], "phi < 1"),
         (["--model", "proposed", "--phi", "0.3", "--e", "0.9", "-O", "phi_c=1.5"], "option phi_c = 1.5"),
         (["--model", "ret", "--phi", "0.3", "--e", "0.9", "-O", "sonine"], "KEY=VALUE"),

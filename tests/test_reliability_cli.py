@@ -75,7 +75,7 @@ def test_bad_options_give_one_line(args: list[str], words: list[str], tmp_path: 
 
 def test_unreachable_dask_scheduler(tmp_path: Path) -> None:
     _refused(["hcs", "map", "-o", str(tmp_path / "m.nc"), "--n-phi", "2", "--n-e", "2", "--model", "ret",
-              "--scheduler", "tcp://127.0.0.1:1"], "Dask scheduler 'tcp://127.0.0.1:1' is unreachable")
+              "--dask", "tcp://127.0.0.1:1"], "Dask scheduler 'tcp://127.0.0.1:1' is unreachable")
 
 
 def test_grid_too_large_for_the_machine_is_refused_with_an_estimate(tmp_path: Path) -> None:
