@@ -65,8 +65,9 @@ def test_example_config_is_valid() -> None:
     assert len(cfg.grid.cells) == 3
 
 
-def test_run_writes_outputs_and_resume_reproduces_the_run_exactly(tmp_path: Path) -> None:
-    cfg = parse_config(_cfg())
+@pytest.mark.parametrize("scheme", ["imex", "ssprk3"])
+def test_run_writes_outputs_and_resume_reproduces_the_run_exactly(tmp_path: Path, scheme: str) -> None:
+    cfg = parse_config(_cfg(time={"scheme": scheme}))
     full = Simulation(cfg, tmp_path / "full")
     ds_full = full.run(progress=False)
     U_full = np.asarray(full.state)
@@ -92,6 +93,9 @@ def test_run_writes_outputs_and_resume_reproduces_the_run_exactly(tmp_path: Path
 
     ds = xr.open_dataset(tmp_path / "full" / TIMESERIES)
     assert ds.attrs["model"] == "ret" and "parameters" in ds.attrs
+    assert ds.attrs["time_scheme"] == scheme and ds.attrs["step_count"] == full.steps > 0
+    assert ds.attrs["binding_step_limit"] in ("cfl", "viscous", "conductive", "cooling")
+    assert ds.attrs["wall_time_per_step_s"] > 0 and ds.dt_cfl.attrs["units"] == "s"
     assert ds.sizes["time"] == 5 and ds.time.attrs["units"] == "s"
     # A uniform-ish gas follows Haff's law closely over τ = 4 (amplitude 5 %).
     assert abs(float(ds.theta_mean[-1] / ds.theta_haff[-1]) - 1.0) < 0.01
