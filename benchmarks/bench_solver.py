@@ -112,20 +112,24 @@ def main() -> None:
                     assert int(out[2]) == args.steps and int(out[3]) == 0, (int(out[2]), int(out[3]))
                 dt = float(out[4])
                 rate = grid.size * args.steps / best
+                rate_cpu = grid.size * args.steps / best_cpu
                 rates[scheme, model_name, precision] = rate
+                rates["cpu", scheme, model_name, precision] = rate_cpu
                 ratio = rate * refs[model_name] / grid.size
                 print(f"[{model_name}] {scheme:6s} {precision}: jit {t_jit:5.1f} s; {best / args.steps * 1e3:7.1f} ms/step "
                       f"wall, {best_cpu / args.steps * 1e3:7.1f} ms/step CPU; {rate / 1e6:6.3f} M cell-steps/s "
-                      f"= {ratio:.3f} x NumPy reference; dt {dt:.3g} s, simulated s per CPU s "
+                      f"= {ratio:.3f} x NumPy reference; {rate_cpu / 1e6:6.3f} M cell-steps per CPU s; dt {dt:.3g} s, simulated s per CPU s "
                       f"{dt * args.steps / best_cpu:.3g}", flush=True)
     for scheme in args.schemes.split(","):
         for p in args.precisions.split(","):
             if (scheme, "proposed", p) in rates and (scheme, "ret", p) in rates:
                 print(f"{scheme} {p}: Proposed/RET cell-step rate {rates[scheme, 'proposed', p] / rates[scheme, 'ret', p]:.2f}"
+                      f" wall, {rates['cpu', scheme, 'proposed', p] / rates['cpu', scheme, 'ret', p]:.2f} CPU"
                       f" (NumPy reference Proposed/RET {refs['ret'] / refs['proposed']:.2f})")
         for m in args.models.split(","):
             if (scheme, m, "float32") in rates and (scheme, m, "float64") in rates:
-                print(f"{scheme} {m}: float32/float64 rate {rates[scheme, m, 'float32'] / rates[scheme, m, 'float64']:.2f}")
+                print(f"{scheme} {m}: float32/float64 rate {rates[scheme, m, 'float32'] / rates[scheme, m, 'float64']:.2f}"
+                      f" wall, {rates['cpu', scheme, m, 'float32'] / rates['cpu', scheme, m, 'float64']:.2f} CPU")
     print(f"load average at the end {os.getloadavg()}")
 
 
