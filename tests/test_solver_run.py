@@ -175,10 +175,11 @@ def test_cli_run_and_bad_config(tmp_path: Path) -> None:
     assert len(res.output.strip().splitlines()) == 1
 
 
-def test_float32_run_lands_on_the_output_times_and_agrees_with_float64() -> None:
+@pytest.mark.parametrize("scheme", ["imex", "ssprk3"])
+def test_float32_run_lands_on_the_output_times_and_agrees_with_float64(scheme: str) -> None:
     results = {}
     for precision in ("float32", "float64"):
-        sim = Simulation(parse_config(_cfg(numerics={"precision": precision})))
+        sim = Simulation(parse_config(_cfg(numerics={"precision": precision}, time={"scheme": scheme})))
         ds = sim.run(progress=False, write_files=False)
         assert str(sim.state.dtype) == precision
         results[precision] = ds
