@@ -1,119 +1,136 @@
-"""Speed of the JAX HCS solver: cell-steps per second on a 64³ RET box (model.md §9).
+"""Speed of the JAX HCS solver: cell-steps per second, as ratios to a NumPy reference pass (model.md §9).
 
-Run:  python benchmarks/bench_solver.py [--cells 64] [--steps 10] [--precision float64]
+Run:  PYTHONPATH=src python benchmarks/bench_solver.py [--cells 64] [--steps 3] [--phi 0.5]
 
-Prints the compile (jit) time separately from the stepping rate, and the ratio of the rate
-to a memory-bandwidth bound measured in the same run: one NumPy copy of the conservative
-state (5 fields) per Runge–Kutta stage, i.e. bound = cells / (3 × t_copy) cell-steps/s.
-A real stage reads and writes the state many times (MUSCL faces, fluxes per axis, closure
-evaluations), so the ratio says how far the kernel is from the cheapest possible sweep.
-The machine's 2 cores are shared with other users: repeat and take the best.
+For each (scheme, model, precision) it prints the compile time, the stepping rate (cell-steps/s,
+wall and CPU time of this process) and the rate as a ratio to a NumPy reference pass timed in the
+same run, so the figures can be compared between runs on a loaded machine:
+
+    reference pass = the cell closures (``Model.reduced`` on the φ field, NumPy) plus one 7-point
+    stencil sweep of the five conservative fields, once per cell: the least work a stage does.
+
+Also printed: the Proposed/RET and float32/float64 ratios, the step limits of the state (acoustic
+CFL, viscous, conductive, cooling) and so the simulated time per CPU second of each scheme, and
+for one explicit right-hand side the optimised HLO (``jit(f).lower(...).compile().as_text()``):
+number of fusions (≈ kernels) and of ``power`` instructions (closure evaluations of the Proposed
+RDF, whose β = 1.75 power XLA keeps as ``pow``).  The machine's 2 cores are shared with other
+users: the load average is printed; repeat and take the best.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import re
 import time
 
 import numpy as np
 
 
+def numpy_reference(model, U: np.ndarray, rho_s: float, e: float) -> float:
+    """Seconds of one NumPy pass: closures at every cell plus a 7-point stencil of the 5 fields."""
+    best = np.inf
+    for _ in range(3):
+        t0 = time.perf_counter()
+        phi = U[0] / rho_s
+        r = model.reduced(phi, e, check=False)
+        lap = -6.0 * U
+        for ax in (1, 2, 3):
+            lap += np.roll(U, 1, axis=ax) + np.roll(U, -1, axis=ax)
+        _ = float(np.sum(r.p)) + float(np.sum(lap[0]))
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def hlo_counts(fn, *args) -> dict[str, int]:
+    import jax
+
+    text = jax.jit(fn).lower(*args).compile().as_text()
+    return {"fusions": len(re.findall(r"^\s*\S*fusion\S* = ", text, flags=re.M)),
+            "power": len(re.findall(r" power\(", text))}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--cells", type=int, default=64)
-    ap.add_argument("--steps", type=int, default=10)
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--precision", default="float64", choices=("float64", "float32"))
-    ap.add_argument("--model", default="ret")
-    ap.add_argument("--profile", default="", help="write a jax.profiler trace to this folder")
+    ap.add_argument("--steps", type=int, default=3)
+    ap.add_argument("--repeats", type=int, default=2)
+    ap.add_argument("--phi", type=float, default=0.5)
+    ap.add_argument("--schemes", default="ssprk3,imex")
+    ap.add_argument("--models", default="ret,proposed")
+    ap.add_argument("--precisions", default="float64,float32")
     args = ap.parse_args()
 
     import jax
     import jax.numpy as jnp
 
+    import ktgf.solver  # noqa: F401  (float64 on)
     from ktgf.closures import get_model
+    from ktgf.closures.coefficients import mean_free_path
     from ktgf.solver.grid import Grid
     from ktgf.solver.initial import random_velocity
     from ktgf.solver.physics import Physics
-    from ktgf.solver.stepping import Numerics, advance
+    from ktgf.solver.stepping import Numerics, advance, explicit_rhs, limits
 
-    n = args.cells
-    model = get_model(args.model)
-    phys = Physics(model, 0.8, 1e-3, 2500.0, 0.99 * model.phi_max)
-    grid = Grid((n, n, n), (20e-3,) * 3)
-    num = Numerics()
-    dtype = jnp.float64 if args.precision == "float64" else jnp.float32
-    U = jnp.asarray(random_velocity(grid, phys, 0.25, 1e-4, 0.05, 0), dtype=dtype)
+    n, e, rho_s, d = args.cells, 0.7, 2500.0, 1e-3
+    ell = mean_free_path(args.phi, d)
+    grid = Grid((n, n, n), (n * ell,) * 3)  # one mean free path per cell
+    print(f"grid {n}^3 = {grid.size} cells, phi = {args.phi}, e = {e}, dx = 1 mean free path; "
+          f"devices {jax.device_count()}, cpu count {os.cpu_count()}, load average {os.getloadavg()} "
+          "(machine shared with other users: figures are lower bounds)")
     far = 1e30
-
-    t0 = time.perf_counter()
-    out = advance(U, 0.0, far, 1, grid, phys, num)
-    jax.block_until_ready(out)
-    t_jit = time.perf_counter() - t0
-
-    best = np.inf
-    for _ in range(args.repeats):
-        t0 = time.perf_counter()
-        out = advance(U, 0.0, far, args.steps, grid, phys, num)
-        jax.block_until_ready(out)
-        best = min(best, time.perf_counter() - t0)
-        assert int(out[2]) == args.steps and int(out[3]) == 0
-    rate = grid.size * args.steps / best
-
-    host = np.asarray(U)
-    dst = np.empty_like(host)
-    t_copy = np.inf
-    for _ in range(20):
-        t0 = time.perf_counter()
-        np.copyto(dst, host)
-        t_copy = min(t_copy, time.perf_counter() - t0)
-    bound = grid.size / (3 * t_copy)
-
-    # Where the time goes: each part of one right-hand-side evaluation compiled on its own.
-    from ktgf.solver.fluxes import convective_flux, pad_periodic, viscous_flux
-    from ktgf.solver.sources import cooling_source
-    from ktgf.solver.state import primitive_fields
-    from ktgf.solver.stepping import rhs, stable_dt
-
-    Ut = tuple(U)
-    W = primitive_fields(Ut)
-    P = pad_periodic(W, 3)
-    parts = {
-        "rhs (one RK stage)": (jax.jit(lambda U: rhs(U, grid, phys, num)), Ut),
-        "  pad + primitive": (jax.jit(lambda U: pad_periodic(primitive_fields(U), 3)), Ut),
-        "  convective flux, 3 axes": (jax.jit(lambda P: [convective_flux(P, grid.cells, a, phys, num.limiter, num.riemann)
-                                                           for a in range(3)]), P),
-        "  viscous + heat flux, 3 axes": (jax.jit(lambda P: [viscous_flux(P, a, grid, phys)[1:] for a in range(3)]), P),
-        "  cooling source": (jax.jit(lambda W: cooling_source(W, W[1], phys)[0]), W),
-        "stable dt (once per step)": (jax.jit(lambda U: stable_dt(U, grid, phys, num)), Ut),
-    }
-    timings = {}
-    for name, (fn, arg) in parts.items():
-        jax.block_until_ready(fn(arg))
-        best_part = np.inf
-        for _ in range(args.repeats):
-            t0 = time.perf_counter()
-            jax.block_until_ready(fn(arg))
-            best_part = min(best_part, time.perf_counter() - t0)
-        timings[name] = best_part
-
-    if args.profile:
-        jax.profiler.start_trace(args.profile)
-        jax.block_until_ready(advance(U, 0.0, far, 2, grid, phys, num))
-        jax.profiler.stop_trace()
-
-    print(f"grid {n}^3 = {grid.size} cells, model {args.model}, {args.precision}, "
-          f"devices {jax.device_count()}, cpu count {os.cpu_count()} (shared with other users: noisy)")
-    print(f"jit (trace + compile + 1 step): {t_jit:.2f} s")
-    print(f"stepping: {args.steps} steps in {best:.3f} s (best of {args.repeats}) = {args.steps / best:.2f} steps/s")
-    print(f"rate: {rate / 1e6:.3f} M cell-steps/s   (aim 2 M on 2 cores)")
-    print(f"bandwidth bound (one state copy of {host.nbytes / 1e6:.1f} MB per RK stage, {t_copy * 1e3:.2f} ms): "
-          f"{bound / 1e6:.1f} M cell-steps/s;  ratio rate/bound = {rate / bound:.4f}")
-    step_time = best / args.steps
-    print(f"time per step {step_time * 1e3:.1f} ms; parts (compiled separately, best of {args.repeats}):")
-    for name, t in timings.items():
-        print(f"  {name:32s} {t * 1e3:8.1f} ms  ({t / grid.size * 1e9:6.1f} ns/cell)")
+    rates, refs = {}, {}
+    for model_name in args.models.split(","):
+        model = get_model(model_name)
+        phys = Physics(model, e, d, rho_s, 0.99 * model.phi_max)
+        U64 = np.asarray(random_velocity(grid, phys, args.phi, 1e-4, 0.01, 0))
+        refs[model_name] = numpy_reference(model, U64, rho_s, e)
+        print(f"[{model_name}] NumPy reference pass {refs[model_name] * 1e3:.1f} ms = "
+              f"{grid.size / refs[model_name] / 1e6:.2f} M cells/s")
+        lim = np.asarray(limits(jnp.asarray(U64), grid, phys, Numerics()))
+        print(f"[{model_name}] step limits [s]: cfl {lim[0]:.3g}, viscous {lim[1]:.3g}, conductive {lim[2]:.3g}, "
+              f"cooling {lim[3]:.3g}")
+        Ut = tuple(jnp.asarray(U64))
+        counts = hlo_counts(lambda U: explicit_rhs(U, grid, phys, Numerics(), viscous=True), Ut)
+        print(f"[{model_name}] optimised HLO of one full right-hand side: {counts['fusions']} fusions, "
+              f"{counts['power']} power instructions")
+        for scheme in args.schemes.split(","):
+            num = Numerics(scheme=scheme)
+            for precision in args.precisions.split(","):
+                dtype = jnp.float64 if precision == "float64" else jnp.float32
+                U = jnp.asarray(U64, dtype=dtype)
+                t0 = time.perf_counter()
+                jax.block_until_ready(advance(U, 0.0, far, 1, grid, phys, num))
+                t_jit = time.perf_counter() - t0
+                best, best_cpu = np.inf, np.inf
+                for _ in range(args.repeats):
+                    t0, c0 = time.perf_counter(), time.process_time()
+                    out = advance(U, 0.0, far, args.steps, grid, phys, num)
+                    jax.block_until_ready(out)
+                    best = min(best, time.perf_counter() - t0)
+                    best_cpu = min(best_cpu, time.process_time() - c0)
+                    assert int(out[2]) == args.steps and int(out[3]) == 0, (int(out[2]), int(out[3]))
+                dt = float(out[4])
+                rate = grid.size * args.steps / best
+                rate_cpu = grid.size * args.steps / best_cpu
+                rates[scheme, model_name, precision] = rate
+                rates["cpu", scheme, model_name, precision] = rate_cpu
+                ratio = rate * refs[model_name] / grid.size
+                print(f"[{model_name}] {scheme:6s} {precision}: jit {t_jit:5.1f} s; {best / args.steps * 1e3:7.1f} ms/step "
+                      f"wall, {best_cpu / args.steps * 1e3:7.1f} ms/step CPU; {rate / 1e6:6.3f} M cell-steps/s "
+                      f"= {ratio:.3f} x NumPy reference; {rate_cpu / 1e6:6.3f} M cell-steps per CPU s; dt {dt:.3g} s, simulated s per CPU s "
+                      f"{dt * args.steps / best_cpu:.3g}", flush=True)
+    for scheme in args.schemes.split(","):
+        for p in args.precisions.split(","):
+            if (scheme, "proposed", p) in rates and (scheme, "ret", p) in rates:
+                print(f"{scheme} {p}: Proposed/RET cell-step rate {rates[scheme, 'proposed', p] / rates[scheme, 'ret', p]:.2f}"
+                      f" wall, {rates['cpu', scheme, 'proposed', p] / rates['cpu', scheme, 'ret', p]:.2f} CPU"
+                      f" (NumPy reference Proposed/RET {refs['ret'] / refs['proposed']:.2f})")
+        for m in args.models.split(","):
+            if (scheme, m, "float32") in rates and (scheme, m, "float64") in rates:
+                print(f"{scheme} {m}: float32/float64 rate {rates[scheme, m, 'float32'] / rates[scheme, m, 'float64']:.2f}"
+                      f" wall, {rates['cpu', scheme, m, 'float32'] / rates['cpu', scheme, m, 'float64']:.2f} CPU")
+    print(f"load average at the end {os.getloadavg()}")
 
 
 if __name__ == "__main__":

@@ -65,8 +65,9 @@ def test_example_config_is_valid() -> None:
     assert len(cfg.grid.cells) == 3
 
 
-def test_run_writes_outputs_and_resume_reproduces_the_run_exactly(tmp_path: Path) -> None:
-    cfg = parse_config(_cfg())
+@pytest.mark.parametrize("scheme", ["imex", "ssprk3"])
+def test_run_writes_outputs_and_resume_reproduces_the_run_exactly(tmp_path: Path, scheme: str) -> None:
+    cfg = parse_config(_cfg(time={"scheme": scheme}))
     full = Simulation(cfg, tmp_path / "full")
     ds_full = full.run(progress=False)
     U_full = np.asarray(full.state)
@@ -92,6 +93,9 @@ def test_run_writes_outputs_and_resume_reproduces_the_run_exactly(tmp_path: Path
 
     ds = xr.open_dataset(tmp_path / "full" / TIMESERIES)
     assert ds.attrs["model"] == "ret" and "parameters" in ds.attrs
+    assert ds.attrs["time_scheme"] == scheme and ds.attrs["step_count"] == full.steps > 0
+    assert ds.attrs["binding_step_limit"] in ("cfl", "viscous", "conductive", "cooling")
+    assert ds.attrs["wall_time_per_step_s"] > 0 and ds.dt_cfl.attrs["units"] == "s"
     assert ds.sizes["time"] == 5 and ds.time.attrs["units"] == "s"
     # A uniform-ish gas follows Haff's law closely over τ = 4 (amplitude 5 %).
     assert abs(float(ds.theta_mean[-1] / ds.theta_haff[-1]) - 1.0) < 0.01
@@ -171,10 +175,11 @@ def test_cli_run_and_bad_config(tmp_path: Path) -> None:
     assert len(res.output.strip().splitlines()) == 1
 
 
-def test_float32_run_lands_on_the_output_times_and_agrees_with_float64() -> None:
+@pytest.mark.parametrize("scheme", ["imex", "ssprk3"])
+def test_float32_run_lands_on_the_output_times_and_agrees_with_float64(scheme: str) -> None:
     results = {}
     for precision in ("float32", "float64"):
-        sim = Simulation(parse_config(_cfg(numerics={"precision": precision})))
+        sim = Simulation(parse_config(_cfg(numerics={"precision": precision}, time={"scheme": scheme})))
         ds = sim.run(progress=False, write_files=False)
         assert str(sim.state.dtype) == precision
         results[precision] = ds

@@ -21,7 +21,7 @@ base = {
     "model": {"name": "proposed", "restitution": 0.7},
     "initial": {"solid_fraction": 0.4, "temperature": 1e-4, "amplitude": 0.05, "seed": 5},
     "grid": {"cells": [16, 8], "relative_to": "transverse", "factor": 1.5},
-    "time": {"end": 3.0, "outputs": 2},
+    "time": {"end": 3.0, "outputs": 2, "scheme": "imex"},
 }
 out = {"devices": jax.device_count()}
 states = []

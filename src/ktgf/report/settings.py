@@ -61,11 +61,11 @@ class ReportSettings(BaseModel):
 
     # (4) 3D homogeneous cooling gas
     cooling_models: tuple[str, ...] = Field(("ret", "proposed"), min_length=1, description="Models run in 3D")
-    cooling_phi: float = Field(0.1, gt=0.0, lt=0.64, description="Solid fraction of the 3D cooling runs")
+    cooling_phi: float = Field(0.5, gt=0.0, lt=0.64, description="Solid fraction of the 3D cooling runs (0.5 > φ_f = 0.49: RET and Proposed differ)")
     cooling_e: float = Field(0.7, gt=0.0, le=1.0, description="Restitution of the 3D cooling runs")
     cooling_below: float = Field(0.7, gt=0.0, lt=1.0, description="Side of the small box as a fraction of L⊥ (stays homogeneous)")
     cooling_above: float = Field(1.4, gt=1.0, le=10.0, description="Side of the large box as a multiple of L∥ (vortices and clusters)")
-    cooling_cells: int = Field(32, ge=8, le=1024, description="Grid cells per side of the 3D box (32: the small box is diffusion-limited, 64 costs ~30x more)")
+    cooling_cells: int = Field(32, ge=8, le=1024, description="Grid cells per side of the 3D box (32: 0.5 and 1.6 mean free paths per cell in the small and large box at phi = 0.5)")
     cooling_t_end: float = Field(400.0, gt=0.0, description="End time in units of the initial collision time 1/ν0(θ0)")
     cooling_seed: int = Field(0, ge=0, description="Seed of the initial velocity perturbation")
 

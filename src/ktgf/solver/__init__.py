@@ -3,14 +3,15 @@
 Conservative variables (ρ, ρu, E = ρ(|u|²/2 + 3θ/2)) on a uniform periodic grid in 1, 2 or 3
 dimensions (one code path; the velocity always has three components).  MUSCL-reconstructed
 HLL (or Rusanov) convective flux with the granular equation of state p = ρθp*(φ), central
-viscous and heat fluxes (η, λ_b, κ and the ω∇φ term) with the closure coefficients evaluated
-at the faces through ``Model.reduced(φ, e, check=False)``, the collisional sink
-−(3/2)ρθ(ζ0 + ζ_U∇·u), and SSP-RK3 with an adaptive step (acoustic CFL, diffusive and cooling
-limits).  Any registered closure model can be used; the solver never branches on its name.
+viscous and heat fluxes (η, λ_b, κ and the ω∇φ term), the closures evaluated once per cell and
+stage through ``Model.reduced(φ, e, check=False)`` (face coefficients: mean of the cells), the
+collisional sink −(3/2)ρθ(ζ0 + ζ_U∇·u), and an adaptive step: IMEX ARS(2,2,2) with implicit
+viscous and heat fluxes (acoustic CFL and cooling limits, :mod:`.imex`) or SSP-RK3 (plus the
+diffusive limits).  Any registered closure model can be used; the solver never branches on its name.
 
 Modules: :mod:`.grid` (periodic grid, a pytree), :mod:`.state` (variables), :mod:`.physics`
 (EoS, sound speed, SI transport from the Model), :mod:`.fluxes`, :mod:`.sources`,
-:mod:`.stepping` (RHS, Δt, SSP-RK3, compiled ``advance`` with failure detection),
+:mod:`.stepping` (RHS, Δt, IMEX/SSP-RK3, compiled ``advance`` with failure detection), :mod:`.imex`,
 :mod:`.initial` (HCS states), :mod:`.diagnostics`, :mod:`.io` (netCDF, checkpoints, VTK .vti,
 PNG), :mod:`.config` (pydantic/TOML), :mod:`.run` (:class:`Simulation`).
 

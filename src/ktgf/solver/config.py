@@ -106,6 +106,9 @@ class NumericsSection(_Section):
     riemann: str = "hll"
     precision: Literal["float64", "float32"] = "float64"
     phi_stop: float | None = Field(None, gt=0.0, lt=1.0, description="stop when max phi reaches this (default 0.99 phi_max)")
+    implicit_tol: float = Field(1e-6, gt=0.0, lt=1.0, description="IMEX: relative residual of the stage solves")
+    implicit_maxiter: int = Field(5, ge=1, le=100, description="IMEX: GMRES restarts of 10 iterations")
+    sweeps: int = Field(1, ge=1, le=5, description="IMEX: Picard passes on the implicit coefficients")
 
     @field_validator("limiter")
     @classmethod
@@ -127,6 +130,8 @@ class TimeSection(_Section):
     unit: Literal["tau", "haff", "s"] = "tau"
     outputs: int = Field(50, ge=1, le=100000)
     max_steps_per_call: int = Field(200, ge=1, le=2**31 - 1, description="steps per compiled call (progress granularity)")
+    scheme: Literal["auto", "imex", "ssprk3"] = Field(
+        "auto", description="imex (implicit diffusion), ssprk3 (explicit) or auto (the cheaper for the initial state)")
 
 
 class OutputSection(_Section):

@@ -1,12 +1,15 @@
 """Finite-volume fluxes: MUSCL-reconstructed upwind convective flux and central viscous/heat fluxes.
 
-Kernels work on tuples of five field arrays (see :mod:`.state`).  Face ``i+1/2`` along axis
-``a`` is stored at index ``i``.  The convective flux uses the granular equation of state
-p = ρθp*(φ) and the sound speed c² = θ(C + 2p*²/3) of :class:`~ktgf.solver.physics.Physics`;
-the primitive variables (ρ, u, θ) are reconstructed with a slope limiter, so face values of
-ρ and θ stay within their neighbours' range (positive).  The viscous and heat fluxes are
-second-order central differences with the closure coefficients evaluated at the face state
-(arithmetic mean of the two cells):
+Kernels work on tuples of field arrays (see :mod:`.state`).  Face ``i+1/2`` along axis ``a``
+is stored at index ``i``.  The closures are evaluated once per cell and stage
+(:func:`cell_fields`); nothing here calls a closure.  The convective flux uses the granular
+equation of state p = ρθp*(φ) and the sound speed c² = θg, g = C + 2p*²/3
+(:class:`~ktgf.solver.physics.Physics`): the primitive variables (ρ, u, θ) and the cell values
+of p* and g are reconstructed with the same slope limiter (face ρ, θ, p*, g stay within their
+neighbours' range, so positive; p* and g are smooth functions of φ, so the face values are
+second-order accurate like a closure evaluation at the reconstructed φ).  The viscous and heat
+fluxes are second-order central differences with face coefficients = arithmetic mean of the two
+cells' coefficients (η, λ_b, κ, ω):
 
     P = p I − η(∇u + ∇uᵀ − (2/3)∇·u I) − λ_b ∇·u I,     q = −κ∇θ − ω∇φ        (model.md §1)
 
@@ -86,7 +89,7 @@ def window(P: Any, cells: tuple[int, ...], axis: int, offset: int, extra: int, s
 
 
 def reconstruct(P: Sequence[Any], cells: tuple[int, ...], axis: int, limiter: str) -> tuple[list[Any], list[Any]]:
-    """Left and right primitive states at the N+1 faces −1/2 … N−1/2 along ``axis`` (MUSCL)."""
+    """Left and right states at the N+1 faces −1/2 … N−1/2 along ``axis`` (MUSCL)."""
     left, right = [], []
     for f in P:
         fm, fc, fp = (window(f, cells, axis, o, 2) for o in (-2, -1, 0))  # cells −1 … N
@@ -97,21 +100,31 @@ def reconstruct(P: Sequence[Any], cells: tuple[int, ...], axis: int, limiter: st
     return left, right
 
 
+def cell_fields(W: Sequence[Any], phys: Physics) -> tuple[tuple[Any, ...], tuple[Any, ...], Any]:
+    """The closures once per cell: (eos, transport, r).
+
+    ``eos`` = (p*, g) for the convective flux, ``transport`` = (η, λ_b, κ, ω) in SI for the
+    viscous and heat fluxes, ``r`` the cell :class:`~ktgf.closures.Reduced` (cooling rate, Δt).
+    """
+    r = phys.reduced(W[0])
+    return (r.p, phys.sound_factor(r)), phys.transport(W[0], W[4], r), r
+
+
 def _euler_flux(W: Sequence[Any], U: Sequence[Any], p: Any, a: int) -> list[Any]:
     un = W[1 + a]
     mom = [U[1 + j] * un + (p if j == a else 0.0) for j in range(3)]
     return [U[0] * un, *mom, (U[4] + p) * un]
 
 
-def convective_flux(
-    P: Sequence[Any], cells: tuple[int, ...], axis: int, phys: Physics, limiter: str, riemann: str
-) -> list[Any]:
-    """Upwind flux (HLL or Rusanov) of the Euler part at the N+1 faces along ``axis`` (padded input P)."""
+def convective_flux(P: Sequence[Any], cells: tuple[int, ...], axis: int, limiter: str, riemann: str) -> list[Any]:
+    """Upwind flux (HLL or Rusanov) of the Euler part at the N+1 faces along ``axis``.
+
+    ``P`` = padded (ρ, u_x, u_y, u_z, θ, p*, g) cell fields (:func:`pad_periodic`).
+    """
     WL, WR = materialise(reconstruct(P, cells, axis, limiter))
-    rL, rR = phys.reduced(WL[0]), phys.reduced(WR[0])
-    pL, pR = phys.pressure(WL[0], WL[4], rL), phys.pressure(WR[0], WR[4], rR)
-    cL, cR = phys.sound_speed(WL[4], rL), phys.sound_speed(WR[4], rR)
-    UL, UR = conservative_fields(WL), conservative_fields(WR)
+    pL, pR = WL[0] * WL[4] * WL[5], WR[0] * WR[4] * WR[5]
+    cL, cR = jnp.sqrt(WL[4] * WL[6]), jnp.sqrt(WR[4] * WR[6])
+    UL, UR = conservative_fields(WL[:5]), conservative_fields(WR[:5])
     FL, FR = _euler_flux(WL, UL, pL, axis), _euler_flux(WR, UR, pR, axis)
     uL, uR = WL[1 + axis], WR[1 + axis]
     pL, pR, cL, cR = materialise((pL, pR, cL, cR))
@@ -134,26 +147,35 @@ def _central(P: Any, grid: Grid, axis: int, b: int) -> Any:
     return (fp - fm) * (0.5 / grid.spacing[b])
 
 
-def viscous_flux(P: Sequence[Any], axis: int, grid: Grid, phys: Physics) -> list[Any]:
-    """Viscous and heat flux at the N+1 faces along ``axis``: (0, −τ·e_a, −(τ·u)_a + q_a).
+def face_mean(P: Any, cells: tuple[int, ...], axis: int) -> Any:
+    """Arithmetic mean of the two cells of every face −1/2 … N−1/2 along ``axis`` (padded P)."""
+    return 0.5 * (window(P, cells, axis, -1, 1) + window(P, cells, axis, 0, 1))
 
-    Normal derivatives are two-point differences across the face; tangential ones the mean
-    of the two cells' central differences.  Coefficients use the face state (mean of cells).
+
+def face_jump(P: Any, cells: tuple[int, ...], axis: int) -> Any:
+    """Right minus left cell value at every face along ``axis`` (padded P)."""
+    return window(P, cells, axis, 0, 1) - window(P, cells, axis, -1, 1)
+
+
+def face_coefficients(Pk: Sequence[Any], cells: tuple[int, ...], axis: int) -> tuple[Any, ...]:
+    """Face values of padded cell coefficients: arithmetic mean of the two cells."""
+    return tuple(face_mean(k, cells, axis) for k in Pk)
+
+
+def stress(Pu: Sequence[Any], eta: Any, lam: Any, axis: int, grid: Grid) -> list[Any]:
+    """Viscous stress τ·e_a at the N+1 faces along ``axis`` (padded velocities Pu, face η, λ_b).
+
+    τ = η(∇u + ∇uᵀ − (2/3)∇·u I) + λ_b∇·u I.  Normal derivatives are two-point differences
+    across the face; tangential ones the mean of the two cells' central differences.
     """
     a = axis
     inv_dx = 1.0 / grid.spacing[a]
-    Wl = [window(f, grid.cells, a, -1, 1) for f in P]  # cells −1 … N−1
-    Wr = [window(f, grid.cells, a, 0, 1) for f in P]  # cells 0 … N
-    rho_f, th_f = 0.5 * (Wl[0] + Wr[0]), 0.5 * (Wl[4] + Wr[4])
-    u_f = [0.5 * (Wl[1 + j] + Wr[1 + j]) for j in range(3)]
-
     n = grid.cells[a]
-    # Tangential derivatives at the faces: mean of the central differences of the two cells.
     tangential = {}
     for b in range(grid.ndim):
         if b != a:
             for j in range(3):
-                g = _central(P[1 + j], grid, a, b)
+                g = _central(Pu[j], grid, a, b)
                 tangential[b, j] = 0.5 * (
                     jax.lax.slice_in_dim(g, 0, n + 1, axis=a) + jax.lax.slice_in_dim(g, 1, n + 2, axis=a)
                 )
@@ -161,38 +183,73 @@ def viscous_flux(P: Sequence[Any], axis: int, grid: Grid, phys: Physics) -> list
 
     def grad(b: int, j: int) -> Any:  # ∂u_j/∂x_b at the face
         if b == a:
-            return (Wr[1 + j] - Wl[1 + j]) * inv_dx
+            return face_jump(Pu[j], grid.cells, a) * inv_dx
         if b >= grid.ndim:
             return 0.0
         return tangential[b, j]
 
     divu = sum(grad(b, b) for b in range(grid.ndim))
-    r = phys.reduced(rho_f)
-    eta, lam, kap, omega = materialise(phys.transport(rho_f, th_f, r))
     tau = [eta * (grad(a, j) + grad(j, a)) for j in range(3)]
     tau[a] = tau[a] + (lam - (2.0 / 3.0) * eta) * divu
-    tau = materialise(tau)
-    q = -kap * (Wr[4] - Wl[4]) * inv_dx - omega * (Wr[0] - Wl[0]) * (inv_dx / phys.material_density)
-    work = tau[0] * u_f[0] + tau[1] * u_f[1] + tau[2] * u_f[2]
-    return [0.0, -tau[0], -tau[1], -tau[2], q - work]
+    return tau
 
 
-def flux_divergence(W: Sequence[Any], grid: Grid, phys: Physics, limiter: str, riemann: str) -> tuple[list[Any], Any]:
-    """−∇·F of the total (convective + viscous + heat) flux per field, and the cell-centred ∇·u."""
-    P = pad_periodic(W, grid.ndim)
+def heat_flux(Ptheta: Any, Prho: Any, kap: Any, omega: Any, axis: int, grid: Grid, rho_s: Any) -> Any:
+    """q·e_a = −κ∂θ/∂x_a − ω∂φ/∂x_a at the N+1 faces along ``axis`` (face κ, ω)."""
+    inv_dx = 1.0 / grid.spacing[axis]
+    return (-kap * face_jump(Ptheta, grid.cells, axis) * inv_dx
+            - omega * face_jump(Prho, grid.cells, axis) * (inv_dx / rho_s))
+
+
+def stress_work(tau: Sequence[Any], Pu: Sequence[Any], cells: tuple[int, ...], axis: int) -> Any:
+    """(τ·u)·e_a at the faces, with the face velocity the mean of the two cells."""
+    return sum(tau[j] * face_mean(Pu[j], cells, axis) for j in range(3))
+
+
+def viscous_flux(P: Sequence[Any], Pk: Sequence[Any], axis: int, grid: Grid, rho_s: Any) -> list[Any]:
+    """Viscous and heat flux at the N+1 faces along ``axis``: (0, −τ·e_a, −(τ·u)_a + q_a).
+
+    ``P`` padded primitive fields, ``Pk`` padded cell coefficients (η, λ_b, κ, ω).
+    """
+    eta, lam, kap, omega = materialise(face_coefficients(Pk, grid.cells, axis))
+    Pu = P[1:4]
+    tau = materialise(stress(Pu, eta, lam, axis, grid))
+    q = heat_flux(P[4], P[0], kap, omega, axis, grid, rho_s)
+    return [0.0, -tau[0], -tau[1], -tau[2], q - stress_work(tau, Pu, grid.cells, axis)]
+
+
+def face_divergence(F: Any, grid: Grid, axis: int) -> Any:
+    """−(F_{i+1/2} − F_{i−1/2})/Δx_a at the cells, from face values −1/2 … N−1/2 (leading axis kept)."""
+    n = grid.cells[axis]
+    ax = F.ndim - grid.ndim + axis
+    return (jax.lax.slice_in_dim(F, 0, n, axis=ax) - jax.lax.slice_in_dim(F, 1, n + 1, axis=ax)) / grid.spacing[axis]
+
+
+def flux_divergence(W: Sequence[Any], coefficients: tuple[tuple[Any, ...], tuple[Any, ...]], grid: Grid,
+                    phys: Physics, limiter: str, riemann: str, viscous: bool = True) -> tuple[list[Any], Any]:
+    """−∇·F per field of the convective (+ viscous and heat, if ``viscous``) flux, and the cell ∇·u.
+
+    ``coefficients`` = (eos, transport) cell fields of :func:`cell_fields`.
+    """
+    eos, transport = coefficients
+    P = pad_periodic((*W, *eos), grid.ndim)
+    Pk = pad_periodic(transport, grid.ndim) if viscous else ()
     out: list[Any] = [0.0] * 5
     for a in range(grid.ndim):
-        Fc = convective_flux(P, grid.cells, a, phys, limiter, riemann)
-        Fv = viscous_flux(P, a, grid, phys)
-        inv_dx = 1.0 / grid.spacing[a]
-        n = grid.cells[a]
+        Fc = convective_flux(P, grid.cells, a, limiter, riemann)
+        if viscous:
+            Fv = viscous_flux(P[:5], Pk, a, grid, phys.material_density)
+            Fc = [Fc[i] + Fv[i] for i in range(5)]
         # One stacked array of face fluxes: XLA then computes all five components in one
         # loop and materialises them, instead of recomputing the face state in each consumer.
-        F = jnp.stack([Fc[i] + Fv[i] for i in range(5)])
-        dF = jax.lax.slice_in_dim(F, 1, n + 1, axis=a + 1) - jax.lax.slice_in_dim(F, 0, n, axis=a + 1)
-        out = [o - dF[i] * inv_dx for i, o in enumerate(out)]
-    divu = sum(
-        (window(P[1 + b], grid.cells, b, 1, 0) - window(P[1 + b], grid.cells, b, -1, 0)) * (0.5 / grid.spacing[b])
+        dF = face_divergence(jnp.stack(Fc), grid, a)
+        out = [o + dF[i] for i, o in enumerate(out)]
+    return out, cell_divergence(P[1:4], grid)
+
+
+def cell_divergence(Pu: Sequence[Any], grid: Grid) -> Any:
+    """Central ∇·u at the cells (padded velocities)."""
+    return sum(
+        (window(Pu[b], grid.cells, b, 1, 0) - window(Pu[b], grid.cells, b, -1, 0)) * (0.5 / grid.spacing[b])
         for b in range(grid.ndim)
     )
-    return out, divu

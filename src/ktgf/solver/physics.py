@@ -63,13 +63,17 @@ class Physics:
         """Equation of state p = ρθp*(φ) [Pa] (model.md §1)."""
         return rho * theta * r.p
 
+    def sound_factor(self, r: Reduced) -> Any:
+        """g = C + 2p*²/3, so that c² = θ g (a function of φ alone, reconstructed to faces)."""
+        return r.C + (2.0 / 3.0) * r.p * r.p
+
     def sound_speed(self, theta: Any, r: Reduced) -> Any:
         """Adiabatic sound speed c = √(θ(C + 2p*²/3)) [m/s].
 
         From c² = (∂p/∂ρ)_e + (p/ρ²)(∂p/∂e)_ρ with p = ρθp*(φ), e = 3θ/2 and
         C = ∂(φp*)/∂φ.
         """
-        return jnp.sqrt(theta * (r.C + (2.0 / 3.0) * r.p**2))
+        return jnp.sqrt(theta * self.sound_factor(r))
 
     def transport(self, rho: Any, theta: Any, r: Reduced) -> tuple[Any, Any, Any, Any]:
         """(η, λ_b, κ, ω) in SI at states (ρ, θ): η0 times the reduced values, ω = θκ0μ*/φ."""

@@ -17,6 +17,7 @@ from any checkpoint reproduces the uninterrupted run bit for bit.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import json
 import math
@@ -43,7 +44,7 @@ from .interrupt import STOP, Interrupted, fault_hook
 from .io import load_checkpoint, save_checkpoint, save_slices, write_vti
 from .physics import Physics
 from .state import PRIMITIVE_NAMES, conservative, primitive
-from .stepping import STATUS_MESSAGES, Numerics, advance, state_status, step
+from .stepping import LIMIT_NAMES, STATUS_MESSAGES, Numerics, advance, binding_limit, choose_scheme, limits, state_status, step
 
 CHECKPOINT = "checkpoint.npz"
 TIMESERIES = "hcs.nc"
@@ -171,7 +172,8 @@ class Simulation:
         self.phys = Physics(self.model, cfg.model.restitution, cfg.particles.diameter, cfg.particles.density, phi_stop)
         self.grid = Grid(tuple(cfg.grid.cells), box_lengths(cfg))
         n = cfg.numerics
-        self.num = Numerics(n.cfl, n.cfl_diffusion, n.cfl_source, n.limiter, n.riemann)
+        self.num = Numerics(n.cfl, n.cfl_diffusion, n.cfl_source, n.limiter, n.riemann, scheme="ssprk3",
+                            implicit_tol=n.implicit_tol, implicit_maxiter=n.implicit_maxiter, sweeps=n.sweeps)
         self.dtype = jnp.float64 if n.precision == "float64" else jnp.float32
         self.directory = Path(directory if directory is not None else cfg.output.directory)
         self.phi0, self.theta0 = cfg.initial.solid_fraction, cfg.initial.temperature
@@ -195,6 +197,12 @@ class Simulation:
                 f"time.outputs = {n_out} distinct outputs"
             )
         self.sharding = self._sharding(cfg.parallel.devices)
+        scheme = cfg.time.scheme
+        if scheme == "auto":  # from the config alone (the uniform initial state), so a resume agrees
+            uniform = conservative(*uniform_fields(self.grid, self.phys, self.phi0, self.theta0))
+            scheme = choose_scheme(uniform, self.grid, self.phys, self.num)
+        self.num = dataclasses.replace(self.num, scheme=scheme)
+        self.wall_stepping, self.steps_timed = 0.0, 0
 
     def _sharding(self, ndev: int) -> Any:
         if ndev == 1:
@@ -292,6 +300,7 @@ class Simulation:
         ckpt = self.directory / CHECKPOINT
         bar = _Progress(progress, self.output_times[-1], self.t_haff, self.phys, self.phi0, self.theta0)
         chunks = 0
+        first_chunk = True
         try:
             with bar:
                 while k < n_out:
@@ -310,7 +319,11 @@ class Simulation:
                             self._fail(U, t, float(dt), steps, status, k, history, ckpt, write_files)
                         U, t, steps = U_new, float(t_new), steps + n
                         chunks += 1
-                        bar.update(t, n, _time.perf_counter() - wall)
+                        wall = _time.perf_counter() - wall
+                        if not first_chunk:  # the first call includes the compilation
+                            self.wall_stepping, self.steps_timed = self.wall_stepping + wall, self.steps_timed + n
+                        first_chunk = False
+                        bar.update(t, n, wall)
                         if on_chunk is not None:
                             on_chunk({"t": t, "steps": steps, "output_index": k})
                         fault_hook("chunk", chunks)
@@ -449,6 +462,9 @@ class Simulation:
             history[name].append(float(d[name]))
         for name in PER_AXIS:
             history[name].append([float(v) for v in np.asarray(d[name])])
+        lim = np.asarray(limits(U, self.grid, self.phys, self.num))
+        for name, v in zip(LIMIT_NAMES, lim):
+            history.setdefault(f"dt_{name}", []).append(float(v))
 
     def _write_fields(self, U: Any, t: float, k: int) -> None:
         out = self.cfg.output
@@ -472,7 +488,7 @@ class Simulation:
         """Save the last good state, reproduce the rejected step and raise a located diagnosis."""
         if write_files:
             self._save(ckpt, U, t, steps, k, history)
-        bad = np.asarray(step(U, dt, self.grid, self.phys, self.num)) if dt > 0 else np.asarray(U)
+        bad, residual = step(U, dt, self.grid, self.phys, self.num) if dt > 0 else (U, 0.0)
         W = np.asarray(primitive(jnp.asarray(bad)))
         phi = W[0] / self.phys.material_density
         if status == 1:
@@ -489,6 +505,8 @@ class Simulation:
         elif status == 4:
             field, idx = "density", np.unravel_index(np.argmin(W[0]), self.grid.cells)
             value = W[0][idx]
+        elif status == 6:
+            field, idx, value = "implicit_residual_over_tolerance", (), float(residual)
         else:
             field, idx, value = "time_step", (), dt
         where = tuple(int(i) for i in idx)
@@ -514,11 +532,15 @@ class Simulation:
         data.update({name: (("time", "axis"), np.asarray(history[name], dtype=float).reshape(len(t), -1))
                      for name in PER_AXIS})
         data["theta_haff"] = ("time", theta_haff)
+        limit_names = [n for n in LIMIT_NAMES if len(history.get(f"dt_{n}", [])) == len(t)]
+        for name in limit_names:
+            data[f"dt_{name}"] = ("time", np.asarray(history[f"dt_{name}"], dtype=float))
         data["tau"] = ("time", np.asarray(tau_of_t(t, self.phys, self.phi0, self.theta0), dtype=float))
         ds = xr.Dataset(data, coords={"time": t, "axis": list("xyz"[: self.grid.ndim])})
         units = {"time": "s", "theta_mean": "m2 s-2", "theta_haff": "m2 s-2", "theta_min": "m2 s-2",
                  "kinetic_energy": "m2 s-2", "ke_transverse": "m2 s-2", "ke_longitudinal": "m2 s-2",
                  "tau": "1", "density_variance": "1", "phi_max": "1", "mode_density": "1", "mode_velocity": "1"}
+        units.update({f"dt_{name}": "s" for name in limit_names})
         for name, unit in units.items():
             ds[name].attrs["units"] = unit
         ds.attrs.update(run_metadata(
@@ -526,7 +548,19 @@ class Simulation:
             haff_time_s=self.t_haff, mean_free_path_m=float(mean_free_path(self.phi0, self.phys.diameter)),
             steps=steps if steps is not None else getattr(self, "steps", None),
         ))
+        ds.attrs.update(self.run_summary(history))
         return ds
+
+    def run_summary(self, history: dict[str, list]) -> dict[str, Any]:
+        """Time scheme, step count, the step limit that bound most outputs, stepping wall time per step."""
+        binding = [binding_limit([history[f"dt_{n}"][i] for n in LIMIT_NAMES], self.num.scheme)
+                   for i in range(len(history.get("dt_cfl", [])))]
+        return {
+            "time_scheme": self.num.scheme,
+            "step_count": int(getattr(self, "steps", 0) or 0),
+            "binding_step_limit": max(set(binding), key=binding.count) if binding else "",
+            "wall_time_per_step_s": self.wall_stepping / self.steps_timed if self.steps_timed else float("nan"),
+        }
 
 
 class _Progress:

@@ -1,4 +1,4 @@
-"""Time integration: the right-hand side, the adaptive stable step and SSP-RK3.
+"""Time integration: the right-hand side, the adaptive stable step, IMEX ARS(2,2,2) and SSP-RK3.
 
 ``advance`` runs whole steps inside one compiled ``lax.while_loop`` until a target time, a
 step budget, or the first step that leaves the physical state space — that step is not
@@ -13,13 +13,18 @@ status meaning
 3      φ ≥ phi_stop (approaching packing) somewhere
 4      ρ ≤ 0 somewhere
 5      the stable time step collapsed (Δt ≤ 0 or NaN)
+6      an implicit stage solve did not converge (IMEX)
 ====== =======================================
 
-Scheme: third-order strong-stability-preserving Runge–Kutta (Shu & Osher 1988),
+Schemes (``Numerics.scheme``):
 
-    U1 = U + Δt L(U);   U2 = 3/4 U + 1/4 (U1 + Δt L(U1));   U' = 1/3 U + 2/3 (U2 + Δt L(U2)),
+* ``imex`` (default): ARS(2,2,2), convection and sink explicit, viscous stress and heat
+  conduction implicit (:mod:`.imex`); Δt from the acoustic CFL and cooling limits only.
+* ``ssprk3``: third-order strong-stability-preserving Runge–Kutta (Shu & Osher 1988),
+  U1 = U + Δt L(U);  U2 = 3/4 U + 1/4 (U1 + Δt L(U1));  U' = 1/3 U + 2/3 (U2 + Δt L(U2)),
+  with the diffusive limits added.
 
-with one Δt per step from the acoustic CFL, diffusive and cooling limits at the step start.
+One Δt per step from the limits at the step start.
 """
 
 from __future__ import annotations
@@ -32,6 +37,7 @@ import jax.numpy as jnp
 
 from .fluxes import LIMITERS, RIEMANN_SOLVERS, flux_divergence, materialise
 from .grid import Grid
+from .imex import EXPLICIT_WEIGHTS, GAMMA, IMPLICIT_WEIGHTS, implicit_stage
 from .physics import Physics
 from .sources import cooling_source
 from .state import primitive_fields
@@ -43,7 +49,11 @@ STATUS_MESSAGES = {
     3: "solid fraction reached phi_stop (near the packing limit)",
     4: "density <= 0",
     5: "stable time step collapsed",
+    6: "implicit (IMEX) stage solve did not converge",
 }
+SCHEMES = ("imex", "ssprk3")
+#: Names of the step limits of :func:`step_limits`, in order.
+LIMIT_NAMES = ("cfl", "viscous", "conductive", "cooling")
 
 
 @jax.tree_util.register_pytree_node_class
@@ -56,7 +66,8 @@ class Numerics:
     cfl : float
         Acoustic Courant number: Δt ≤ cfl / max Σ_a (|u_a| + c)/Δx_a.
     cfl_diffusion : float
-        Δt ≤ cfl_diffusion / (2 max D Σ_a Δx_a⁻²), D the largest of (4η/3 + λ_b)/ρ and κ/(3ρ/2).
+        Explicit scheme only: Δt ≤ cfl_diffusion / (2 max D Σ_a Δx_a⁻²) for both D = (4η/3 + λ_b)/ρ
+        (viscous) and D = κ/(3ρ/2) (conductive).
     cfl_source : float
         Δt ≤ cfl_source / max|ζ| (must be < 1 for the positivity argument of :mod:`.sources`).
     limiter : str
@@ -65,6 +76,15 @@ class Numerics:
         ``hll`` or ``rusanov``.
     dt_max : float
         Upper bound on Δt [s] (``inf``: none).
+    scheme : str
+        ``imex`` (ARS(2,2,2), viscous and heat fluxes implicit: :mod:`.imex`) or ``ssprk3``
+        (everything explicit).
+    implicit_tol : float
+        Relative residual of the implicit stage solves (GMRES, CG).
+    implicit_maxiter : int
+        GMRES restarts (of :data:`~ktgf.solver.imex.RESTART` iterations; CG gets as many iterations).
+    sweeps : int
+        Picard passes updating the frozen θ of the implicit coefficients (2 keeps second order).
     """
 
     cfl: float = 0.4
@@ -73,14 +93,21 @@ class Numerics:
     limiter: str = "vanleer"
     riemann: str = "hll"
     dt_max: float = float("inf")
+    scheme: str = "imex"
+    implicit_tol: float = 1e-6
+    implicit_maxiter: int = 5
+    sweeps: int = 1
 
-    def tree_flatten(self) -> tuple[tuple, tuple[str, str]]:
-        return (self.cfl, self.cfl_diffusion, self.cfl_source, self.dt_max), (self.limiter, self.riemann)
+    _LEAVES = ("cfl", "cfl_diffusion", "cfl_source", "dt_max", "implicit_tol")
+    _STATIC = ("limiter", "riemann", "scheme", "implicit_maxiter", "sweeps")
+
+    def tree_flatten(self) -> tuple[tuple, tuple]:
+        return tuple(getattr(self, k) for k in self._LEAVES), tuple(getattr(self, k) for k in self._STATIC)
 
     @classmethod
-    def tree_unflatten(cls, aux: tuple[str, str], leaves: tuple) -> Numerics:
+    def tree_unflatten(cls, aux: tuple, leaves: tuple) -> Numerics:
         obj = object.__new__(cls)
-        for name, v in zip(("cfl", "cfl_diffusion", "cfl_source", "dt_max", "limiter", "riemann"), (*leaves, *aux)):
+        for name, v in zip(cls._LEAVES + cls._STATIC, (*leaves, *aux)):
             object.__setattr__(obj, name, v)
         return obj
 
@@ -91,34 +118,57 @@ class Numerics:
             raise InputError(f"limiter {self.limiter!r} is not valid: choose one of {LIMITERS}")
         if self.riemann not in RIEMANN_SOLVERS:
             raise InputError(f"riemann solver {self.riemann!r} is not valid: choose one of {RIEMANN_SOLVERS}")
+        if self.scheme not in SCHEMES:
+            raise InputError(f"time scheme {self.scheme!r} is not valid: choose one of {SCHEMES}")
+
+
+def explicit_rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, viscous: bool, r: Any = None) -> list[Any]:
+    """−∇·F + S: the convective flux and sink (+ viscous and heat flux if ``viscous``).
+
+    ``r``: cell coefficients of ρ already evaluated (the closures run once per cell and stage).
+    """
+    W = materialise(primitive_fields(U))
+    if r is None:
+        r = phys.reduced(W[0])
+    eos = (r.p, phys.sound_factor(r))
+    transport = phys.transport(W[0], W[4], r) if viscous else ()
+    dU, divu = flux_divergence(W, (eos, transport), grid, phys, num.limiter, num.riemann, viscous=viscous)
+    source, _ = cooling_source(W, divu, phys, r)
+    dU[4] = dU[4] + source
+    return dU
 
 
 def rhs(U: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
-    """dU/dt = −∇·F(U) + S(U)."""
-    W = materialise(primitive_fields(U))
-    dU, divu = flux_divergence(W, grid, phys, num.limiter, num.riemann)
-    source, _ = cooling_source(W, divu, phys)
-    dU[4] = dU[4] + source
-    return tuple(dU)
+    """dU/dt = −∇·F(U) + S(U) (all terms)."""
+    return tuple(explicit_rhs(U, grid, phys, num, viscous=True))
 
 
-def stable_dt(U: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
-    """Largest step allowed by the acoustic, diffusive and cooling limits (see :class:`Numerics`)."""
+def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None) -> Any:
+    """The four step limits (acoustic CFL, viscous, conductive, cooling) of :class:`Numerics` [s]."""
     W = primitive_fields(U)
     rho, u, theta = W[0], W[1:4], W[4]
-    r = phys.reduced(rho)
+    if r is None:
+        r = phys.reduced(rho)
     c = phys.sound_speed(theta, r)
     wave = sum((jnp.abs(u[a]) + c) / grid.spacing[a] for a in range(grid.ndim))
     eta, lam, kap, _ = phys.transport(rho, theta, r)
-    diff = jnp.maximum((4.0 / 3.0 * eta + lam) / rho, kap / (1.5 * rho))
     inv_dx2 = sum(1.0 / h**2 for h in grid.spacing)
+    viscous = num.cfl_diffusion / (2.0 * inv_dx2 * jnp.max((4.0 / 3.0 * eta + lam) / rho))
+    conductive = num.cfl_diffusion / (2.0 * inv_dx2 * jnp.max(kap / (1.5 * rho)))
     # max|ζ| ≤ max ζ0 + max|ζ_U| max|∇·u|, and the central ∇·u obeys
     # |∇·u| ≤ Σ_a (max u_a − min u_a)/(2Δx_a): plain reductions only, since a stencil inside
     # XLA's CPU reduction loop makes it an order of magnitude slower.
     divu_bound = sum((jnp.max(u[a]) - jnp.min(u[a])) * (0.5 / grid.spacing[a]) for a in range(grid.ndim))
     zeta = jnp.max(phys.cooling_rate(rho, theta, 0.0, r)) + jnp.max(jnp.abs(r.zeta_u)) * divu_bound
-    dt = jnp.minimum(num.cfl / jnp.max(wave), num.cfl_diffusion / (2.0 * inv_dx2 * jnp.max(diff)))
-    dt = jnp.minimum(dt, num.cfl_source / zeta)
+    return jnp.stack([num.cfl / jnp.max(wave), viscous, conductive, num.cfl_source / zeta])
+
+
+def stable_dt(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None) -> Any:
+    """Largest step of the scheme: the minimum of its limits (the IMEX scheme has no diffusive ones)."""
+    lim = step_limits(U, grid, phys, num, r)
+    dt = jnp.minimum(lim[0], lim[3])
+    if num.scheme == "ssprk3":
+        dt = jnp.minimum(dt, jnp.minimum(lim[1], lim[2]))
     return jnp.minimum(dt, num.dt_max)
 
 
@@ -136,6 +186,73 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> An
         return tuple(a * u + (1.0 - a) * (uk + dt * l) for u, uk, l in zip(U, Uk, L))
 
     return jax.lax.fori_loop(0, 3, stage, tuple(U))
+
+
+def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> tuple[Any, Any]:
+    """One ARS(2,2,2) step (:mod:`.imex`); returns the state and the worst solve residual / tolerance.
+
+    The two implicit stages run in a ``fori_loop`` (traced once); the closures are evaluated
+    once per stage, at the stage density, and shared by the implicit solve and the next
+    explicit evaluation.
+    """
+    dtype = U[0].dtype
+    wE = jnp.asarray(EXPLICIT_WEIGHTS, dtype)
+    wI = jnp.asarray(IMPLICIT_WEIGHTS, dtype)
+    Un = tuple(U)
+
+    def stage(k: Any, carry: tuple) -> tuple:
+        Uk, rk, KE1, KI2, worst = carry
+        KE = explicit_rhs(Uk, grid, phys, num, viscous=False, r=rk)
+        KE1 = tuple(jnp.where(k == 0, a, b) for a, b in zip(KE, KE1))
+        Uhat = tuple(u + dt * (wE[k, 0] * e1 + wE[k, 1] * e + wI[k] * i2)
+                     for u, e1, e, i2 in zip(Un, KE1, KE, KI2))
+        # The stage solves run in float64 also for a float32 state: float32 Krylov iterations
+        # stall above the tolerance (measured: residual 67x the limit after a few steps).
+        Uhat64 = tuple(u.astype(jnp.float64) for u in Uhat)
+        r = phys.reduced(Uhat64[0])
+        Ui, fI, res = implicit_stage(Uhat64, GAMMA * jnp.asarray(dt, jnp.float64), grid, phys, r,
+                                     jnp.asarray(num.implicit_tol, jnp.float64), num.implicit_maxiter, num.sweeps)
+        r = jax.tree_util.tree_map(lambda x: jnp.asarray(x).astype(dtype), r)
+        return tuple(u.astype(dtype) for u in Ui), r, KE1, \
+            tuple(jnp.broadcast_to(f, Un[0].shape).astype(dtype) for f in fI), jnp.maximum(worst, res.astype(dtype))
+
+    zeros = tuple(jnp.zeros_like(u) for u in Un)
+    r0 = jax.tree_util.tree_map(lambda x: jnp.asarray(x).astype(dtype), phys.reduced(Un[0]))
+    init = (Un, r0, zeros, zeros, jnp.zeros((), dtype))
+    Ui, _, _, _, worst = jax.lax.fori_loop(0, 2, stage, init)
+    return Ui, worst
+
+
+def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> tuple[Any, Any]:
+    """One step of the configured scheme: (state, implicit residual / tolerance — 0 for SSP-RK3)."""
+    if num.scheme == "imex":
+        return imex_step(U, dt, grid, phys, num)
+    return ssprk3_step(U, dt, grid, phys, num), jnp.zeros((), U[0].dtype)
+
+
+#: CPU time of one IMEX step over one SSP-RK3 step, measured (benchmarks/bench_solver.py, RET at
+#: φ = 0.5 with Δx = ℓ: 143–165 ms against 35–37 ms at 32³, 26 against 5.7 ms at 16³).
+IMEX_COST = 4.5
+#: ``auto`` picks IMEX when its step is more than this many times the explicit one: the
+#: break-even IMEX_COST plus a margin for its compilation (≈ 4× that of SSP-RK3, measured).
+IMEX_AUTO_RATIO = 6.0
+
+
+def choose_scheme(U: Any, grid: Grid, phys: Physics, num: Numerics) -> str:
+    """``imex`` or ``ssprk3``: IMEX where its step exceeds the explicit one by IMEX_AUTO_RATIO."""
+    lim = [float(v) for v in limits(U, grid, phys, num)]
+    explicit = min(lim)
+    return "imex" if min(lim[0], lim[3]) > IMEX_AUTO_RATIO * explicit else "ssprk3"
+
+
+def binding_limit(lim: Any, scheme: str) -> str:
+    """Name of the smallest of the step limits the scheme obeys."""
+    active = (0, 3) if scheme == "imex" else (0, 1, 2, 3)
+    return LIMIT_NAMES[min(active, key=lambda i: float(lim[i]))]
+
+
+#: An implicit solve whose final relative residual exceeds this multiple of its tolerance fails.
+RESIDUAL_FAIL = 10.0
 
 
 def state_status(U: Any, phys: Physics) -> Any:
@@ -170,9 +287,10 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         dt_stable = stable_dt(U, grid, phys, num).astype(t.dtype)
         last = dt_stable >= t_end - t
         dt = jnp.where(last, t_end - t, dt_stable)
-        U_new = ssprk3_step(U, dt.astype(U[0].dtype), grid, phys, num)
+        U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num)
         bad_state = state_status(U_new, phys)
         status = jnp.where(bad_state != 0, bad_state, jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5))
+        status = jnp.where((status == 0) & ~(residual <= RESIDUAL_FAIL), 6, status)
         good = status == 0
         U = tuple(jnp.where(good, a, b) for a, b in zip(U_new, U))
         t = jnp.where(good, jnp.where(last, t_end, t + dt), t)
@@ -187,6 +305,13 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
 
 
 @jax.jit
-def step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
-    """One SSP-RK3 step (compiled), used to reproduce a failed step for its diagnosis."""
-    return jnp.stack(ssprk3_step(tuple(U), dt, grid, phys, num))
+def step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> tuple[Any, Any]:
+    """One step (compiled) and its implicit residual / tolerance, to reproduce a failed step for its diagnosis."""
+    U_new, residual = scheme_step(tuple(U), dt, grid, phys, num)
+    return jnp.stack(U_new), residual
+
+
+@jax.jit
+def limits(U: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
+    """:func:`step_limits` compiled (per-output record of the binding limit)."""
+    return step_limits(tuple(U), grid, phys, num)

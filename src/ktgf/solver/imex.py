@@ -1,0 +1,238 @@
+"""IMEX Runge–Kutta time stepping: convection and the collisional sink explicit, viscous stress
+and heat conduction implicit, so Δt is set by the acoustic CFL and the cooling rate alone.
+
+Scheme: the ARS(2,2,2) pair of Ascher, Ruuth & Spiteri (1997), *Implicit-explicit Runge–Kutta
+methods for time-dependent partial differential equations*, Appl. Numer. Math. 25, 151–167,
+§2.6 — second order, the implicit part L-stable and stiffly accurate (the step result is the
+last stage, so no explicit evaluation of the stiff operator is needed), γ = 1 − 1/√2,
+δ = 1 − 1/(2γ):
+
+    explicit (Ã, b̃)                  implicit (A, b)
+    0 | 0     0    0                 0 | 0    0    0
+    γ | γ     0    0                 γ | 0    γ    0
+    1 | δ   1−δ    0                 1 | 0  1−γ    γ
+      | δ   1−δ    0                   | 0  1−γ    γ
+
+For dU/dt = f_E(U) + f_I(U) one step is (f_E: convection + sink, f_I: −∇·(viscous + heat flux))
+
+    Û₂ = Uⁿ + Δt γ f_E(Uⁿ),                       U₂ = Û₂ + Δt γ f_I(U₂)
+    Û₃ = Uⁿ + Δt(δ f_E(Uⁿ) + (1−δ) f_E(U₂)) + Δt(1−γ) f_I(U₂),   Uⁿ⁺¹ = U₃ = Û₃ + Δt γ f_I(U₃)
+
+— two convective evaluations and two implicit stage solves per step.
+
+Implicit stage solve.  f_I has no mass component, so ρ of a stage is the known ρ̂ and the
+closures (functions of φ) are evaluated once per stage at ρ̂.  With the coefficients frozen at a
+temperature θ_k (η, λ_b, κ ∝ √θ, ω ∝ θ^{3/2}) the stage equation splits into two linear problems:
+
+    ρ̂u − aΔt ∇·τ[η, λ_b](u) = m̂                                     (3 velocity components)
+    (3/2)ρ̂θ − aΔt ∇·(κ∇θ) = Ê − ρ̂|u|²/2 + aΔt ∇·(τ·u + ω∇φ)           (then θ, given u)
+
+The first is solved by GMRES (the discrete operator is not symmetric for variable η), the second
+by CG (symmetric positive definite), both matrix-free with the exact inverse of the
+constant-coefficient operator (mean ρ̂, η, λ_b, κ) applied by FFT as preconditioner (periodic
+grid; the symbols of the same discrete stencils).  ``sweeps`` Picard passes update θ_k: the
+first uses θ of Û (an O(Δt) error in the coefficients), the second θ of the first solution
+(O(Δt²)), which keeps the scheme second order (measured in tests/test_solver_imex.py).  The
+stage state is then U = Û + aΔt f_I(ρ̂, u, θ) with f_I the same flux divergence the explicit
+scheme uses, so mass, momentum and energy are conserved exactly whatever the solver residual;
+the residual (stage equation minus that state) is checked, and a solve whose relative
+residual exceeds 10× the tolerance rejects the step (status 6).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax.scipy.sparse.linalg import cg, gmres
+
+from ..closures.coefficients import Reduced
+from .fluxes import face_coefficients, face_divergence, face_jump, pad_periodic, stress, viscous_flux
+from .grid import Grid
+from .physics import Physics
+from .state import primitive_fields
+
+GAMMA = 1.0 - 1.0 / math.sqrt(2.0)
+DELTA = 1.0 - 1.0 / (2.0 * GAMMA)
+#: Explicit weights of (f_E(Uⁿ), f_E(U₂)) and implicit weight of f_I(U₂) in Û of stages 2 and 3.
+EXPLICIT_WEIGHTS = ((GAMMA, 0.0), (DELTA, 1.0 - DELTA))
+IMPLICIT_WEIGHTS = (0.0, 1.0 - GAMMA)
+#: GMRES Krylov dimension per restart.
+RESTART = 10
+
+
+def _symbols(grid: Grid, dtype: Any) -> tuple[list[Any], list[Any]]:
+    """Fourier symbols (rfftn layout) of the discrete stencils, per grid axis.
+
+    s²_a = (2 sin(πm/n)/Δx)² (two-point second difference, −∂²), t_a = sin(2πm/n)/Δx
+    (central difference, i∂); arrays broadcastable to the rfftn shape of a field.
+    """
+    s2, t = [], []
+    for a, n in enumerate(grid.cells):
+        m = np.fft.rfftfreq(n) * n if a == grid.ndim - 1 else np.fft.fftfreq(n) * n
+        shape = [1] * grid.ndim
+        shape[a] = m.size
+        h = grid.spacing[a]
+        s2.append(jnp.asarray((2.0 * np.sin(np.pi * m / n)) ** 2, dtype).reshape(shape) / (h * h))
+        t.append(jnp.asarray(np.sin(2.0 * np.pi * m / n), dtype).reshape(shape) / h)
+    return s2, t
+
+
+def _fft(f: Any, grid: Grid) -> Any:
+    return jnp.fft.rfftn(f, axes=tuple(range(grid.ndim)))
+
+
+def _ifft(f: Any, grid: Grid, dtype: Any) -> Any:
+    return jnp.fft.irfftn(f, s=grid.cells, axes=tuple(range(grid.ndim))).astype(dtype)
+
+
+def momentum_preconditioner(grid: Grid, rho: Any, eta: Any, lam: Any, adt: Any, dtype: Any):
+    """Exact inverse of ρ − aΔt∇·τ[η, λ_b] for constant ρ, η, λ_b (per wavevector a 3×3 system).
+
+    Symbol of −∇·τ: η|s|² I + c(diag(s²) − diag(t²)) + c t tᵀ, c = η/3 + λ_b; the matrix
+    D + c' t tᵀ is inverted by the Sherman–Morrison formula (D > 0 since t² ≤ s²).
+    """
+    s2, t = _symbols(grid, dtype)
+    s2 = s2 + [0.0] * (3 - grid.ndim)
+    t = t + [0.0] * (3 - grid.ndim)
+    s2sum = sum(s2)
+    c = adt * (eta / 3.0 + lam)
+    D = [rho + adt * eta * s2sum + c * (s2[j] - t[j] * t[j]) for j in range(3)]
+
+    def apply(r: tuple) -> tuple:
+        rh = [_fft(x, grid) for x in r]
+        y = [rh[j] / D[j] for j in range(3)]
+        num = sum(t[j] * y[j] for j in range(3))
+        den = 1.0 + c * sum(t[j] * t[j] / D[j] for j in range(3))
+        coef = c * num / den
+        return tuple(_ifft(y[j] - coef * t[j] / D[j], grid, dtype) for j in range(3))
+
+    return apply
+
+
+def heat_preconditioner(grid: Grid, rho: Any, kappa: Any, adt: Any, dtype: Any):
+    """Exact inverse of (3/2)ρ − aΔt∇·(κ∇) for constant ρ, κ."""
+    s2, _ = _symbols(grid, dtype)
+    D = 1.5 * rho + adt * kappa * sum(s2)
+    return lambda r: _ifft(_fft(r, grid) / D, grid, dtype)
+
+
+def viscous_divergence(W: tuple, transport: tuple, grid: Grid, phys: Physics) -> list[Any]:
+    """f_I = −∇·(viscous + heat flux) at the cells: (0, ∇·τ, ∇·(τ·u) − ∇·q)."""
+    P = pad_periodic(W, grid.ndim)
+    Pk = pad_periodic(transport, grid.ndim)
+    out: list[Any] = [0.0] * 5
+    for a in range(grid.ndim):
+        F = viscous_flux(P, Pk, a, grid, phys.material_density)
+        dF = face_divergence(jnp.stack([jnp.broadcast_to(f, F[1].shape) for f in F[1:]]), grid, a)
+        out = [out[0]] + [o + dF[i] for i, o in enumerate(out[1:])]
+    out[0] = jnp.zeros_like(W[0])
+    return out
+
+
+def _face_sum(faces: list[Any], grid: Grid, axis: int) -> Any:
+    """Sum of a face coefficient over the two faces of every cell along ``axis``."""
+    n = grid.cells[axis]
+    f = faces[axis]
+    return jax.lax.slice_in_dim(f, 0, n, axis=axis) + jax.lax.slice_in_dim(f, 1, n + 1, axis=axis)
+
+
+def _scaled(apply: Any, scale: Any) -> Any:
+    """S⁻¹ M⁻¹ S⁻¹: the constant-coefficient inverse with the diagonal variation of the operator."""
+    if isinstance(scale, tuple):
+        return lambda r: tuple(y / s for y, s in zip(apply(tuple(x / s for x, s in zip(r, scale))), scale))
+    return lambda r: apply(r / scale) / scale
+
+
+def _norm(x: Any) -> Any:
+    return jnp.sqrt(sum(jnp.sum(f * f) for f in (x if isinstance(x, tuple) else (x,))))
+
+
+def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced, tol: Any, maxiter: int,
+                   sweeps: int) -> tuple[tuple, list[Any], Any]:
+    """Solve U = Û + aΔt f_I(U) (see the module docstring).
+
+    Returns the stage state, f_I at it, and the largest relative residual divided by ``tol``.
+    """
+    dtype = Uhat[0].dtype
+    Wh = primitive_fields(Uhat)
+    rho = Wh[0]
+    m_hat, E_hat = Uhat[1:4], Uhat[4]
+    rho_mean = jnp.mean(rho)
+    u, theta = tuple(Wh[1:4]), Wh[4]
+    floor = 100.0 * float(jnp.finfo(dtype).eps)
+    inv_dx2 = [1.0 / (h * h) for h in grid.spacing]
+    # Coefficient temperature: θ of Û plus the explicit implicit-part increment, an O(Δt²)
+    # estimate of the stage θ (kept within a factor 2 of θ̂, which only matters far outside the
+    # asymptotic range).
+    fI = viscous_divergence(Wh, phys.transport(rho, theta, r), grid, phys)
+    heat = fI[4] - sum(x * f for x, f in zip(u, fI[1:4]))
+    theta = jnp.clip(theta + adt * heat / (1.5 * rho), 0.5 * theta, 2.0 * theta)
+
+    worst = jnp.zeros((), dtype)
+    for _ in range(sweeps):
+        transport = phys.transport(rho, theta, r)
+        Pk = pad_periodic(transport, grid.ndim)
+        faces = [face_coefficients(Pk, grid.cells, a) for a in range(grid.ndim)]
+        eta_f = [f[0] for f in faces]
+        c_f = [f[0] / 3.0 + f[1] for f in faces]
+        kap_f = [f[2] for f in faces]
+
+        def div_tau(v: tuple) -> list[Any]:
+            Pu = pad_periodic(v, grid.ndim)
+            out: list[Any] = [0.0, 0.0, 0.0]
+            for a in range(grid.ndim):
+                dF = face_divergence(jnp.stack(stress(Pu, faces[a][0], faces[a][1], a, grid)), grid, a)
+                out = [o - dF[j] for j, o in enumerate(out)]
+            return out
+
+        def A(v: tuple) -> tuple:
+            d = div_tau(v)
+            return tuple(rho * v[j] - adt * d[j] for j in range(3))
+
+        eta_m, lam_m = jnp.mean(transport[0]), jnp.mean(transport[1])
+        c_m = eta_m / 3.0 + lam_m
+        iso = sum(_face_sum(eta_f, grid, a) * inv_dx2[a] for a in range(grid.ndim))
+        iso_m = 2.0 * eta_m * sum(inv_dx2)
+        scale = tuple(
+            jnp.sqrt((rho + adt * (iso + (_face_sum(c_f, grid, j) * inv_dx2[j] if j < grid.ndim else 0.0)))
+                     / (rho_mean + adt * (iso_m + (2.0 * c_m * inv_dx2[j] if j < grid.ndim else 0.0))))
+            for j in range(3))
+        M = _scaled(momentum_preconditioner(grid, rho_mean, eta_m, lam_m, adt, dtype), scale)
+        b = tuple(m - a for m, a in zip(m_hat, A(u)))  # solve for the correction to the current u
+        atol_m = floor * _norm(m_hat)
+        du, _ = gmres(A, b, tol=tol, atol=atol_m, restart=RESTART, maxiter=maxiter, M=M, solve_method="incremental")
+        u = tuple(x + dx for x, dx in zip(u, du))
+
+        def B(th: Any) -> Any:
+            Pt = pad_periodic((th,), grid.ndim)[0]
+            div = sum(face_divergence(-kap_f[a] * face_jump(Pt, grid.cells, a) / grid.spacing[a], grid, a)
+                      for a in range(grid.ndim))
+            return 1.5 * rho * th - adt * div
+
+        # Right-hand side: Ê − ρ̂|u|²/2 + aΔt∇·(τ·u + ω∇φ), i.e. the stage equation with κ = 0.
+        fI0 = viscous_divergence((rho, *u, jnp.zeros_like(theta)), transport, grid, phys)
+        rhs_E = E_hat - 0.5 * rho * sum(x * x for x in u) + adt * fI0[4]
+        kap_m = jnp.mean(transport[2])
+        hscale = jnp.sqrt((1.5 * rho + adt * sum(_face_sum(kap_f, grid, a) * inv_dx2[a] for a in range(grid.ndim)))
+                          / (1.5 * rho_mean + 2.0 * adt * kap_m * sum(inv_dx2)))
+        Mh = _scaled(heat_preconditioner(grid, rho_mean, kap_m, adt, dtype), hscale)
+        th0 = primitive_fields((rho, *(rho * x for x in u), E_hat))[4]  # θ of Û with the new u
+        bE = rhs_E - B(th0)
+        atol_E = floor * _norm(rhs_E)
+        dth, _ = cg(B, bE, tol=tol, atol=atol_E, maxiter=RESTART * maxiter, M=Mh)
+        theta = th0 + dth
+
+        # The conservative stage state and the residual of its two linear problems.
+        fI = viscous_divergence((rho, *u, theta), transport, grid, phys)
+        U = (rho, *(m + adt * f for m, f in zip(m_hat, fI[1:4])), E_hat + adt * fI[4])
+        res_m = _norm(tuple(rho * x - m for x, m in zip(u, U[1:4])))
+        res_E = _norm(U[4] - rho * (0.5 * sum(x * x for x in u) + 1.5 * theta))
+        tiny = float(jnp.finfo(dtype).tiny)  # a zero right-hand side (uniform gas) is solved exactly
+        worst = jnp.maximum(worst, jnp.maximum(res_m / jnp.maximum(jnp.maximum(tol * _norm(b), atol_m), tiny),
+                                               res_E / jnp.maximum(jnp.maximum(tol * _norm(bE), atol_E), tiny)))
+        theta = primitive_fields(U)[4]
+    return U, fI, worst
