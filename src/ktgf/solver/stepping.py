@@ -80,9 +80,9 @@ class Numerics:
         ``imex`` (ARS(2,2,2), viscous and heat fluxes implicit: :mod:`.imex`) or ``ssprk3``
         (everything explicit).
     implicit_tol : float
-        Relative residual of the implicit stage solves (GMRES, CG).
+        Relative residual of the implicit stage solves (BiCGSTAB, CG).
     implicit_maxiter : int
-        GMRES restarts (of :data:`~ktgf.solver.imex.RESTART` iterations; CG gets as many iterations).
+        Krylov iterations of each stage solve, in units of :data:`~ktgf.solver.imex.RESTART` (10).
     sweeps : int
         Picard passes updating the frozen θ of the implicit coefficients (2 keeps second order).
     """
