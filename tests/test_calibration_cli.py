@@ -203,7 +203,7 @@ def test_plot_coefficients_and_couette_sweep_take_the_model_file(fitted, tmp_pat
     r = runner.invoke(app, [*args, "--model-file", str(out)])
     assert r.exit_code == 0, r.output
     mine = json.loads(r.stdout)[0]
-    assert mine["converged"] and mine["wall_shear_stress"] != pytest.approx(plain["wall_shear_stress"], rel=1e-3)
+    assert mine["converged"] and mine["wall_shear_stress_Pa"] != pytest.approx(plain["wall_shear_stress_Pa"], rel=1e-3)
 
 
 def test_couette_calibration_round_trip_walls_through_compare(tmp_path, data_dir):

@@ -149,7 +149,7 @@ def test_cli_sweep_through_executor(tmp_path):
     assert len(rows) == 4 and all(row["converged"] for row in rows)
     # more specular (smaller φ') walls slip more
     for ew in (0.8, 0.95):
-        s = {row["specularity"]: row["slip"] for row in rows if row["wall_restitution"] == ew}
+        s = {row["specularity"]: row["slip_over_U"] for row in rows if row["wall_restitution"] == ew}
         assert s[0.05] > s[0.5]
 
 

@@ -148,11 +148,11 @@ def _sweep_task(task: tuple[dict[str, Any], float, float]) -> dict[str, Any]:
     try:
         ds = run_config(cfg, model)
     except ConvergenceError as exc:
-        return {**row, "converged": False, "slip": float("nan"), "wall_shear_stress": float("nan"),
+        return {**row, "converged": False, "slip_over_U": float("nan"), "wall_shear_stress_Pa": float("nan"),
                 "max_phi": float("nan"), "valid": False, "message": str(exc)[:80]}
     U = float(ds.attrs["velocity_scale"])
-    return {**row, "converged": True, "slip": float(abs(ds["wall_slip"].values[0]) / U),
-            "wall_shear_stress": float(ds["wall_shear_stress"].values[0]),
+    return {**row, "converged": True, "slip_over_U": float(abs(ds["wall_slip"].values[0]) / U),
+            "wall_shear_stress_Pa": float(ds["wall_shear_stress"].values[0]),
             "max_phi": float(ds.attrs["max_phi"]), "valid": bool(ds.attrs["physically_valid"]), "message": ""}
 
 

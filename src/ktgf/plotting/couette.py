@@ -49,7 +49,7 @@ def _d(ds: Any) -> float:
     return float(json.loads(ds.attrs["parameters"])["d"])
 
 
-def plot_sweep(rows: list[dict[str, Any]], out: str | Path, *, quantity: str = "slip") -> Path:
+def plot_sweep(rows: list[dict[str, Any]], out: str | Path, *, quantity: str = "slip_over_U") -> Path:
     """A swept quantity against the specularity, one line per wall restitution."""
     import matplotlib.pyplot as plt
 
