@@ -48,7 +48,7 @@ from .stepping import LIMIT_NAMES, STATUS_MESSAGES, Numerics, advance, binding_l
 
 CHECKPOINT = "checkpoint.npz"
 TIMESERIES = "hcs.nc"
-HISTORY_KEYS = ("time", *SCALARS, *PER_AXIS)
+HISTORY_KEYS = ("time", *SCALARS, *PER_AXIS, *(f"dt_{n}" for n in LIMIT_NAMES))
 #: Config fields that may differ between a checkpoint and the run resuming it: where and how
 #: often files are written, the chunk size (the step sequence does not depend on it) and the
 #: end time / output count (outputs after the last one recorded follow the new schedule).
