@@ -230,11 +230,11 @@ def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> tu
     return ssprk3_step(U, dt, grid, phys, num), jnp.zeros((), U[0].dtype)
 
 
-#: CPU time of one IMEX step over one SSP-RK3 step, measured (benchmarks/bench_solver.py, RET at
-#: φ = 0.5 with Δx = ℓ: 143–165 ms against 35–37 ms at 32³, 26 against 5.7 ms at 16³).
-IMEX_COST = 4.5
+#: CPU time of one IMEX step over one SSP-RK3 step, measured (RET at φ = 0.5 with Δx = ℓ, 32³:
+#: 108 ms against 36 ms with BiCGSTAB; 143–165 against 35–37 ms with the earlier GMRES).
+IMEX_COST = 3.0
 #: ``auto`` picks IMEX when its step is more than this many times the explicit one: the
-#: break-even IMEX_COST plus a margin for its compilation (≈ 4× that of SSP-RK3, measured).
+#: break-even IMEX_COST times two, a margin for its compilation (≈ 4× that of SSP-RK3, measured).
 IMEX_AUTO_RATIO = 6.0
 
 
