@@ -259,3 +259,13 @@ def test_page_renders_in_headless_chromium(built, tmp_path) -> None:
     # A displayed page has text and figures: many distinct colours, not a blank or error page.
     colours = np.unique((img[..., :3] * 255).astype(np.uint8).reshape(-1, 3), axis=0)
     assert len(colours) > 200
+
+
+def test_page_headings_are_numbered_once_each(built) -> None:
+    """Result sections, discussion and rerun part carry the numbers 1, 2, ..., N without a repeat."""
+    import re
+
+    page = (built.out / PAGE_NAME).read_text()
+    numbers = [int(n) for n in re.findall(r"<h2>(\d+)\. ", page)]
+    assert numbers == list(range(1, len(numbers) + 1)), numbers
+    assert len(numbers) == len(built.statuses) + 2

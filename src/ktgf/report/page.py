@@ -30,7 +30,9 @@ PAGE_MODE = 0o644
 GENERATOR = "ktgf reproduce"
 #: Sections every page has besides the registered ones (generated at page time, never cached).
 FIXED_SECTIONS = ("summary", "discussion", "rerun")
-DISCUSSION = "5. Discussion"
+def closing_titles(n_sections: int) -> tuple[str, str]:
+    """Titles of the two closing parts, numbered after the ``n_sections`` result sections."""
+    return f"{n_sections + 1}. Discussion", f"{n_sections + 2}. How to rerun"
 PACKAGES = ("numpy", "scipy", "xarray", "netCDF4", "h5netcdf", "matplotlib", "jax", "pydantic", "typer")
 
 _CSS = """
@@ -110,7 +112,8 @@ def _section(r: SectionResult) -> str:
 
 def _discussion(results: list[SectionResult]) -> str:
     by_key = {s.key: s for s in sections()}
-    parts = [f'<section id="{section_id("discussion")}"><h2>{DISCUSSION}</h2>',
+    title = closing_titles(len(results))[0]
+    parts = [f'<section id="{section_id("discussion")}"><h2>{title}</h2>',
              "<p class=\"status\">Generated from the numbers of the sections above.</p>"]
     sub = 0
     for r in results:
@@ -118,8 +121,8 @@ def _discussion(results: list[SectionResult]) -> str:
         if r.status in ("computed", "cached") and sec is not None:
             sentences = sec.discuss(r.numbers)
             if sentences:
-                sub += 1  # numbered within the discussion (5.1, 5.2, ...), not with the section numbers again
-                parts.append(f"<h3>{DISCUSSION.split('.')[0]}.{sub} {html.escape(_unnumbered(r.title))}</h3>")
+                sub += 1  # numbered within the discussion (6.1, 6.2, ...), not with the section numbers again
+                parts.append(f"<h3>{title.split('.')[0]}.{sub} {html.escape(_unnumbered(r.title))}</h3>")
                 parts += [f"<p>{html.escape(s)}</p>" for s in sentences]
         elif r.status == "unavailable":
             parts.append(f"<p><b>{html.escape(r.title)}</b>: not available in this build, so not discussed.</p>")
@@ -147,7 +150,7 @@ def _rerun(results: list[SectionResult], settings: ReportSettings, data_dir: Pat
     from ..closures.models import get_model
 
     command = " ".join(argv) if argv else settings.rerun_options()
-    parts = [f'<section id="{section_id("rerun")}"><h2>6. How to rerun</h2>',
+    parts = [f'<section id="{section_id("rerun")}"><h2>{closing_titles(len(results))[1]}</h2>',
              f"<p>Command: <code>{html.escape(command)}</code> (a rerun reuses cached sections whose inputs are unchanged; "
              "delete the <code>.cache</code> folder to recompute everything).</p>"]
     versions = [["ktgf", __version__], ["python", platform.python_version()], ["platform", platform.platform()]]
@@ -188,7 +191,8 @@ def write_page(out: Path, results: list[SectionResult], settings: ReportSettings
     kind = "quick (coarse) run" if settings.quick else "full run"
     toc = "".join(f'<li><a href="#{section_id(r.key)}">{html.escape(r.title)}</a></li>' for r in results)
     toc = f'<li><a href="#{section_id("summary")}">Summary</a></li>' + toc
-    toc += f'<li><a href="#{section_id("discussion")}">{DISCUSSION}</a></li><li><a href="#{section_id("rerun")}">6. How to rerun</a></li>'
+    discussion, rerun = closing_titles(len(results))
+    toc += f'<li><a href="#{section_id("discussion")}">{discussion}</a></li><li><a href="#{section_id("rerun")}">{rerun}</a></li>'
     body = "\n".join(_section(r) for r in results)
     doc = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
