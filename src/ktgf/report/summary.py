@@ -34,6 +34,11 @@ class Row:
         return [n for n, v in self.errors.items() if v <= low + TIE]
 
 
+def model_names(rows: list[Row]) -> list[str]:
+    """Every model of any row, in the order they first appear (a section may add models, e.g. ``dense``)."""
+    return list(dict.fromkeys(n for r in rows for n in r.errors))
+
+
 @dataclass
 class Summary:
     rows: list[Row] = field(default_factory=list)
@@ -58,7 +63,7 @@ def summarise(results: list[SectionResult]) -> Summary:
     """Collect the comparison rows from the sections' numbers and derive recommendations and caveats."""
     by = {r.key: r for r in results if r.status in ("computed", "cached")}
     s = Summary()
-    hcs, coef, cou = by.get("hcs"), by.get("coefficients"), by.get("couette")
+    hcs, coef, cou, dense = by.get("hcs"), by.get("coefficients"), by.get("couette"), by.get("dense")
     states: list[tuple[float, float]] = []
     if hcs is not None and "cooling_mean_abs_error" in hcs.numbers:
         states = [tuple(float(x) for x in k.split(",")) for k in hcs.numbers.get("cooling_best", {})]
@@ -82,6 +87,12 @@ def summarise(results: list[SectionResult]) -> Summary:
         for key, what, pct in (("phi_rms", "φ profile: RMS(φ − φ_DEM)", False), ("theta_rms_rel", "θ profile: RMS(θ/θ_DEM − 1)", True),
                                ("u_rms_over_U", "u profile: RMS(u − u_DEM)/U", False)):
             s.rows.append(Row(case, what, "dense", {n: v[key] for n, v in ce.items()}, data, pct))
+    if dense is not None and "couette_wall" in dense.numbers:
+        cw = {n: v for n, v in dense.numbers["couette_wall"].items() if v.get("valid")}
+        data = _data(dense, "couette_wall_stresses")
+        if cw:
+            for key, what in (("tau_error", "wall shear stress τ_w: |error|"), ("p_error", "wall normal stress p: |error|")):
+                s.rows.append(Row("Couette cell, wall stresses (predicted)", what, "dense", {n: abs(v[key]) for n, v in cw.items()}, data))
     _recommend(s, states)
     _caveats(s, by, hcs)
     return s
@@ -104,7 +115,7 @@ def _recommend(s: Summary, states: list[tuple[float, float]]) -> None:
             for n in r.best:
                 wins[n] = wins.get(n, 0) + 1
         top = max(wins.values())
-        best = [n for n in rows[0].errors if wins.get(n, 0) == top]
+        best = [n for n in model_names(rows) if wins.get(n, 0) == top]
         groups = {tuple(r.best) for r in telling if set(r.best) <= set(best)}
         if len(groups) > 1:  # e.g. one theory wins one comparison, the other another: say so, pick none
             s.recommendations.append(
@@ -112,7 +123,7 @@ def _recommend(s: Summary, states: list[tuple[float, float]]) -> None:
                     f"{_join(r.best)} closest in {r.measure.split(':')[0]} ({_fmt(r.errors[r.best[0]], r.percent)})" for r in telling)
                 + f"{tail}.")
             continue
-        detail = "; ".join(f"{r.measure.split(':')[0]} {_fmt(r.errors[best[0]], r.percent)}" for r in rows)
+        detail = "; ".join(f"{r.measure.split(':')[0]} {_fmt(r.errors[best[0]], r.percent)}" for r in rows if best[0] in r.errors)
         s.recommendations.append(
             f"{where}: {_join(best)} — closest to the DEM in {top} of {len(telling)} comparisons that tell the models apart "
             f"({'tied, identical there' if len(best) > 1 else 'its errors'}: {detail}).")
@@ -137,7 +148,7 @@ def _caveats(s: Summary, by: dict[str, SectionResult], hcs: SectionResult | None
     if any(r.case.startswith("Couette") for r in s.rows):
         s.caveats.append("Couette: each model's wall specularity is fitted to this same DEM case, so the profile errors test the bulk "
                          "closures, not a blind prediction; the DEM walls are bumpy, the continuum walls Johnson–Jackson.")
-        mp = by["couette"].numbers.get("couette_max_phi", {})
+        mp = by["couette"].numbers.get("couette_max_phi", {}) if "couette" in by else {}
         over = [n for n, v in mp.items() if v >= 0.62]
         if over:
             s.caveats.append(f"Couette: the maximum φ of {_join(over)} reaches "
@@ -156,18 +167,15 @@ def summary_html(results: list[SectionResult]) -> str:
     import html
 
     s = summarise(results)
-    if not s.rows:
-        names = []
-    else:
-        names = list(s.rows[0].errors)
+    names = model_names(s.rows)
     parts = ['<section id="sec-summary"><h2>Summary: which model, where, and how wrong</h2>']
     if s.rows:
         head = "".join(f"<th>{html.escape(_label(n))}</th>" for n in names)
         body = []
         for r in s.rows:
             cells = "".join(
-                f"<td>{'<b>' if n in r.best else ''}{html.escape(_fmt(r.errors[n], r.percent))}{'</b>' if n in r.best else ''}</td>"
-                for n in names)
+                (f"<td>{'<b>' if n in r.best else ''}{html.escape(_fmt(r.errors[n], r.percent))}{'</b>' if n in r.best else ''}</td>"
+                 if n in r.errors else "<td>—</td>") for n in names)
             link = f'<a href="{html.escape(r.data)}">{html.escape(r.data.rsplit("/", 1)[-1])}</a>' if r.data else "—"
             body.append(f'<tr><td class="l">{html.escape(r.case)}</td><td class="l">{html.escape(r.measure)}</td>{cells}'
                         f'<td class="l">{link}</td></tr>')
