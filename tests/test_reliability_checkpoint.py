@@ -18,38 +18,21 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from _tiny_case import tiny_case
 from typer.testing import CliRunner
 
 from ktgf.cli import app
 from ktgf.solver.io import load_checkpoint, save_checkpoint
 from ktgf.solver.outdir import LOCK
 
-CASE = """
-[model]
-name = "ret"
-restitution = 0.8
-[initial]
-solid_fraction = 0.25
-temperature = 1e-4
-amplitude = 0.05
-seed = 2
-[grid]
-cells = [8]
-relative_to = "transverse"
-factor = 1.5
-[time]
-end = {end}
-outputs = 4
-[output]
-checkpoint_every = 1
-vtk_every = {vtk_every}
-png = false
-"""
+
+def case_text(end: float = 4.0, vtk_every: int = 2) -> str:
+    return tiny_case(end=end, output=f"checkpoint_every = 1\nvtk_every = {vtk_every}")
 
 
 def _case(tmp: Path, name: str = "case.toml", end: float = 4.0, vtk_every: int = 2, extra: str = "") -> Path:
     p = tmp / name
-    p.write_text(CASE.format(end=end, vtk_every=vtk_every) + extra)
+    p.write_text(case_text(end, vtk_every) + extra)
     return p
 
 
@@ -194,7 +177,7 @@ def test_history_times_must_be_the_output_times(ck: Path, tmp_path: Path) -> Non
 def test_another_config_is_refused_naming_the_field(ck: Path, tmp_path: Path) -> None:
     code, err = _run(_case(tmp_path, extra="[numerics]\ncfl = 0.3\n"), "-o", tmp_path / "o", "--resume", ck)
     _one_line_error(code, err, "field numerics.cfl = 0.4 in the checkpoint, 0.3 now")
-    text = CASE.format(end=4.0, vtk_every=2).replace("restitution = 0.8", "restitution = 0.9")
+    text = case_text(4.0, 2).replace("restitution = 0.8", "restitution = 0.9")
     (tmp_path / "e.toml").write_text(text)
     _one_line_error(*_run(tmp_path / "e.toml", "-o", tmp_path / "o", "--resume", ck), "model.restitution")
 

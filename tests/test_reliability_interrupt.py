@@ -20,34 +20,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from _tiny_case import tiny_case
 
 from ktgf.solver.io import load_checkpoint
 from ktgf.solver.outdir import LOCK
 
 # 1D, 8 cells, one step per compiled chunk (many chunk boundaries), checkpoints every 2nd output
-CASE = """
-[model]
-name = "ret"
-restitution = 0.8
-[initial]
-solid_fraction = 0.25
-temperature = 1e-4
-amplitude = 0.05
-seed = 2
-[grid]
-cells = [8]
-relative_to = "transverse"
-factor = 1.5
-[time]
-end = 4.0
-outputs = 4
-max_steps_per_call = 1
-[output]
-directory = "run"
-checkpoint_every = 2
-vtk_every = 2
-png = false
-"""
+CASE = tiny_case(time="max_steps_per_call = 1", output='directory = "run"\ncheckpoint_every = 2\nvtk_every = 2')
 
 
 def _cli(*args: str, fault: str | None = None, monkeypatch: pytest.MonkeyPatch) -> tuple[int, str]:
