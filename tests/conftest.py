@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 from pathlib import Path
 
 import pytest
@@ -36,7 +37,30 @@ def _jax_x64() -> None:
 
 @pytest.fixture(scope="session")
 def quick_report(tmp_path_factory):
-    """One ``ktgf reproduce --quick`` report per test session; tests copy it before changing it."""
+    """One ``ktgf reproduce --quick`` report per test run; tests copy it before changing it.
+
+    Under pytest-xdist the first worker that needs it builds it in the run's shared temporary
+    folder (behind a file lock); every worker then rebuilds its own copy from the report's cache,
+    which recomputes nothing, so the minute-long build happens once per run, not once per worker.
+    """
     from ktgf.report import ReportSettings, build_report
 
-    return build_report(ReportSettings.preset(quick=True, out=tmp_path_factory.mktemp("quick") / "r"))
+    def build(out):
+        return build_report(ReportSettings.preset(quick=True, out=out))
+
+    own = tmp_path_factory.mktemp("quick") / "r"
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - no flock (Windows): each worker builds its own
+        fcntl = None
+    if fcntl is None or not os.environ.get("PYTEST_XDIST_WORKER"):
+        return build(own)
+    shared = tmp_path_factory.getbasetemp().parent / "quick_report"
+    shared.mkdir(exist_ok=True)
+    with open(shared / "lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not (shared / "done").exists():
+            build(shared / "r")
+            (shared / "done").touch()
+    shutil.copytree(shared / "r", own)
+    return build(own)
