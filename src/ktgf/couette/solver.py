@@ -27,6 +27,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from ..errors import ConvergenceError
+from . import arclength
 from .equations import N_VARS, Problem
 from .uniform_shear import uniform_shear
 
@@ -261,7 +262,7 @@ def homotopy_paths(problem: Problem) -> list[list[dict[str, Any]]]:
 
 
 def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: float, max_iter: int,
-            ptc_max_iter: int):
+            ptc_max_iter: int, continuation: str = "natural"):
     """Natural-parameter continuation through ``stages`` with adaptive steps; returns (X, iterations, steps)."""
     sub = _staged_problem(problem, stages[0])
     X, rep = newton(sub, naive_start(sub), tol=tol, max_iter=max_iter)
@@ -272,8 +273,15 @@ def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: 
             f"Couette solver did not converge from the naive start nor from the easy state ({rep.message}); "
             f"last relative residual {rep.residual:.3g}", history, X, sub)
     steps = 0
+    folds: list[float] = []
     for a, b in zip(stages[:-1], stages[1:]):
         s, ds = 0.0, 0.25
+        if continuation == "arclength":
+            X, path = _arclength_stage(problem, a, b, s, X, history, tol)
+            total_it += path.corrector_iterations
+            steps += len(path.lam) - 1 + path.rejected_steps
+            folds += path.folds
+            continue
         while s < 1.0:
             s_try = min(1.0, s + ds)
             sub = _staged_problem(problem, _interpolate(a, b, s_try))
@@ -287,15 +295,43 @@ def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: 
             else:
                 ds *= 0.5
                 if ds < 1e-3:
-                    raise CouetteConvergenceError(
-                        f"Couette continuation stalled (mean phi {sub.mean_phi:.4f}, e {sub.e:.4f}, "
-                        f"specularity {[round(w.specularity, 5) for w in sub.walls]}): {rep.message}; "
-                        f"last relative residual {rep.residual:.3g}", history, Xt, sub)
-    return X, total_it, steps
+                    # natural-parameter steps cannot pass a turning point of the solution curve:
+                    # follow the rest of this stage by pseudo-arclength continuation
+                    why = (f"natural-parameter continuation stalled at mean phi {sub.mean_phi:.4f}, e {sub.e:.4f}, "
+                           f"specularity {[round(w.specularity, 5) for w in sub.walls]} ({rep.message}, last "
+                           f"relative residual {rep.residual:.3g}); then ")
+                    X, path = _arclength_stage(problem, a, b, s, X, history, tol, why)
+                    total_it += path.corrector_iterations
+                    steps += len(path.lam) - 1 + path.rejected_steps
+                    folds += path.folds
+                    break
+    return X, total_it, steps, folds
+
+
+def _arclength_stage(problem: Problem, a: dict[str, Any], b: dict[str, Any], s: float, X: np.ndarray,
+                     history: list, tol: float, why: str = ""):
+    """Pseudo-arclength continuation of one homotopy stage from its fraction s to 1, polished by Newton."""
+    try:
+        X, path = arclength.follow(lambda lam: _staged_problem(problem, _interpolate(a, b, lam)), X, s, 1.0,
+                                   lam_min=0.0)
+    except arclength.ArclengthStall as exc:
+        last = _staged_problem(problem, _interpolate(a, b, exc.lam))
+        raise CouetteConvergenceError(
+            f"Couette continuation failed: {why}{exc} (there: mean phi {last.mean_phi:.4f}, e {last.e:.4f}, "
+            f"specularity {[round(w.specularity, 5) for w in last.walls]})", history, exc.X, last) from None
+    end = _staged_problem(problem, b)
+    Xn, rn = newton(end, X, tol=tol)
+    history += rn.history
+    path.corrector_iterations += rn.iterations
+    if not rn.converged:
+        raise CouetteConvergenceError(
+            f"Couette continuation: the arclength path reached the end of the stage but Newton did not polish it "
+            f"({rn.message}; relative residual {rn.residual:.3g})", history, Xn, end)
+    return Xn, path
 
 
 def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10, max_iter: int = 60,
-          ptc_max_iter: int = 400) -> tuple[np.ndarray, dict[str, Any]]:
+          ptc_max_iter: int = 400, continuation: str = "natural") -> tuple[np.ndarray, dict[str, Any]]:
     """Solve the steady problem; returns the unknowns and a dict of solver diagnostics.
 
     ``max_iter`` bounds each Newton solve, ``ptc_max_iter`` each pseudo-transient run.
@@ -322,7 +358,7 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
     steps = 0
     for stages in homotopy_paths(problem):
         try:
-            X, it, st = _follow(problem, stages, history, tol, max_iter, ptc_max_iter)
+            X, it, st, folds = _follow(problem, stages, history, tol, max_iter, ptc_max_iter, continuation)
         except CouetteConvergenceError as exc:
             failure = failure or exc
             continue
@@ -332,4 +368,4 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
         assert failure is not None
         raise failure
     return X, {"iterations": total_it, "continuation_steps": steps, "residual": relative_residual(problem, X),
-               "history": history, "method": "continuation"}
+               "history": history, "method": "continuation", "folds": folds}
