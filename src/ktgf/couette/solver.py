@@ -11,7 +11,11 @@ When Newton fails from the naive start (uniform φ̄, linear velocity, θ of uni
 solver first tries pseudo-transient continuation, then follows homotopies from an easy problem
 (mean φ ≤ 0.3, e ≥ 0.9, specularity ≥ 0.1, no centripetal term in the annular cell) to the
 target with adaptive steps: one parameter group per stage, then all at once
-(:func:`homotopy_paths`).  Near-jammed plug states (φ within ~1e-4 of φ_c, θ ~ 1e-8 U²) have
+(:func:`homotopy_paths`).  Natural-parameter steps cannot pass a turning point (fold) of the
+solution curve; when a stage's step falls below 1e-3 the rest of that stage is followed by
+pseudo-arclength continuation (:mod:`ktgf.couette.arclength`), which can (``continuation=
+"arclength"`` uses it for every stage; the fallback is the default because it leaves every case
+that natural steps solve on its old path and time, docs/dense.md §5.2).  Near-jammed plug states (φ within ~1e-4 of φ_c, θ ~ 1e-8 U²) have
 Jacobian condition numbers of 1e12–1e13 and are where the solver can stop.  If it fails it raises :class:`~ktgf.errors.ConvergenceError`
 carrying the residual history and the last iterate.
 """
@@ -26,7 +30,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from ..errors import ConvergenceError
+from ..errors import ConvergenceError, InputError
 from . import arclength
 from .equations import N_VARS, Problem
 from .uniform_shear import uniform_shear
@@ -263,7 +267,7 @@ def homotopy_paths(problem: Problem) -> list[list[dict[str, Any]]]:
 
 def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: float, max_iter: int,
             ptc_max_iter: int, continuation: str = "natural"):
-    """Natural-parameter continuation through ``stages`` with adaptive steps; returns (X, iterations, steps)."""
+    """Continuation through ``stages`` with adaptive steps; returns (X, iterations, steps, folds passed)."""
     sub = _staged_problem(problem, stages[0])
     X, rep = newton(sub, naive_start(sub), tol=tol, max_iter=max_iter)
     history += rep.history
@@ -335,6 +339,9 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
     """Solve the steady problem; returns the unknowns and a dict of solver diagnostics.
 
     ``max_iter`` bounds each Newton solve, ``ptc_max_iter`` each pseudo-transient run.
+    ``continuation``: ``"natural"`` (default; pseudo-arclength only where natural steps stall) or
+    ``"arclength"`` (pseudo-arclength for every homotopy stage).  The diagnostics hold
+    ``folds``: the stage fractions of the turning points passed.
 
     Raises
     ------
@@ -342,6 +349,8 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
         With the residual history and the last iterate, if neither Newton from the start nor
         the continuation converges.
     """
+    if continuation not in ("natural", "arclength"):
+        raise InputError(f"continuation = {continuation!r} is not valid: choose 'natural' or 'arclength'")
     start = naive_start(problem) if X0 is None else X0
     X, rep = newton(problem, start, tol=tol, max_iter=max_iter)
     history = list(rep.history)
