@@ -71,7 +71,8 @@ def main() -> None:
     ax1.plot(mean_phi(a[:, 0]), a[:, 1], "-", lw=1.5)
     for f in pa.folds:
         ax1.axvline(mean_phi(f), color="0.6", ls=":", lw=1)
-    ax1.axhline(MODEL.phi_max * (1 - JAM_TOLERANCE), color="r", ls="--", lw=1, label="jammed-core limit of the validity flag")
+    ax1.axhline(MODEL.phi_max * (1 - JAM_TOLERANCE), color="r", ls="--", lw=1,
+                label="jammed-core limit of the validity flag")
     ax1.set_xlabel("mean solid fraction (homotopy parameter)")
     ax1.set_ylabel("max φ")
     ax1.set_title(f"(a) continuation in mean φ, specularity {spec}")

@@ -36,7 +36,8 @@ class _Cubic:
 def _root(mu):
     """The real root of x³ − 3x − μ = 0 for |μ| > 2 (Cardano)."""
     s = math.sqrt(mu * mu / 4.0 - 1.0)
-    return math.copysign(abs(mu / 2.0 + s) ** (1 / 3), mu / 2.0 + s) + math.copysign(abs(mu / 2.0 - s) ** (1 / 3), mu / 2.0 - s)
+    cbrt = lambda v: math.copysign(abs(v) ** (1 / 3), v)  # noqa: E731
+    return cbrt(mu / 2.0 + s) + cbrt(mu / 2.0 - s)
 
 
 def test_follows_an_s_curve_through_both_folds():

@@ -20,9 +20,10 @@ which would fail exactly where it is needed (singular ∂R/∂X at the fold).
 
 Step control: a step is accepted when the chord corrector (the bordered matrix factorised once,
 at the predictor) converges within ``MAX_CORRECTOR`` iterations, each correction at most half the
-previous one (or stagnating below ``ROUND_OFF_STEP``: round-off in near-jammed cores); Δs grows ×1.5 after fast corrections and is halved after a failed
-one; the predictor is limited so that no ln θ or logit φ moves by more than ``MAX_PREDICTOR``.
-Folds are detected as sign changes of t_λ and reported.  When the curve crosses the end value
+previous one (or stagnating below ``ROUND_OFF_STEP``: round-off in near-jammed cores); Δs grows
+×1.5 after fast corrections and is halved after a failed one; the predictor is limited so that
+no ln θ or logit φ moves by more than ``MAX_PREDICTOR``.  Folds are detected where λ along the
+accepted points reverses, and reported.  When the curve crosses the end value
 λ₁, the point on the curve at λ = λ₁ is found with λ fixed (the last row becomes δλ = λ₁ − λ).
 
 Failures raise :class:`ArclengthStall` with a diagnosis (step collapse, the curve turning back

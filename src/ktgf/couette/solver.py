@@ -320,9 +320,12 @@ def _arclength_stage(problem: Problem, a: dict[str, Any], b: dict[str, Any], s: 
                                    lam_min=0.0)
     except arclength.ArclengthStall as exc:
         last = _staged_problem(problem, _interpolate(a, b, exc.lam))
+        _, theta, phi = last.unpack(exc.X)
         raise CouetteConvergenceError(
             f"Couette continuation failed: {why}{exc} (there: mean phi {last.mean_phi:.4f}, e {last.e:.4f}, "
-            f"specularity {[round(w.specularity, 5) for w in last.walls]})", history, exc.X, last) from None
+            f"specularity {[round(w.specularity, 5) for w in last.walls]}; the last point has max phi = "
+            f"phi_max - {last.phi_max - float(phi.max()):.2g} and min theta = {float(theta.min()):.2g} V^2)",
+            history, exc.X, last) from None
     end = _staged_problem(problem, b)
     Xn, rn = newton(end, X, tol=tol)
     history += rn.history
