@@ -14,7 +14,7 @@ from _calibration_synthetic import synthetic_couette as synthetic_couette_file
 from _calibration_synthetic import synthetic_shear
 from ktgf import get_model
 from ktgf.calibration import calibrate, read_data
-from ktgf.calibration.residuals import make_terms
+from ktgf.calibration.residuals import _shear_jacobian_function, make_terms
 
 
 def _fd(term, x, h_rel=1e-6):
@@ -36,6 +36,22 @@ def test_uniform_shear_jax_jacobian_matches_finite_differences(tmp_path, model, 
     assert term.method == "jax", term.method_note  # exact: traced through the closures and the closed form
     assert np.abs(J).max() > 1.0  # the parameters matter
     np.testing.assert_allclose(J, _fd(term, x), rtol=1e-6, atol=1e-7 * np.abs(J).max())
+
+
+def test_uniform_shear_jacobian_compiled_once_per_model_and_data(tmp_path):
+    """A second term of the same model, names and states reuses the compiled Jacobian; other states do not."""
+    x = {"phi_c": 0.65, "beta": 1.6}
+    f1 = synthetic_shear(tmp_path / "a.csv", get_model("ret"), [0.3, 0.5])
+    f2 = synthetic_shear(tmp_path / "b.csv", get_model("ret"), [0.3, 0.55])
+    (t1,) = make_terms(get_model("visc-div"), [read_data(f1)], list(x), "sigma")
+    (t2,) = make_terms(get_model("visc-div"), [read_data(f1)], list(x), "sigma")
+    J1, J2 = t1.jacobian(x), t2.jacobian(x)
+    assert t1._jac is t2._jac
+    np.testing.assert_array_equal(J1, J2)
+    # other states or other fitted names get their own function (not called here: no second compilation)
+    other_data = _shear_jacobian_function(get_model("visc-div"), ("phi_c", "beta"), read_data(f2))
+    other_names = _shear_jacobian_function(get_model("visc-div"), ("beta", "phi_c"), read_data(f1))
+    assert other_data is not t1._jac and other_names is not t1._jac
 
 
 N_CELLS = 60

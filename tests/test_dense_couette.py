@@ -57,17 +57,17 @@ def test_ekt_jacobian_matches_directional_derivatives():
         np.testing.assert_allclose(J @ v, fd, rtol=1e-4, atol=1e-6 * np.abs(fd).max())
 
 
-# The DEM cell (H = 19 d, U = 10, ρ_s = 6/π, mean φ 0.5) at e = e_w = 0.7 with Visc.div.: the continuation
-# stalls for 7 of 12 specularities in 0.16–0.245 with the C⁰ junction of model.md and for 5 of 12 with
-# the smooth junction (docs/dense.md §5, measured).  The stall sits where the densest node has just
-# passed φ_f (max φ ≈ 0.496 for both junctions), at mean φ ≈ 0.33 on the homotopy path, so the kink is
-# not the whole cause: a known solver limit, kept visible (strict xfail: a fix shows up as XPASS).
+# The DEM cell (H = 19 d, U = 10, ρ_s = 6/π, mean φ 0.5) at e = e_w = 0.7 with Visc.div.: natural-parameter
+# continuation stalled for 5 of 12 specularities in 0.16–0.245 at a fold of the path (max φ ≈ 0.496 just past
+# φ_f); the arclength fallback passes it (docs/dense.md §5.2, tests/test_couette_arclength.py).  The solution
+# it reaches is a jammed plug: below specularity ≈ 0.232 the model has no unjammed solution, and the run's
+# validity flag says so.
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="natural-parameter continuation stalls past phi_f (docs/dense.md §5)")
-def test_visc_div_dem_cell_at_e07_known_stall():
+def test_visc_div_dem_cell_at_e07_converges_to_a_flagged_jammed_plug():
     from ktgf.couette.run import Material, run
 
     w = Wall(specularity=0.16773, restitution=0.7)
     ds = run(get_model("visc-div"), PlanarCell(19.0, 10.0), w, w, 0.5, Material(1.0, 6 / math.pi, 0.7),
              n_cells=200, stretch=1.5)
     assert ds.attrs["solver_relative_residual"] < 1e-8
+    assert ds.attrs["physically_valid"] == 0 and "jammed core" in ds.attrs["validity"]

@@ -49,6 +49,23 @@ def test_ekt_j_elastic_dense_limit():
     assert ekt_j(1.0, 1e8) == pytest.approx(1.0 + math.pi / 12, rel=1e-6)
 
 
+@pytest.mark.parametrize("e", [1.0, 0.9, 0.7, 0.3])
+def test_ekt_j_is_the_garzo_dufty_viscosity_without_the_sonine_correction(e):
+    """J is the shear viscosity of Garzó & Dufty (1999) with c* = 0 in units of (8/(5√π)) ρ_s d φ G √T.
+
+    An independent check of the J formula (its denominator 24 − 6(1 − e)² − 5(1 − e²) included)
+    against the RET viscosity of model.md §3, whose numbers are checked against oracles elsewhere;
+    at e = 1 it is the Enskog viscosity.
+    """
+    model = get_model("ret", sonine=False)
+    phi = np.array([0.05, 0.2, 0.4, 0.55, 0.6])
+    d, rho_s, theta = 1.3, 1.7, 2.0
+    eta = model.coefficients(phi, e, np.full(phi.size, theta), d=d, rho_s=rho_s, check=False).eta
+    G = phi * model.chi(phi)
+    np.testing.assert_allclose(eta / (8 / (5 * math.sqrt(math.pi)) * rho_s * d * math.sqrt(theta) * phi * G),
+                               ekt_j(e, G), rtol=1e-12)
+
+
 def test_ekt_reduces_to_standard_theory_without_shear_and_when_l_equals_d():
     base = get_model("ret")
     ekt = base.replace(dissipation=CorrelationLength(c=1.0))

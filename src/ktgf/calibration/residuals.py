@@ -113,17 +113,44 @@ class ShearTerm:
         enable_x64()
         fitted = [n for n in self.names if n not in WALL_PARAMETERS]
         if self._jac is None:
-
-            def pred(x):
-                return shear_prediction(traced_model(self.model, dict(zip(fitted, x))), self.data, traced=True)
-
-            self._jac = jax.jit(jax.jacfwd(pred))
+            self._jac = _shear_jacobian_function(self.model, tuple(fitted), self.data)
         J = np.zeros((self.obs.size, len(self.names)))
         if fitted:
             Jm = np.asarray(self._jac(jnp.asarray([values[n] for n in fitted], dtype=jnp.float64)))
             for j, n in enumerate(fitted):
                 J[:, self.names.index(n)] = Jm[:, j]
         return J / self.scale[:, None]
+
+
+#: Compiled uniform-shear Jacobians by (model, fitted names, φ, e): tracing and XLA compilation cost
+#: ~1.5 s CPU per fit, the Jacobian evaluations ~1 ms, so repeated fits of one model to one file
+#: (sweeps of start values, ``docs/dense_fit.py``, a notebook) compile once per process.
+_SHEAR_JACOBIANS: dict[tuple, Any] = {}
+_SHEAR_JACOBIANS_MAX = 32
+
+
+def _shear_jacobian_function(model: Model, fitted: tuple[str, ...], data: UniformShearData) -> Any:
+    """``jax.jit(jax.jacfwd(...))`` of the uniform-shear predictions in the fitted options, cached."""
+    import jax
+
+    key = (model, fitted, np.asarray(data.phi).tobytes(), np.asarray(data.e).tobytes())
+    try:
+        fn = _SHEAR_JACOBIANS.get(key)
+    except TypeError:  # a model with an unhashable option: no caching
+        key, fn = None, None
+    if fn is None:
+        phi, e = np.array(data.phi), np.array(data.e)
+        states = UniformShearData(data.path, phi, e, {}, {})
+
+        def pred(x):
+            return shear_prediction(traced_model(model, dict(zip(fitted, x))), states, traced=True)
+
+        fn = jax.jit(jax.jacfwd(pred))
+        if key is not None:
+            if len(_SHEAR_JACOBIANS) >= _SHEAR_JACOBIANS_MAX:
+                _SHEAR_JACOBIANS.pop(next(iter(_SHEAR_JACOBIANS)))
+            _SHEAR_JACOBIANS[key] = fn
+    return fn
 
 
 def traced_model(model: Model, values: dict[str, Any]) -> Model:

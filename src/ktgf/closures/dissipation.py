@@ -12,10 +12,12 @@ units of d) that grows with the shear rate:
     J = (1 + e)/2 + (π/32) [5 + 2(1 + e)(3e − 1)G][5 + 4(1 + e)G] / ([24 − 6(1 − e)² − 5(1 − e²)] G²)
 
 with c an order-one constant that those papers fit to particle data.  The formula is taken
-from Jenkins & Berzi (2010) as we recall it; its equation number and the value of c used there
-could not be checked against the paper (not in the project library) — treat c as a parameter to
-fit (``docs/dense.md``).  The papers also use J in their viscosity; here only L is taken, so the
-correction can be composed with any theory.
+from Jenkins & Berzi (2010) as we recall it; its equation number, the prefactor of Λ and the value
+of c used there are not verified against the printed paper (searched, docs/dense.md §2.4) — treat
+c as a parameter to fit.  J is verified by identity: it is the Garzó & Dufty (1999) shear
+viscosity with the Sonine correction c* = 0 in units of (8/(5√π)) ρ_s d φ G √T (tested to 1e-12).
+The papers also use J in their viscosity; here only L is taken, so the correction can be composed
+with any theory.
 
 Where it applies: the factor needs the local shear measure s = d γ̇/√θ.  With ``shear=None``
 (homogeneous cooling, the HCS stability analysis, the 3D solver, the Couette solver) s = 0 and
@@ -53,7 +55,11 @@ class NoDissipationCorrection:
 
 
 def ekt_j(e: Any, G: Any) -> Any:
-    """J(e, G) of extended kinetic theory (Jenkins & Berzi 2010), G = φχ."""
+    """J(e, G) of extended kinetic theory (Jenkins & Berzi 2010), G = φχ.
+
+    Equal to the Garzó–Dufty (1999) shear viscosity without the Sonine correction divided by
+    (8/(5√π)) ρ_s d φ G √T (the Enskog value at e = 1; ``tests/test_dense_models.py``).
+    """
     num = (5.0 + 2.0 * (1.0 + e) * (3.0 * e - 1.0) * G) * (5.0 + 4.0 * (1.0 + e) * G)
     den = (24.0 - 6.0 * (1.0 - e) ** 2 - 5.0 * (1.0 - e**2)) * G**2
     return 0.5 * (1.0 + e) + (math.pi / 32.0) * num / den

@@ -260,8 +260,9 @@ class JammingPowerLaw(_DivergesAtPhiC):
     """Carnahan–Starling plus a jamming divergence of free exponent: χ = χ_CS + a φ²/(φ_c − φ)^b.
 
     The form of Chialvo & Sundaresan, Phys. Fluids 25, 070603 (2013), their fitted χ (there
-    b = 1.5, a = 0.58, φ_c = 0.64, from DEM of sheared frictionless spheres; the equation
-    number could not be checked here: the paper is not in the project library),
+    b = 1.5, a = 0.58, φ_c = 0.64, from DEM of sheared frictionless spheres; not verified against
+    the printed paper — a public implementation cites it as Eq. (31) with the same a and b, a hint
+    only; docs/dense.md §2.4),
     with the divergence exponent b made a parameter so that the dense rise can be fitted
     (``docs/dense.md``).  Smooth (C^∞) on 0 ≤ φ < φ_c; reduces to CS for a = 0 and is
     CS + O(φ²) for φ → 0.  Defaults a = 0.58, φ_c = 0.64, b = 1.5 (the published values).

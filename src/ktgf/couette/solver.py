@@ -11,7 +11,11 @@ When Newton fails from the naive start (uniform φ̄, linear velocity, θ of uni
 solver first tries pseudo-transient continuation, then follows homotopies from an easy problem
 (mean φ ≤ 0.3, e ≥ 0.9, specularity ≥ 0.1, no centripetal term in the annular cell) to the
 target with adaptive steps: one parameter group per stage, then all at once
-(:func:`homotopy_paths`).  Near-jammed plug states (φ within ~1e-4 of φ_c, θ ~ 1e-8 U²) have
+(:func:`homotopy_paths`).  Natural-parameter steps cannot pass a turning point (fold) of the
+solution curve; when a stage's step falls below 1e-3 the rest of that stage is followed by
+pseudo-arclength continuation (:mod:`ktgf.couette.arclength`), which can (``continuation=
+"arclength"`` uses it for every stage; the fallback is the default because it leaves every case
+that natural steps solve on its old path and time, docs/dense.md §5.2).  Near-jammed plug states (φ within ~1e-4 of φ_c, θ ~ 1e-8 U²) have
 Jacobian condition numbers of 1e12–1e13 and are where the solver can stop.  If it fails it raises :class:`~ktgf.errors.ConvergenceError`
 carrying the residual history and the last iterate.
 """
@@ -26,7 +30,8 @@ from typing import Any
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from ..errors import ConvergenceError
+from ..errors import ConvergenceError, InputError
+from . import arclength
 from .equations import N_VARS, Problem
 from .uniform_shear import uniform_shear
 
@@ -261,8 +266,8 @@ def homotopy_paths(problem: Problem) -> list[list[dict[str, Any]]]:
 
 
 def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: float, max_iter: int,
-            ptc_max_iter: int):
-    """Natural-parameter continuation through ``stages`` with adaptive steps; returns (X, iterations, steps)."""
+            ptc_max_iter: int, continuation: str = "natural"):
+    """Continuation through ``stages`` with adaptive steps; returns (X, iterations, steps, folds passed)."""
     sub = _staged_problem(problem, stages[0])
     X, rep = newton(sub, naive_start(sub), tol=tol, max_iter=max_iter)
     history += rep.history
@@ -272,8 +277,15 @@ def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: 
             f"Couette solver did not converge from the naive start nor from the easy state ({rep.message}); "
             f"last relative residual {rep.residual:.3g}", history, X, sub)
     steps = 0
+    folds: list[float] = []
     for a, b in zip(stages[:-1], stages[1:]):
         s, ds = 0.0, 0.25
+        if continuation == "arclength":
+            X, path = _arclength_stage(problem, a, b, s, X, history, tol)
+            total_it += path.corrector_iterations
+            steps += len(path.lam) - 1 + path.rejected_steps
+            folds += path.folds
+            continue
         while s < 1.0:
             s_try = min(1.0, s + ds)
             sub = _staged_problem(problem, _interpolate(a, b, s_try))
@@ -287,18 +299,52 @@ def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: 
             else:
                 ds *= 0.5
                 if ds < 1e-3:
-                    raise CouetteConvergenceError(
-                        f"Couette continuation stalled (mean phi {sub.mean_phi:.4f}, e {sub.e:.4f}, "
-                        f"specularity {[round(w.specularity, 5) for w in sub.walls]}): {rep.message}; "
-                        f"last relative residual {rep.residual:.3g}", history, Xt, sub)
-    return X, total_it, steps
+                    # natural-parameter steps cannot pass a turning point of the solution curve:
+                    # follow the rest of this stage by pseudo-arclength continuation
+                    why = (f"natural-parameter continuation stalled at mean phi {sub.mean_phi:.4f}, e {sub.e:.4f}, "
+                           f"specularity {[round(w.specularity, 5) for w in sub.walls]} ({rep.message}, last "
+                           f"relative residual {rep.residual:.3g}); then ")
+                    X, path = _arclength_stage(problem, a, b, s, X, history, tol, why)
+                    total_it += path.corrector_iterations
+                    steps += len(path.lam) - 1 + path.rejected_steps
+                    folds += path.folds
+                    break
+    return X, total_it, steps, folds
+
+
+def _arclength_stage(problem: Problem, a: dict[str, Any], b: dict[str, Any], s: float, X: np.ndarray,
+                     history: list, tol: float, why: str = ""):
+    """Pseudo-arclength continuation of one homotopy stage from its fraction s to 1, polished by Newton."""
+    try:
+        X, path = arclength.follow(lambda lam: _staged_problem(problem, _interpolate(a, b, lam)), X, s, 1.0,
+                                   lam_min=0.0)
+    except arclength.ArclengthStall as exc:
+        last = _staged_problem(problem, _interpolate(a, b, exc.lam))
+        _, theta, phi = last.unpack(exc.X)
+        raise CouetteConvergenceError(
+            f"Couette continuation failed: {why}{exc} (there: mean phi {last.mean_phi:.4f}, e {last.e:.4f}, "
+            f"specularity {[round(w.specularity, 5) for w in last.walls]}; the last point has max phi = "
+            f"phi_max - {last.phi_max - float(phi.max()):.2g} and min theta = {float(theta.min()):.2g} V^2)",
+            history, exc.X, last) from None
+    end = _staged_problem(problem, b)
+    Xn, rn = newton(end, X, tol=tol)
+    history += rn.history
+    path.corrector_iterations += rn.iterations
+    if not rn.converged:
+        raise CouetteConvergenceError(
+            f"Couette continuation: the arclength path reached the end of the stage but Newton did not polish it "
+            f"({rn.message}; relative residual {rn.residual:.3g})", history, Xn, end)
+    return Xn, path
 
 
 def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10, max_iter: int = 60,
-          ptc_max_iter: int = 400) -> tuple[np.ndarray, dict[str, Any]]:
+          ptc_max_iter: int = 400, continuation: str = "natural") -> tuple[np.ndarray, dict[str, Any]]:
     """Solve the steady problem; returns the unknowns and a dict of solver diagnostics.
 
     ``max_iter`` bounds each Newton solve, ``ptc_max_iter`` each pseudo-transient run.
+    ``continuation``: ``"natural"`` (default; pseudo-arclength only where natural steps stall) or
+    ``"arclength"`` (pseudo-arclength for every homotopy stage).  The diagnostics hold
+    ``folds``: the stage fractions of the turning points passed.
 
     Raises
     ------
@@ -306,6 +352,8 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
         With the residual history and the last iterate, if neither Newton from the start nor
         the continuation converges.
     """
+    if continuation not in ("natural", "arclength"):
+        raise InputError(f"continuation = {continuation!r} is not valid: choose 'natural' or 'arclength'")
     start = naive_start(problem) if X0 is None else X0
     X, rep = newton(problem, start, tol=tol, max_iter=max_iter)
     history = list(rep.history)
@@ -322,7 +370,7 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
     steps = 0
     for stages in homotopy_paths(problem):
         try:
-            X, it, st = _follow(problem, stages, history, tol, max_iter, ptc_max_iter)
+            X, it, st, folds = _follow(problem, stages, history, tol, max_iter, ptc_max_iter, continuation)
         except CouetteConvergenceError as exc:
             failure = failure or exc
             continue
@@ -332,4 +380,4 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
         assert failure is not None
         raise failure
     return X, {"iterations": total_it, "continuation_steps": steps, "residual": relative_residual(problem, X),
-               "history": history, "method": "continuation"}
+               "history": history, "method": "continuation", "folds": folds}

@@ -1,0 +1,127 @@
+"""Pseudo-arclength continuation (ktgf.couette.arclength) and the Couette cases it makes converge."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from ktgf.closures import get_model
+from ktgf.couette import PlanarCell, Wall, arclength
+from ktgf.couette.run import Material, build_problem, run
+from ktgf.couette.solver import solve
+
+
+class _Cubic:
+    """x³ − 3x = μ(λ) in the first unknown (two trivial ones besides): an S-curve with folds at μ = ±2."""
+
+    def __init__(self, mu):
+        self.mu = mu
+
+    def terms(self, X):
+        return {}
+
+    def residual(self, X, t=None):
+        return np.array([X[0] ** 3 - 3.0 * X[0] - self.mu, X[1], X[2]])
+
+    def residual_scales(self, t):
+        return np.ones(3) * (1.0 + abs(self.mu))
+
+    def jacobian(self, X, R):
+        return sp.csc_matrix(np.diag([3.0 * X[0] ** 2 - 3.0, 1.0, 1.0]))
+
+
+def _root(mu):
+    """The real root of x³ − 3x − μ = 0 for |μ| > 2 (Cardano)."""
+    s = math.sqrt(mu * mu / 4.0 - 1.0)
+    cbrt = lambda v: math.copysign(abs(v) ** (1 / 3), v)  # noqa: E731
+    return cbrt(mu / 2.0 + s) + cbrt(mu / 2.0 - s)
+
+
+def test_follows_an_s_curve_through_both_folds():
+    """μ = 8λ − 4: from the lower branch at λ = 0 to the upper one at λ = 1, through the folds at λ = 3/4 and 1/4."""
+    family = lambda lam: _Cubic(8.0 * lam - 4.0)  # noqa: E731
+    X0 = np.array([_root(-4.0), 0.0, 0.0])
+    X, path = arclength.follow(family, X0, 0.0, 1.0, ds0=0.05)
+    assert X[0] == pytest.approx(_root(4.0), rel=1e-9)  # 2.1958…, the only root at μ = 4
+    assert len(path.folds) == 2
+    assert path.folds[0] == pytest.approx(0.75, abs=0.02) and path.folds[1] == pytest.approx(0.25, abs=0.02)
+    # it went along the middle branch (−1 < x < 1), which natural-parameter continuation never reaches
+    assert any(-0.9 < X[0] < 0.9 for X in path.X)
+
+
+def test_says_when_the_curve_turns_back():
+    """x² = 1/2 − λ has no solution beyond the fold at λ = 1/2: the path comes back and says so."""
+
+    class Parabola(_Cubic):
+        def residual(self, X, t=None):
+            return np.array([X[0] ** 2 - self.mu, X[1], X[2]])
+
+        def jacobian(self, X, R):
+            return sp.csc_matrix(np.diag([2.0 * X[0], 1.0, 1.0]))
+
+    family = lambda lam: Parabola(0.5 - lam)  # noqa: E731
+    with pytest.raises(arclength.ArclengthStall, match="turned back") as info:
+        arclength.follow(family, np.array([math.sqrt(0.5), 0.0, 0.0]), 0.0, 1.0)
+    assert info.value.path.folds == [pytest.approx(0.5, abs=0.01)]
+    assert info.value.X[0] < 0  # it came back on the other branch, x = −√(1/2 − λ)
+
+
+def _dem_cell(spec, n_cells):
+    """The DEM Couette cell (H = 19 d, U = 10, ρ_s = 6/π, mean φ 0.5) at e = e_w = 0.7, Visc.div."""
+    w = Wall(specularity=spec, restitution=0.7)
+    return build_problem(get_model("visc-div"), PlanarCell(19.0, 10.0), w, w, 0.5,
+                         Material(1.0, 6 / math.pi, 0.7), n_cells, 1.5)
+
+
+def test_dem_cell_e07_converges_through_the_folds():
+    """A case natural-parameter continuation stalled on (docs/dense.md §5.2): it passes two folds now."""
+    pr = _dem_cell(0.16773, 40)
+    X, info = solve(pr)
+    u, theta, phi = pr.unpack(X)
+    assert info["residual"] < 1e-8
+    assert len(info["folds"]) >= 2
+    assert np.all(theta > 0) and phi.max() < pr.phi_max
+    assert pr.V @ phi / pr.V.sum() == pytest.approx(0.5, abs=1e-10)
+
+
+def test_unjammed_branch_ends_at_a_fold_in_specularity():
+    """At mean φ 0.5 the unjammed solution (spec 0.245) folds back near spec 0.232 onto a near-jammed branch.
+
+    So at spec 0.245 there are (at least) two solutions, and below the fold no unjammed one: the
+    e = 0.7 stalls had no physical solution to find (docs/dense.md §5.2).
+    """
+    s0, s1 = 0.245, 0.16
+    pr0 = _dem_cell(s0, 200)
+    X0, _ = solve(pr0)
+    family = lambda lam: _dem_cell(math.exp(math.log(s0) + lam * math.log(s1 / s0)), 200)  # noqa: E731
+    with pytest.raises(arclength.ArclengthStall, match="turned back") as info:
+        arclength.follow(family, X0, 0.0, 1.0, lam_min=-0.05)
+    (fold,) = info.value.path.folds
+    assert 0.225 < math.exp(math.log(s0) + fold * math.log(s1 / s0)) < 0.24
+    back = info.value.X  # the other solution at spec ≈ 0.245 (λ ≈ 0)
+    assert pr0.unpack(X0)[2].max() < 0.99 * 0.64 < pr0.unpack(back)[2].max()
+
+
+@pytest.mark.slow
+def test_dem_cell_e07_every_specularity_converges():
+    """All 12 specularities 0.16–0.245 at 200 cells converge; below the fold only a jammed plug exists.
+
+    The validity flag of the run says so: jammed (invalid) below spec ≈ 0.232, valid above.
+    """
+    failures, verdicts = [], {}
+    for spec in np.linspace(0.16, 0.245, 12):
+        w = Wall(specularity=float(spec), restitution=0.7)
+        try:
+            ds = run(get_model("visc-div"), PlanarCell(19.0, 10.0), w, w, 0.5, Material(1.0, 6 / math.pi, 0.7),
+                     n_cells=200, stretch=1.5)
+        except Exception as exc:  # noqa: BLE001 - collect every failure
+            failures.append((spec, str(exc)[:120]))
+            continue
+        assert ds.attrs["solver_relative_residual"] < 1e-8
+        assert float(ds["theta"].min()) > 0 and ds.attrs["max_phi"] < 0.64
+        verdicts[round(float(spec), 5)] = bool(ds.attrs["physically_valid"])
+    assert not failures, failures
+    assert all(v == (s > 0.232) for s, v in verdicts.items()), verdicts
