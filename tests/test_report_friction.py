@@ -43,6 +43,6 @@ def test_friction_section_outputs_and_errors(tmp_path, data_dir):
     errs = res.numbers["friction_errors"]["frictional"]
     assert errs[1]["T_err"] == pytest.approx(0.008, abs=0.002)  # docs/friction.md §6: +0.8 % at μ = 0.5, φ = 0.4
     goal = res.numbers["friction_goal"]
-    assert set(goal) == {"0.4", "0.5"} and goal["0.5"] > 0.15
+    assert set(goal) == {"0.4", "0.5"} and max(goal.values()) < 0.15  # docs/friction.md §6: largest error 13.3 %
     (sentence,) = section.discuss(res.numbers)
-    assert "not met" in sentence
+    assert "is met" in sentence

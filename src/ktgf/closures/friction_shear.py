@@ -200,12 +200,15 @@ def mu_i_uniform_shear(rheology: Any, dilatancy: Any, phi: Any) -> FrictionalShe
 
 
 def recommended_parts(theory: str = "ret") -> FrictionalShearParts:
-    """The ``frictional`` composition of ``docs/friction.md`` §6 as parts (nothing fitted).
+    """The registered ``frictional`` composition as parts (``docs/friction.md`` §6), with another theory if asked.
 
-    ``theory`` (RET by default) with the Chialvo–Sundaresan χ diverging at φ_c(μ) and Walton's collision
-    rule with β0 = 1 — the registered model ``frictional`` (the same numbers: tested).
+    ``theory`` (RET by default) with the Chialvo–Sundaresan χ diverging at φ_c(μ), the EKT correlation
+    length of ``frictional`` (c fitted, :mod:`ktgf.closures.friction.calibrated`) and Walton's collision rule
+    with β0 = 1 — for RET the registered model ``frictional`` itself (the same numbers: tested).
     """
     from .models import get_model
 
-    return FrictionalShearParts(get_model(theory).replace(rdf=FrictionalChialvoSundaresan()),
-                                restitution=WaltonRestitution(beta0=1.0))
+    model = get_model("frictional")
+    if theory != "ret":
+        model = model.replace(theory=get_model(theory).theory)
+    return FrictionalShearParts(model, restitution=WaltonRestitution(beta0=1.0))

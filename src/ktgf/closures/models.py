@@ -20,8 +20,9 @@ proposed    Garzó & Dufty (1999)  viscosity-divergence RDF   theory's own
 and the recommended dense model ``dense`` (``docs/dense.md``): RET with the viscosity-divergence
 RDF whose divergence exponent β is fitted to the DEM uniform shear (:mod:`ktgf.closures.dense`), and
 the recommended model for frictional particles ``frictional`` (``docs/friction.md``): RET with the
-Chialvo–Sundaresan RDF diverging at the frictional jamming fraction φ_c(μ) and Walton's collision rule
-(:mod:`ktgf.closures.friction.model_slot`), nothing fitted.
+Chialvo–Sundaresan RDF diverging at the frictional jamming fraction φ_c(μ), Walton's collision rule
+(:mod:`ktgf.closures.friction.model_slot`) and the EKT correlation length whose constant c is the one
+number fitted (to T of one row of the frictional DEM file, :mod:`ktgf.closures.friction.calibrated`).
 """
 
 from __future__ import annotations
@@ -38,7 +39,8 @@ from .garzo_dufty1999 import GarzoDufty1999
 from .lun1984 import Lun1984
 from .rdf import CarnahanStarling, RadialDistribution, Torquato, ViscosityDivergence
 from .dense import DENSE_BETA
-from .dissipation import DISSIPATIONS, NoDissipationCorrection
+from .dissipation import DISSIPATIONS, CorrelationLength, NoDissipationCorrection
+from .friction.calibrated import FRICTIONAL_C
 from .friction.jamming import FrictionalChialvoSundaresan
 from .friction.model_slot import FRICTIONS, Friction, NoFriction
 from .viscosity_divergence import NoViscosityCorrection, ViscosityDivergenceLaw
@@ -339,11 +341,13 @@ register_model(
         "frictional",
         GarzoDufty1999(),
         FrictionalChialvoSundaresan(mu=0.5),
+        dissipation=CorrelationLength(c=FRICTIONAL_C),
         friction=Friction(mu=0.5, restitution="walton", beta0=1.0),
         label="Frictional",
         description=(
             "Recommended for frictional particles (default mu = 0.5; option mu): RET, Chialvo-Sundaresan RDF "
-            "diverging at phi_c(mu), Walton's collision rule with beta0 = 1; nothing fitted (docs/friction.md)"
+            "diverging at phi_c(mu), Walton's collision rule with beta0 = 1, EKT correlation length with c fitted "
+            "to T of one row of the frictional DEM file (docs/friction.md)"
         ),
     ),
 )
