@@ -109,22 +109,23 @@ class Friction:
         scale: √I2D → √(I2D + (ε γ̇_ref)²) (Schaeffer) — see ``docs/friction.md`` §8.
     """
 
+    # defaults are the sub-parts' own (one source of every documented constant)
     mu: float = 0.0
     restitution: str = "walton"
-    beta0: float = 1.0
-    tangential_beta: float = -1.0
-    q: float = 0.4
-    cs_amplitude: float = 1.5
-    cs_decay: float = 3.0
+    beta0: float = WaltonRestitution.beta0
+    tangential_beta: float = RoughSphereRestitution.beta
+    q: float = WaltonRestitution.q
+    cs_amplitude: float = ChialvoSundaresanRestitution.amplitude
+    cs_decay: float = ChialvoSundaresanRestitution.decay
     stress: str = "none"
-    jj_Fr: float = 0.05
-    jj_n: float = 2.0
-    jj_p: float = 5.0
-    jj_phi_min: float = 0.5
+    jj_Fr: float = JohnsonJacksonPressure.Fr
+    jj_n: float = JohnsonJacksonPressure.n
+    jj_p: float = JohnsonJacksonPressure.p
+    jj_phi_min: float = JohnsonJacksonPressure.phi_min
     jj_phi_max: float = 0.0
-    jj_delta_min: float = 0.05
-    phi_fr_deg: float = 28.5
-    n_compression: float = 1.03
+    jj_delta_min: float = JohnsonJacksonPressure.delta_min
+    phi_fr_deg: float = SchaefferViscosity.phi_fr_deg
+    n_compression: float = SrivastavaSundaresanViscosity.n_compression
     blend: str = "none"
     blend_phi_star: float = 0.0
     blend_width: float | None = None
