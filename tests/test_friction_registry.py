@@ -157,7 +157,8 @@ def test_shear_cli_mu_prints_the_dem_columns():
                                           "--format", "json"]).stdout)
     assert plain == zero and plain[0]["Trot_over_T"] is None
     csv = runner.invoke(app, ["shear", "--model", "frictional", "--mu", "0.3", "--phi", "0.4", "--e", "0.7", "--format", "csv"])
-    assert csv.stdout.splitlines()[0].startswith("model,phi,e,mu,T,Trot_over_T,p_star,tau_over_p,p_over_nT")
+    assert csv.stdout.splitlines()[0] == ("model,phi,e,T,eta_star,eta_over_eta0,p_over_nT,astar,tau_over_p,L_over_d,"
+                                          "Trot_over_T,p_star,mu")  # the frictionless columns keep their places
 
 
 @pytest.mark.parametrize(

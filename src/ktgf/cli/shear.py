@@ -49,7 +49,7 @@ def with_friction(model: Any, mu: float | None) -> Any:
 
 
 def shear_rows(model: Any, phi: np.ndarray, e: np.ndarray, stress_scale: float | None = None) -> list[dict[str, float]]:
-    """One row per (φ, e): φ, e, μ, T, T_rot/T, p_star, eta_star, eta_over_eta0, p_over_nT, astar, τ/p, L/d."""
+    """One row per (φ, e): φ, e, T, eta_star, eta_over_eta0, p_over_nT, astar, τ/p, L/d, T_rot/T, p_star, μ."""
     from ..closures.friction_shear import model_uniform_shear
     from ..couette.uniform_shear import shear_state
 
@@ -69,9 +69,10 @@ def shear_rows(model: Any, phi: np.ndarray, e: np.ndarray, stress_scale: float |
     if model.friction.has_stress:  # the frictional stress adds to p and τ (docs/friction.md §5)
         cols["tau_over_p"] = np.array([float(f.tau_over_p[0]) for f in fr])
         cols["p_over_nT"] = np.array([float(f.p_over_nT[0]) for f in fr])
-    order = ("T", "Trot_over_T", "p_star", "tau_over_p", "p_over_nT", "eta_star", "eta_over_eta0", "astar", "L_over_d")
+    # the frictionless columns first, in their original order; the frictional DEM file's columns after them
+    order = ("T", "eta_star", "eta_over_eta0", "p_over_nT", "astar", "tau_over_p", "L_over_d", "Trot_over_T", "p_star")
     mu = float(model.friction.mu)
-    return [{"phi": float(phis[i]), "e": float(es[i]), "mu": mu, **{k: float(cols[k][i]) for k in order}}
+    return [{"phi": float(phis[i]), "e": float(es[i]), **{k: float(cols[k][i]) for k in order}, "mu": mu}
             for i in range(phis.size)]
 
 
