@@ -165,3 +165,26 @@ def test_walton_limits():
     assert law.inelasticity(0.7, 0.5) > 1 - 0.7**2
     with pytest.raises(InputError, match="beta0 = -1"):
         WaltonRestitution(beta0=-1.0)
+
+
+def test_walton_hcs_tends_to_the_rough_sphere_hcs_and_is_the_attractor():
+    """μ → ∞ (always sticking): Huthmann & Zippelius's rough-sphere HCS ratio and cooling with β = β0; at finite μ the
+    ratio is where the relative cooling rates of the two temperatures agree, reached from a rotation-free start."""
+    from scipy.integrate import solve_ivp
+
+    law, rough = WaltonRestitution(beta0=0.4), RoughSphereRestitution(beta=0.4)
+    r_inf = float(rough.hcs_rotational_ratio(0.7, 1.0))
+    assert law.hcs_rotational_ratio(0.7, 1e4) == pytest.approx(r_inf, rel=1e-8)
+    A, B, _ = rough.collision_coefficients(0.7, 1.0)
+    assert law.hcs_inelasticity(0.7, 1e4) == pytest.approx(4 * (A - B * r_inf), rel=1e-8)
+    w = WaltonRestitution()
+    assert w.hcs_rotational_ratio(0.7, 0.0) == 0.0 and w.hcs_inelasticity(0.7, 0.0) == pytest.approx(0.51)
+
+    def drift(_, y):
+        tr, rot = w._energy_changes(0.7, 0.5, y[0])
+        return [rot - y[0] * tr]
+
+    sol = solve_ivp(drift, (0.0, 60.0), [0.0], rtol=1e-10, atol=1e-12)
+    assert sol.y[0, -1] == pytest.approx(w.hcs_rotational_ratio(0.7, 0.5), rel=1e-6)
+    assert w.hcs_rotational_ratio(0.7, 0.5) > w.rotational_ratio(0.7, 0.5)  # the HCS keeps more rotation than shear
+    assert math.isinf(w.hcs_rotational_ratio(0.7, 0.1))  # weak friction: T_rot/T grows without bound

@@ -12,6 +12,8 @@ reader.  Format (TOML)::
     [model.options]                   # any option of the model (Model.with_options)
     phi_c = 0.632
     beta = 1.93
+    # friction = "coulomb"            # part choices by key: friction (none | coulomb), dissipation
+    # mu = 0.3                        # ... and then that part's options (docs/friction.md)
 
     [walls]                           # optional (Couette fits): both walls
     specularity = 0.08
@@ -87,7 +89,7 @@ def load_model_file(path: str | Path) -> ModelFile:
     options = sec.get("options", {})
     if not isinstance(options, dict):
         raise _err(path, "model.options", "must be a table of option = value")
-    valid = model.options()
+    valid = {**model.options(), **_part_choices(options)}
     for k, v in options.items():
         if k not in valid:
             raise _err(path, f"model.options.{k}", f"model {base!r} has no such option; valid: {', '.join(valid)}")
@@ -115,6 +117,29 @@ def load_model_file(path: str | Path) -> ModelFile:
             raise _err(path, f"walls.{k}", f"{v!r} is out of range: valid {lo:g} < {k} <= {hi:g}")
     return ModelFile(path, model, base, dict(options), {k: float(v) for k, v in walls.items()},
                      dict(data.get("fit", {})), dict(data.get("provenance", {})), sec.get("rdf"))
+
+
+def _part_choices(options: dict[str, Any]) -> dict[str, Any]:
+    """Options that choose a part by key (``friction``, ``dissipation``) and, for a chosen part, its own options."""
+    from dataclasses import fields
+
+    from ..closures.dissipation import DISSIPATIONS
+    from ..closures.friction.model_slot import FRICTIONS
+
+    out: dict[str, Any] = {}
+    for name, table in (("friction", FRICTIONS), ("dissipation", DISSIPATIONS)):
+        key = options.get(name)
+        if name in options:
+            out[name] = ""
+        if isinstance(key, str) and key in table:
+            out.update({f.name: getattr(table[key](), f.name) for f in fields(table[key])})
+    return out
+
+
+def part_choice_options(model: Any, reference: Any) -> dict[str, Any]:
+    """``friction``/``dissipation`` keys where ``model`` chose another part than ``reference`` (for writing)."""
+    return {name: getattr(model, name).key for name in ("friction", "dissipation")
+            if getattr(model, name).key != getattr(reference, name).key}
 
 
 # -- writing ---------------------------------------------------------------------------------
@@ -187,8 +212,9 @@ def fit_text(result: Any, *, command: str = "", start_file: ModelFile | None = N
 
         reference = reference.replace(rdf=get_rdf(start_file.rdf))
     ref_opts = reference.options()
-    opts = {k: v for k, v in result.model.options().items()
-            if k in result.names or (k in ref_opts and ref_opts[k] != v and isinstance(v, (int, float, str)))}
+    opts = {**part_choice_options(result.model, reference),
+            **{k: v for k, v in result.model.options().items()
+               if k in result.names or (k not in ref_opts or ref_opts[k] != v) and isinstance(v, (int, float, str))}}
     fit = {
         "parameters": result.names, "values": [float(v) for v in result.values],
         "standard_errors": [float(v) for v in result.stderr], "correlation": [[float(c) for c in row] for row in result.correlation],

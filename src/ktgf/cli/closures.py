@@ -30,6 +30,7 @@ def model_rows(models: list | None = None) -> list[dict[str, str]]:
             "rdf": m.rdf.describe(),
             "viscosity": m.viscosity.label,
             "dissipation": m.dissipation.label,
+            "friction": m.friction.describe(),
             "options": ", ".join(f"{k}={v}" for k, v in m.options().items()),
             "reference": m.theory.reference,
             "description": m.description,

@@ -32,8 +32,25 @@ def parse_options(items: list[str] | None) -> dict[str, Any]:
     return out
 
 
-def shear_rows(model: Any, phi: np.ndarray, e: np.ndarray) -> list[dict[str, float]]:
-    """One row per (φ, e): φ, e, T, eta_star, eta_over_eta0, p_over_nT, astar, stress ratio, L/d."""
+def with_friction(model: Any, mu: float | None) -> Any:
+    """The model at friction coefficient μ (``--mu``): routed to its friction part, added if it has none.
+
+    A frictionless model given μ > 0 gets the ``coulomb`` friction part with its defaults (Walton's rule,
+    β0 = 1), its RDF unchanged; μ = 0 leaves a frictionless model as it is.
+    """
+    if mu is None:
+        return model
+    from ..closures.friction._part import check_friction_coefficient
+
+    check_friction_coefficient(mu)
+    if model.friction.key == "none":
+        return model if mu == 0.0 else model.with_options(friction="coulomb", mu=float(mu))
+    return model.with_options(mu=float(mu))
+
+
+def shear_rows(model: Any, phi: np.ndarray, e: np.ndarray, stress_scale: float | None = None) -> list[dict[str, float]]:
+    """One row per (φ, e): φ, e, T, eta_star, eta_over_eta0, p_over_nT, astar, τ/p, L/d, T_rot/T, p_star, μ."""
+    from ..closures.friction_shear import model_uniform_shear
     from ..couette.uniform_shear import shear_state
 
     if phi.size == 0 or e.size == 0:
@@ -45,8 +62,18 @@ def shear_rows(model: Any, phi: np.ndarray, e: np.ndarray) -> list[dict[str, flo
     s = shear_state(model, phis, es)
     cols = {"T": s.T, "eta_star": s.eta_star, "eta_over_eta0": s.eta_over_eta0, "p_over_nT": s.p_over_nT,
             "astar": s.astar, "tau_over_p": s.stress_ratio, "L_over_d": s.L_over_d}
-    cols = {k: np.broadcast_to(v, phis.shape) for k, v in cols.items()}
-    return [{"phi": float(phis[i]), "e": float(es[i]), **{k: float(v[i]) for k, v in cols.items()}} for i in range(phis.size)]
+    cols = {k: np.broadcast_to(v, phis.shape).astype(float) for k, v in cols.items()}
+    fr = [model_uniform_shear(model, np.array([p]), float(q), stress_scale=stress_scale) for p, q in zip(phis, es)]
+    cols["Trot_over_T"] = np.array([float(f.Trot_over_T[0]) for f in fr])
+    cols["p_star"] = np.array([float(f.p_star[0]) for f in fr])
+    if model.friction.has_stress:  # the frictional stress adds to p and τ (docs/friction.md §5)
+        cols["tau_over_p"] = np.array([float(f.tau_over_p[0]) for f in fr])
+        cols["p_over_nT"] = np.array([float(f.p_over_nT[0]) for f in fr])
+    # the frictionless columns first, in their original order; the frictional DEM file's columns after them
+    order = ("T", "eta_star", "eta_over_eta0", "p_over_nT", "astar", "tau_over_p", "L_over_d", "Trot_over_T", "p_star")
+    mu = float(model.friction.mu)
+    return [{"phi": float(phis[i]), "e": float(es[i]), **{k: float(cols[k][i]) for k in order}, "mu": mu}
+            for i in range(phis.size)]
 
 
 @handle_errors
@@ -55,21 +82,27 @@ def shear(
     model_file: Path = model_file_option(),
     phi: str = typer.Option(..., "--phi", help="Solid fraction: " + VALUES_HELP + "."),
     e: str = typer.Option(..., "--e", help="Restitution coefficient(s), 0 < e < 1."),
+    mu: float = typer.Option(None, "--mu", help="Particle friction coefficient mu >= 0 (adds Walton friction to a "
+                             "frictionless model; docs/friction.md)."),
+    stress_scale: float = typer.Option(None, "--stress-scale", help="rho_s d^2 gdot^2 [Pa]: needed only by a model "
+                                       "with a frictional stress (option stress)."),
     option: list[str] = typer.Option(
         None, "--option", "-O", help="Model option KEY=VALUE (repeatable, applied to every model), e.g. phi_f=0.46."
     ),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
-    """Steady uniform (Lees–Edwards) shear from the closed forms of docs/model.md §9.
+    """Steady uniform (Lees–Edwards) shear from the closed forms of docs/model.md §9 (frictional: docs/friction.md).
 
-    Columns as in the DEM file dem_uniform_shear.csv (d = m = 1): T = θ/(γ̇d)², eta_star = η d²/√(mT),
-    eta_over_eta0 = η/η0, p_over_nT = p/(nT), astar = γ̇/ν0; tau_over_p = |P_xy|/p and L_over_d
-    (extended-kinetic-theory correlation length, 1 without that option).
+    Columns as in the DEM files dem_uniform_shear.csv and dem_uniform_shear_friction.csv (d = m = 1, shear
+    rate 1, rho_s = 6/pi): T = θ/(γ̇d)², Trot_over_T (NaN/null where the model has no rotation), p_star =
+    p/(rho_s d² γ̇²), tau_over_p = |P_xy|/p, p_over_nT = p/(nT), eta_star = η d²/√(mT), eta_over_eta0 = η/η0,
+    astar = γ̇/ν0 and L_over_d (extended-kinetic-theory correlation length, 1 without that option).
     """
     options = parse_options(option)
     ms = [m.with_options(**options) if options else m for m in resolve_models(model, model_file)]
+    ms = [with_friction(m, mu) for m in ms]
     phis, es = parse_values(phi, "phi"), parse_values(e, "e")
-    rows = [{"model": m.name, **row} for m in ms for row in shear_rows(m, phis, es)]
+    rows = [{"model": m.name, **row} for m in ms for row in shear_rows(m, phis, es, stress_scale)]
     emit(rows, fmt, title=f"{', '.join(m.label or m.name for m in ms)}: Navier–Stokes uniform shear (d = m = 1, shear rate 1)")
 
 

@@ -1,9 +1,11 @@
 """Frictional closures against ``dem_uniform_shear_friction.csv``: the comparison table of ``docs/friction.md``.
 
-What is fitted (and only this): the tangential restitution β of the rough-sphere dissipation, to the
-rotational temperature T_rot/T of the single row μ = 0.5, φ = 0.4 (:func:`fit_tangential_restitution`).
-Everything else is predicted: the other columns of that row, the row φ = 0.5 and the frictionless
-row (μ = 0).  The remaining compositions have no fitted parameter at all.
+What is fitted (one number per composition, at most): the tangential restitution β of the rough-sphere
+dissipation, to the rotational temperature T_rot/T of the row μ = 0.5, φ = 0.4 (:func:`fit_tangential_restitution`);
+and, for the registered ``frictional`` model, the EKT correlation-length constant c to T of the row μ = 0.5,
+φ = 0.5 (:func:`ktgf.closures.friction.calibrated.fit_correlation_constant`).  Everything else is predicted:
+the other columns of those rows, the other μ = 0.5 row and the frictionless row (μ = 0).  The remaining
+compositions have no fitted parameter at all.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from .friction import (
 )
 from .friction import RoughSphereRestitution, WaltonRestitution
 from .friction_shear import FrictionalShearParts, frictional_uniform_shear, mu_i_uniform_shear
+from .friction.calibrated import FRICTIONAL_C
 from .models import get_model
 
 DEM_FILE = "dem_uniform_shear_friction.csv"
@@ -68,6 +71,8 @@ def compositions(rows: list[dict[str, float]]) -> list[tuple[str, str, Any]]:
          FrictionalShearParts(ret.replace(rdf=fcs), restitution=RoughSphereRestitution(beta=beta))),
         ("RET, χ_CS13(φ_c(μ)), Walton μ, β0 = 1", "nothing (β0 = 1: the DEM contact law)",
          FrictionalShearParts(ret.replace(rdf=fcs), restitution=WaltonRestitution(beta0=1.0))),
+        (f"**frictional** (registered): the same + EKT c = {FRICTIONAL_C:g}", "c to T at μ = 0.5, φ = 0.5",
+         FrictionalShearParts(get_model("frictional"), restitution=WaltonRestitution(beta0=1.0))),
         ("Enskog, χ_CS13(φ_c(μ)), e_eff Chialvo–Sundaresan", "nothing",
          FrictionalShearParts(get_model("enskog").replace(rdf=fcs))),
         ("RET, χ_CS13(φ_c(μ)), e_eff Chialvo–Sundaresan + dense-T floor", "nothing",

@@ -33,11 +33,13 @@ from .friction import (
     ChialvoSundaresanRestitution,
     FrictionalChialvoSundaresan,
     JammingFraction,
+    RoughSphereRestitution,
     SchaefferViscosity,
-    modified_cooling_rate,
+    WaltonRestitution,
     with_jamming_fraction,
 )
 from .friction._part import check_friction_coefficient
+from .friction.model_slot import Friction
 from .models import Model
 
 #: τ/(ρ_s d² γ̇²) = ETA0_CONSTANT η* √T, with η0 = (5√π/96) ρ_s d √θ (model.md §1).
@@ -109,52 +111,78 @@ class FrictionalShearParts:
         return self.model
 
 
-@dataclass(frozen=True)
-class _EffectiveDissipation:
-    """A model whose cooling rate carries the frictional dissipation (so uniform_shear can be reused)."""
+def friction_from_law(law: Any, mu: float) -> Friction:
+    """The model's ``friction`` part for a restitution-law object at μ (flat options, see :class:`Friction`)."""
+    if isinstance(law, WaltonRestitution):
+        return Friction(mu=float(mu), restitution="walton", beta0=law.beta0, q=law.q)
+    if isinstance(law, RoughSphereRestitution):
+        return Friction(mu=float(mu), restitution="rough-sphere", tangential_beta=law.beta, q=law.q)
+    if isinstance(law, ChialvoSundaresanRestitution):
+        return Friction(mu=float(mu), restitution="chialvo-sundaresan-2013", cs_amplitude=law.amplitude,
+                        cs_decay=law.decay)
+    raise InputError(f"unknown restitution law {law!r}")
 
-    model: Model
-    restitution: Any
-    mu: float
 
-    def reduced(self, phi: Any, e: Any, *, check: bool = True):
-        r = self.model.reduced(phi, e, check=check)
-        inel = self.restitution.inelasticity(np.asarray(e, dtype=float), self.mu)
-        return r._replace(zeta0=modified_cooling_rate(r.zeta0, np.asarray(e, dtype=float), inel))
+def model_uniform_shear(model: Model, phi: Any, e: float, *, stress_scale: float | None = None,
+                        dense_temperature: Any = None) -> FrictionalShear:
+    """Uniform shear of a registry model (its friction part included) in the DEM file's definitions.
 
-    def __getattr__(self, name: str) -> Any:
-        # everything else (RDF, dissipation part, ...) is the wrapped model's
-        return getattr(self.model, name)
+    The closed forms of model.md §9 with the model's ζ0 (which carries the friction part's
+    (1 − e_eff²)/(1 − e²)); T_rot/T from the friction part (NaN where not modelled); the friction
+    part's frictional stress w p_f (Pa, so ``stress_scale`` = ρ_s d² γ̇² [Pa] is then required) added
+    with τ_f = (τ_f/p_f) w p_f of unregularised simple shear, its work dissipated without feeding θ.
+    Frictionless models give their Navier–Stokes uniform shear unchanged.  Raises
+    :class:`~ktgf.errors.InputError` for e outside (0, 1) and φ outside [0, φ_max).
+    """
+    if not 0.0 < e < 1.0:
+        raise InputError(f"restitution coefficient e = {e:g} is out of range: valid 0 < e < 1 (uniform shear needs dissipation)")
+    friction = model.friction
+    if friction.has_stress and stress_scale is None:
+        raise InputError(f"model {model.name!r} has a frictional stress (stress = {friction.stress!r}): give the stress "
+                         "scale rho_s d^2 gdot^2 in Pa (ktgf shear --stress-scale)")
+    if stress_scale is not None and not stress_scale > 0.0:
+        raise InputError(f"stress scale = {stress_scale:g} is out of range: valid stress_scale > 0 (Pa)")
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    model.check(phi, e)
+    state = uniform_shear(model, phi, e)
+    T = np.asarray(state.temperature_ratio, dtype=float)
+    if dense_temperature is not None:
+        T = np.maximum(T, dense_temperature.temperature_ratio(phi, model.phi_max))
+    r = model.reduced(phi, e)
+    p_star = phi * np.asarray(r.p, dtype=float) * T
+    tau_star = ETA0_CONSTANT * np.asarray(r.eta, dtype=float) * np.sqrt(T)
+    if friction.has_stress:
+        p_f = np.asarray(friction.frictional_pressure(phi, model.phi_max), dtype=float) / stress_scale
+        p_star, tau_star = p_star + p_f, tau_star + friction.simple_shear_stress_ratio(T) * p_f
+    rot = friction.rotational_ratio(e)
+    trot = np.full_like(phi, np.nan) if rot is None else np.full_like(phi, float(rot))
+    return FrictionalShear(phi=phi, T=T, Trot_over_T=trot, p_star=p_star, tau_over_p=tau_star / p_star,
+                           p_over_nT=p_star / (phi * T))
 
 
 def frictional_uniform_shear(parts: FrictionalShearParts, phi: Any, e: float, mu: float) -> FrictionalShear:
     """Uniform-shear prediction for frictional spheres at solid fractions φ, restitution e < 1, friction μ ≥ 0.
 
+    The composition is turned into a registry model (:meth:`FrictionalShearParts.model_at` with the
+    friction part of its restitution law) and solved by :func:`model_uniform_shear`; a frictional
+    stress given as parts (SI pressure object, any φ_max) is added the same way.
     Raises :class:`~ktgf.errors.InputError` for μ < 0, e outside (0, 1) and φ outside [0, φ_c(μ)).
     """
     check_friction_coefficient(mu)
     if not 0.0 < e < 1.0:
         raise InputError(f"restitution coefficient e = {e:g} is out of range: valid 0 < e < 1 (uniform shear needs dissipation)")
     parts.restitution.check(e, mu)
-    model = parts.model_at(mu)
-    phi = np.atleast_1d(np.asarray(phi, dtype=float))
-    state = uniform_shear(_EffectiveDissipation(model, parts.restitution, float(mu)), phi, e)
-    T = np.asarray(state.temperature_ratio, dtype=float)
-    if parts.dense_temperature is not None:
-        T = np.maximum(T, parts.dense_temperature.temperature_ratio(phi, model.phi_max))
-    r = model.reduced(phi, e)
-    p_star = phi * np.asarray(r.p, dtype=float) * T
-    tau_star = ETA0_CONSTANT * np.asarray(r.eta, dtype=float) * np.sqrt(T)
-    if parts.frictional_pressure is not None:
-        weight = 1.0 if parts.blend is None else parts.blend.weight(phi)
-        p_f = weight * parts.frictional_pressure.pressure(phi) / parts.stress_scale
-        visc = parts.frictional_viscosity
-        ratio = visc.simple_shear_stress_ratio(T) if hasattr(visc, "simple_shear_stress_ratio") else visc.shear_stress_ratio()
-        p_star, tau_star = p_star + p_f, tau_star + ratio * p_f
-    rot = parts.restitution.rotational_ratio(e, mu)
-    trot = np.full_like(phi, np.nan) if rot is None else np.broadcast_to(np.asarray(rot, dtype=float), phi.shape).copy()
-    return FrictionalShear(phi=phi, T=T, Trot_over_T=trot, p_star=p_star, tau_over_p=tau_star / p_star,
-                           p_over_nT=p_star / (phi * T))
+    model = parts.model_at(mu).replace(friction=friction_from_law(parts.restitution, mu))
+    s = model_uniform_shear(model, phi, e, dense_temperature=parts.dense_temperature)
+    if parts.frictional_pressure is None:
+        return s
+    p_star, tau_star = s.p_star, s.tau_over_p * s.p_star
+    weight = 1.0 if parts.blend is None else parts.blend.weight(s.phi)
+    p_f = weight * parts.frictional_pressure.pressure(s.phi) / parts.stress_scale
+    visc = parts.frictional_viscosity
+    ratio = visc.simple_shear_stress_ratio(s.T) if hasattr(visc, "simple_shear_stress_ratio") else visc.shear_stress_ratio()
+    p_star, tau_star = p_star + p_f, tau_star + ratio * p_f
+    return s._replace(p_star=p_star, tau_over_p=tau_star / p_star, p_over_nT=p_star / (s.phi * s.T))
 
 
 def mu_i_uniform_shear(rheology: Any, dilatancy: Any, phi: Any) -> FrictionalShear:
@@ -172,13 +200,15 @@ def mu_i_uniform_shear(rheology: Any, dilatancy: Any, phi: Any) -> FrictionalShe
 
 
 def recommended_parts(theory: str = "ret") -> FrictionalShearParts:
-    """The provisional ``frictional`` composition of ``docs/friction.md`` §6 (nothing fitted).
+    """The registered ``frictional`` composition as parts (``docs/friction.md`` §6), with another theory if asked.
 
-    ``theory`` (RET by default) with the Chialvo–Sundaresan χ diverging at φ_c(μ) and Walton's collision
-    rule with β0 = 1.  Not registered yet: the registry entry waits for the dense-regime issue.
+    ``theory`` (RET by default) with the Chialvo–Sundaresan χ diverging at φ_c(μ), the EKT correlation
+    length of ``frictional`` (c fitted, :mod:`ktgf.closures.friction.calibrated`) and Walton's collision rule
+    with β0 = 1 — for RET the registered model ``frictional`` itself (the same numbers: tested).
     """
-    from .friction import WaltonRestitution
     from .models import get_model
 
-    return FrictionalShearParts(get_model(theory).replace(rdf=FrictionalChialvoSundaresan()),
-                                restitution=WaltonRestitution(beta0=1.0))
+    model = get_model("frictional")
+    if theory != "ret":
+        model = model.replace(theory=get_model(theory).theory)
+    return FrictionalShearParts(model, restitution=WaltonRestitution(beta0=1.0))

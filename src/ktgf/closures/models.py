@@ -1,4 +1,4 @@
-"""Named closure models: compositions theory × RDF × viscosity law × dissipation correction, and their registry.
+"""Named closure models: compositions theory × RDF × viscosity law × dissipation correction × friction, and their registry.
 
 A :class:`Model` is a small frozen (hashable) object, so solvers can take it as a static
 argument of ``jax.jit``.  Solvers never branch on model names: they call
@@ -18,7 +18,11 @@ proposed    Garzó & Dufty (1999)  viscosity-divergence RDF   theory's own
 =========== ===================== ========================== ==========================
 
 and the recommended dense model ``dense`` (``docs/dense.md``): RET with the viscosity-divergence
-RDF whose divergence exponent β is fitted to the DEM uniform shear (:mod:`ktgf.closures.dense`).
+RDF whose divergence exponent β is fitted to the DEM uniform shear (:mod:`ktgf.closures.dense`), and
+the recommended model for frictional particles ``frictional`` (``docs/friction.md``): RET with the
+Chialvo–Sundaresan RDF diverging at the frictional jamming fraction φ_c(μ), Walton's collision rule
+(:mod:`ktgf.closures.friction.model_slot`) and the EKT correlation length whose constant c is the one
+number fitted (to T of one row of the frictional DEM file, :mod:`ktgf.closures.friction.calibrated`).
 """
 
 from __future__ import annotations
@@ -35,7 +39,10 @@ from .garzo_dufty1999 import GarzoDufty1999
 from .lun1984 import Lun1984
 from .rdf import CarnahanStarling, RadialDistribution, Torquato, ViscosityDivergence
 from .dense import DENSE_BETA
-from .dissipation import DISSIPATIONS, NoDissipationCorrection
+from .dissipation import DISSIPATIONS, CorrelationLength, NoDissipationCorrection
+from .friction.calibrated import FRICTIONAL_C
+from .friction.jamming import FrictionalChialvoSundaresan
+from .friction.model_slot import FRICTIONS, Friction, NoFriction
 from .viscosity_divergence import NoViscosityCorrection, ViscosityDivergenceLaw
 
 
@@ -80,6 +87,10 @@ class Model:
     dissipation : DissipationCorrection
         Multiplier of the cooling rate ζ0 (default: none; :class:`~ktgf.closures.dissipation.
         CorrelationLength` is extended kinetic theory, active only where a shear rate is given).
+    friction : NoFriction or Friction
+        Frictional particles (default: none): multiplies ζ0 by (1 − e_eff²)/(1 − e²) and carries the
+        optional frictional stress that the uniform-shear and Couette solvers add
+        (:mod:`ktgf.closures.friction.model_slot`).
     label, description : str
         Display name and one-line description.
 
@@ -96,8 +107,12 @@ class Model:
     rdf: RadialDistribution
     viscosity: Any = field(default_factory=NoViscosityCorrection)
     dissipation: Any = field(default_factory=NoDissipationCorrection)
+    friction: Any = field(default_factory=NoFriction)
     label: str = ""
     description: str = ""
+
+    def __post_init__(self) -> None:
+        self.friction.check_model(self)
 
     @property
     def phi_max(self) -> float:
@@ -110,6 +125,7 @@ class Model:
             if value is None:
                 raise InputError(f"{name} is missing (None); give a number or an array")
         check_state(phi, e, theta, phi_max=self.phi_max, rdf_name=self.rdf.describe())
+        self.friction.check_state(e)
 
     def reduced(self, phi: Any, e: Any, *, check: bool = True, shear: Any = None) -> Reduced:
         """Reduced coefficients at solid fraction φ and restitution e (broadcast together).
@@ -126,10 +142,10 @@ class Model:
         phi, e = asarray(phi), asarray(e)
         chi, dchi = self.rdf.chi(phi), self.rdf.dchi(phi)
         r = self.theory.reduced(phi, e, chi, dchi)
-        return r._replace(
-            eta=r.eta * self.viscosity.factor(phi),
-            zeta0=r.zeta0 * self.dissipation.factor(phi, e, chi, shear),
-        )
+        zeta0 = r.zeta0 * self.dissipation.factor(phi, e, chi, shear)
+        if self.friction.mu > 0.0:  # frictionless (μ = 0): ζ0 untouched, bit for bit
+            zeta0 = zeta0 * self.friction.zeta0_factor(e)
+        return r._replace(eta=r.eta * self.viscosity.factor(phi), zeta0=zeta0)
 
     def coefficients(
         self, phi: Any, e: Any, theta: Any, *, d: Any, rho_s: Any, check: bool = True, shear: Any = None
@@ -160,14 +176,24 @@ class Model:
         ``zeta11``, ``sonine``, ``omega``, ``alpha`` go to the theory; ``phi_f``, ``phi_c``,
         ``beta``, ``a``, ``junction``, ``junction_width`` to the RDF and (where it has them) the
         viscosity law; ``dissipation`` (``"none"`` or ``"jenkins-berzi-2010"``) picks the
-        dissipation correction, whose ``c`` is then an option too.
+        dissipation correction, whose ``c`` is then an option too; ``friction`` (``"none"`` or
+        ``"coulomb"``) picks the friction part, whose options (``mu``, ``restitution``, ``stress``, ...,
+        :class:`~ktgf.closures.friction.model_slot.Friction`) are then options too.  ``mu`` goes to every
+        part that has it (the friction part and a frictional RDF's jamming fraction).
         """
+        if "friction" in options:
+            key = options.pop("friction")
+            if key not in FRICTIONS:
+                raise InputError(f"option friction = {key!r} is not valid; choose one of {', '.join(FRICTIONS)}")
+            if key != self.friction.key:
+                return dataclasses.replace(self, friction=FRICTIONS[key]()).with_options(**options)
         if "dissipation" in options:  # a part chosen by name, e.g. dissipation="jenkins-berzi-2010"
             key = options.pop("dissipation")
             if key not in DISSIPATIONS:
                 raise InputError(f"option dissipation = {key!r} is not valid; choose one of {', '.join(DISSIPATIONS)}")
             return dataclasses.replace(self, dissipation=DISSIPATIONS[key]()).with_options(**options)
-        parts = {"theory": self.theory, "rdf": self.rdf, "viscosity": self.viscosity, "dissipation": self.dissipation}
+        parts = {"theory": self.theory, "rdf": self.rdf, "viscosity": self.viscosity, "dissipation": self.dissipation,
+                 "friction": self.friction}
         new = {}
         used: set[str] = set()
         for part_name, part in parts.items():
@@ -187,6 +213,7 @@ class Model:
             **{k: v for k, v in self.rdf.params().items() if not callable(v)},
             **self.viscosity.options(),
             **self.dissipation.options(),
+            **self.friction.options(),
         }
 
     def metadata(self) -> dict[str, str]:
@@ -201,12 +228,14 @@ class Model:
             "rdf": self.rdf.describe(),
             "viscosity_law": self.viscosity.key,
             "dissipation": self.dissipation.key,
+            "friction": self.friction.key,
             "model_options": json.dumps(
                 {
                     "theory": self.theory.options(),
                     "rdf": {k: v for k, v in self.rdf.params().items() if not callable(v)},
                     "viscosity": self.viscosity.options(),
                     "dissipation": self.dissipation.options(),
+                    "friction": self.friction.options(),
                 }
             ),
         }
@@ -304,6 +333,21 @@ register_model(
         description=(
             "Recommended for dense flows: RET with the viscosity-divergence RDF, exponent beta fitted to "
             "DEM uniform shear (docs/dense.md)"
+        ),
+    ),
+)
+register_model(
+    Model(
+        "frictional",
+        GarzoDufty1999(),
+        FrictionalChialvoSundaresan(mu=0.5),
+        dissipation=CorrelationLength(c=FRICTIONAL_C),
+        friction=Friction(mu=0.5, restitution="walton", beta0=1.0),
+        label="Frictional",
+        description=(
+            "Recommended for frictional particles (default mu = 0.5; option mu): RET, Chialvo-Sundaresan RDF "
+            "diverging at phi_c(mu), Walton's collision rule with beta0 = 1, EKT correlation length with c fitted "
+            "to T of one row of the frictional DEM file (docs/friction.md)"
         ),
     ),
 )

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from .frictional_stress import frictional_terms
 from .walls import Wall, jj_dissipation, jj_friction
 
 N_VARS = 3  # u, ln θ, ψ per node
@@ -78,6 +79,7 @@ class Problem:
     centrifugal: float = 1.0  # multiplier of the centripetal term (1 = physics; <1 only inside a homotopy)
     central_differences: bool = True  # O(h²) Jacobian: the near-jammed states have condition numbers ~1e13
     fd_step: float = 1e-5
+    stress_scale: float = 0.0  # ρ_s V² [Pa]: converts a frictional stress (model option stress) to solver units
 
     def __post_init__(self) -> None:
         x = self.x
@@ -93,6 +95,11 @@ class Problem:
         self.B_wall = g.volume_metric(x[[0, -1]])
         self.u_wall = g.wall_velocities()
         self.walls = (self.bottom, self.top)
+        self.reference_shear_rate = abs(self.u_wall[1] - self.u_wall[0]) / (x[-1] - x[0])  # U/H in V/d
+        if self.model.friction.has_stress and not self.stress_scale > 0.0:
+            from ..errors import InputError
+
+            raise InputError("a model with a frictional stress needs the Couette stress scale rho_s V^2 > 0 (Pa)")
 
     # --- fields --------------------------------------------------------------------------
     def unpack(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -137,9 +144,12 @@ class Problem:
             shear=shear,
         )
         node, face = slice(0, n), slice(n, None)
-        F = self.A * c.eta[face] * dw / self.dx
+        rate_f = self.A / self.geometry.stress_metric(self.xf) * dw / self.dx
+        p_fric, mu_fric = frictional_terms(self, phi, phi_f, theta_f, rate_f)  # zeros without a frictional stress
+        F_kinetic = self.A * c.eta[face] * dw / self.dx
+        F = F_kinetic + self.A * mu_fric * dw / self.dx
         E = self.B * (c.kappa[face] * np.diff(theta) + c.omega[face] * np.diff(phi)) / self.dx
-        P = F * dw
+        P = F_kinetic * dw  # frictional work is dissipated at the contacts (frictional_stress.py)
         gamma = 1.5 * phi * theta * c.zeta0[node]
         chi_w = self.model.chi(phi[[0, -1]])
         F_wall = np.zeros(2)
@@ -157,10 +167,12 @@ class Problem:
                 E_wall[k] = sign * self.B_wall[k] * (D - G)
                 if wall.heat_flux == "conductive":  # JJ set κ∂θ/∂n only: add the ω∂φ/∂x part
                     E_wall[k] += self.B_wall[k] * c.omega[node][i] * self._wall_gradient(phi, k)
+        p = c.p[node] + p_fric
         return {
-            "u": u, "theta": theta, "phi": phi, "p": c.p[node], "eta": c.eta[node],
+            "u": u, "theta": theta, "phi": phi, "p": p, "eta": c.eta[node],
             "F": F, "E": E, "P": P, "gamma": gamma, "F_wall": F_wall, "E_wall": E_wall, "slip": slip,
-            "K": self.centrifugal * self.geometry.centripetal(u, self.x, phi, c.p[node]),
+            "K": self.centrifugal * self.geometry.centripetal(u, self.x, phi, p),
+            "p_frictional": p_fric, "frictional_work": (F - F_kinetic) * dw,
         }
 
     def residual(self, X: np.ndarray, t: dict[str, np.ndarray] | None = None) -> np.ndarray:

@@ -83,7 +83,9 @@ def build_problem(model, geometry, bottom: Wall, top: Wall, mean_phi: float, mat
 
         raise InputError(f"gap = {(x1 - x0) * material.d:g} m is out of range: valid gap >= one particle diameter d = {material.d:g} m")
     x = stretched_nodes(x0, x1, n_cells, stretch)
-    return Problem(model, geometry, bottom, top, float(mean_phi), material.e, x, v_scale=geometry.velocity_scale())
+    V = geometry.velocity_scale()
+    return Problem(model, geometry, bottom, top, float(mean_phi), material.e, x, v_scale=V,
+                   stress_scale=material.rho_s * V**2)
 
 
 def to_dataset(problem: Problem, X: np.ndarray, material: Material, *, phi_rcp: float = 0.64,
@@ -114,7 +116,7 @@ def to_dataset(problem: Problem, X: np.ndarray, material: Material, *, phi_rcp: 
     slip_work = np.array([1.0, -1.0]) * tau_wall * slip  # traction power lost to slip at each wall
     wbar = g.angular(np.array(problem.u_wall), problem.x[[0, -1]])
     power_in = float(np.mean(F_face) * (wbar[1] - wbar[0]))
-    dissipation = float(problem.V @ t["gamma"])
+    dissipation = float(problem.V @ t["gamma"]) + float(np.sum(t["frictional_work"]))  # collisions + contact friction
     budget = power_in - dissipation + float(np.sum(Bw * (heat_in - slip_work)))
     max_phi = float(phi.max())
     verdict = validity(max_phi, phi_rcp, float(problem.model.phi_max), theta * V**2, V,
@@ -126,7 +128,9 @@ def to_dataset(problem: Problem, X: np.ndarray, material: Material, *, phi_rcp: 
             "u": (coord, u * V, {"long_name": "tangential velocity", "units": "m/s"}),
             "phi": (coord, phi, {"long_name": "solid volume fraction", "units": "1"}),
             "theta": (coord, theta * V**2, {"long_name": "granular temperature", "units": "m2/s2"}),
-            "p": (coord, t["p"] * stress_scale, {"long_name": "pressure", "units": "Pa"}),
+            "p": (coord, t["p"] * stress_scale, {"long_name": "pressure (kinetic-collisional + frictional)", "units": "Pa"}),
+            "p_frictional": (coord, t["p_frictional"] * stress_scale,
+                             {"long_name": "frictional (enduring-contact) pressure, blended", "units": "Pa"}),
             "shear_rate": (coord, gdot_hat * V / d, {"long_name": "shear rate", "units": "1/s"}),
             "shear_stress": (coord, t["eta"] * gdot_hat * stress_scale,
                              {"long_name": "shear stress eta*shear rate at the nodes", "units": "Pa"}),

@@ -270,6 +270,50 @@ class WaltonRestitution(FrictionPart):
         loss = self.inelasticity(e, mu)
         return math.sqrt(1.0 - loss) if loss <= 1.0 else math.nan
 
+    def _energy_changes(self, e: float, mu: float, r: float) -> tuple[float, float]:
+        """(⟨ΔE_tr⟩, ⟨ΔE_rot⟩) per collision at T = m = 1, T_rot/T = r (class docstring; same prefactor)."""
+        m1, m2 = _walton_moments(float(e), float(mu), self.beta0, self.q, float(r))
+        f = r / (self.q + r)
+        return -(1.0 - float(e) ** 2) - ((1.0 - f) * m1 - m2), m2 / self.q - f * m1
+
+    def hcs_rotational_ratio(self, e: Any, mu: Any) -> float:
+        """T_rot/T of the homogeneous cooling state: both temperatures decay at the same relative rate.
+
+        With dT/dτ ∝ ⟨ΔE_tr⟩ T and dT_rot/dτ ∝ ⟨ΔE_rot⟩ T (equal prefactors: for constant β these are
+        −4(A T − B T_rot) and 4(B T − C T_rot), :class:`RoughSphereRestitution`), r = T_rot/T obeys
+        dr/dτ ∝ ⟨ΔE_rot⟩(r) − r ⟨ΔE_tr⟩(r); its positive root is returned (0 at μ = 0).  When the drift
+        stays positive up to r = 10³ there is no finite ratio in this Maxwellian closure — weak sliding
+        friction drains rotation more slowly than the normal restitution cools translation, so T_rot/T grows
+        without bound — and ``inf`` is returned (e = 0.7, β0 = 1: μ = 0.1 gives inf, μ = 0.5 gives 1.6).
+        Limit (tested): μ → ∞ gives the rough-sphere value of Huthmann & Zippelius (1997) with β = β0.
+        """
+        from scipy.optimize import brentq
+
+        if float(mu) == 0.0:
+            return 0.0
+
+        def drift(r: float) -> float:
+            tr, rot = self._energy_changes(e, mu, r)
+            return rot - r * tr
+
+        high = 1.0
+        while drift(high) > 0.0:  # friction spins a rotation-free gas up; the drift turns negative, or never
+            high *= 2.0
+            if high > 1e3:
+                return math.inf
+        return brentq(drift, 0.0, high, xtol=1e-13, rtol=1e-12)
+
+    def hcs_inelasticity(self, e: Any, mu: Any) -> float:
+        """1 − e_HCS² = −⟨ΔE_tr⟩ at the HCS ratio: the translational cooling of the HCS in units of the smooth (1 − e²).
+
+        Haff's law for frictional spheres: dT/dt = −(1 − e_HCS²)/(1 − e²) × (smooth cooling rate), since
+        translational and rotational temperature decay together at that rate.  NaN where the ratio is infinite.
+        """
+        if float(mu) == 0.0:
+            return 1.0 - float(e) ** 2
+        r = self.hcs_rotational_ratio(e, mu)
+        return math.nan if math.isinf(r) else -self._energy_changes(e, mu, r)[0]
+
     def check(self, e: Any, mu: Any) -> None:
         """Raise :class:`~ktgf.errors.InputError` for μ < 0."""
         check_friction_coefficient(mu)

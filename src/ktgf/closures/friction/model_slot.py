@@ -1,0 +1,303 @@
+"""The ``friction`` part of a :class:`~ktgf.closures.models.Model`: restitution law + optional frictional stress + blend.
+
+A model is theory × RDF × viscosity law × dissipation × friction.  The friction part changes the
+kinetic coefficients in one place only, the collisional dissipation (``docs/friction.md`` Eq. 1.1):
+
+    ζ0* → ζ0* (1 − e_eff²)/(1 − e²),   e_eff from the restitution law at the part's μ,
+
+and it carries (for the solvers that add it: uniform shear, Couette) an optional rate-independent
+frictional stress p_f(φ) w(φ) with a frictional viscosity (Johnson & Jackson 1987 with Schaeffer 1987
+or Srivastava & Sundaresan 2003) and a blend w(φ).  The frictional jamming fraction is the RDF's
+business (:class:`~ktgf.closures.friction.FrictionalChialvoSundaresan` carries μ; ``Model.with_options
+(mu=...)`` routes μ to both parts).
+
+The options are flat scalars (so that ``Model.with_options``, ``ktgf shear -O`` and model files
+handle them like every other option); the sub-parts of :mod:`ktgf.closures.friction` are built from
+them and validate them.  :class:`NoFriction` (the default of every model) has no options.
+
+**Reduction at μ = 0**: the law's e_eff is e exactly, and :meth:`Friction.zeta0_factor` returns the
+Python float 1.0 without touching ζ0, so the coefficients are bit-identical to the frictionless
+model's (tested).  The frictional stress does *not* depend on μ (it is the enduring-contact stress of
+MFiX/OpenFOAM, a continuum law): it is off (``stress = "none"``) unless chosen.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ...errors import InputError
+from ..options import choice_option, real_option
+from .blending import SigmoidBlend, TanhBlend
+from .collisions import ChialvoSundaresanRestitution, RoughSphereRestitution, WaltonRestitution
+from .stress import JohnsonJacksonPressure, SchaefferViscosity, SrivastavaSundaresanViscosity
+
+#: φ_max of the Johnson–Jackson pressure for an RDF that does not diverge below 1 (model.md §2).
+RANDOM_CLOSE_PACKING = 0.64
+#: Restitution laws by option value.
+RESTITUTIONS: tuple[str, ...] = ("walton", "rough-sphere", "chialvo-sundaresan-2013")
+#: Frictional stresses by option value: none, or the Johnson–Jackson pressure with a frictional viscosity.
+STRESSES: tuple[str, ...] = ("none", "schaeffer", "srivastava-sundaresan")
+#: Blends of the frictional stress by option value.
+BLEND_CHOICES: tuple[str, ...] = ("none", "tanh", "sigmoid")
+
+
+@dataclass(frozen=True)
+class NoFriction:
+    """Frictionless particles: the model's coefficients unchanged, no frictional stress."""
+
+    key: ClassVar[str] = "none"
+    label: ClassVar[str] = "frictionless"
+    reference: ClassVar[str] = ""
+    mu: ClassVar[float] = 0.0
+    has_stress: ClassVar[bool] = False
+
+    def zeta0_factor(self, e: Any) -> Any:
+        """Multiplier of ζ0*: 1."""
+        return 1.0
+
+    def rotational_ratio(self, e: Any) -> None:
+        """T_rot/T is not modelled (no rotation): ``None``."""
+        return None
+
+    def check_model(self, model: Any) -> None:
+        """Nothing to check."""
+
+    def check_state(self, e: Any) -> None:
+        """Nothing to check."""
+
+    def options(self) -> dict[str, Any]:
+        return {}
+
+    def params(self) -> dict[str, Any]:
+        return {}
+
+    def describe(self) -> str:
+        return "none"
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Frictional particles: Coulomb friction μ in the collisions, optionally a frictional stress.
+
+    Parameters (all model options)
+    ------------------------------
+    mu : float
+        Particle (Coulomb) friction coefficient, ≥ 0.
+    restitution : str
+        ``walton`` (Coulomb + sticking β0, no fitted parameter), ``rough-sphere`` (constant
+        tangential restitution ``tangential_beta``) or ``chialvo-sundaresan-2013`` (e_eff fit).
+    beta0, tangential_beta, q, cs_amplitude, cs_decay : float
+        Parameters of those laws (:mod:`ktgf.closures.friction.collisions`): Walton's sticking
+        restitution β0 = 1, the rough-sphere β = −1, q = 4I/(md²) = 2/5, CS13's a = 3/2, b = 3.
+    stress : str
+        ``none``, ``schaeffer`` or ``srivastava-sundaresan``: Johnson–Jackson p_f with that viscosity.
+    jj_Fr, jj_n, jj_p, jj_phi_min, jj_phi_max, jj_delta_min : float
+        Johnson–Jackson constants (MFiX/OpenFOAM defaults 0.05 Pa, 2, 5, 0.5, packing limit, 0.05);
+        ``jj_phi_max = 0`` means the model's packing limit (the RDF's φ_c, so φ_c(μ) with a frictional RDF;
+        0.64 for Carnahan–Starling).
+    phi_fr_deg, n_compression : float
+        Angle of internal friction (28.5°) and Srivastava–Sundaresan's compression exponent (1.03).
+    blend, blend_phi_star, blend_width : str, float, float
+        ``none``, ``tanh`` or ``sigmoid``; φ* (required with a blend) and the relative width W/(1 − φ*)
+        (unset: the MFiX value, 0.02 tanh, 0.04 sigmoid; 0 is refused — a zero-width blend is a step).
+    regularisation : float
+        ε of the rate-independent viscosity in a solver, as a fraction of the flow's shear-rate
+        scale: √I2D → √(I2D + (ε γ̇_ref)²) (Schaeffer) — see ``docs/friction.md`` §8.
+    """
+
+    # defaults are the sub-parts' own (one source of every documented constant)
+    mu: float = 0.0
+    restitution: str = "walton"
+    beta0: float = WaltonRestitution.beta0
+    tangential_beta: float = RoughSphereRestitution.beta
+    q: float = WaltonRestitution.q
+    cs_amplitude: float = ChialvoSundaresanRestitution.amplitude
+    cs_decay: float = ChialvoSundaresanRestitution.decay
+    stress: str = "none"
+    jj_Fr: float = JohnsonJacksonPressure.Fr
+    jj_n: float = JohnsonJacksonPressure.n
+    jj_p: float = JohnsonJacksonPressure.p
+    jj_phi_min: float = JohnsonJacksonPressure.phi_min
+    jj_phi_max: float = 0.0
+    jj_delta_min: float = JohnsonJacksonPressure.delta_min
+    phi_fr_deg: float = SchaefferViscosity.phi_fr_deg
+    n_compression: float = SrivastavaSundaresanViscosity.n_compression
+    blend: str = "none"
+    blend_phi_star: float = 0.0
+    blend_width: float | None = None
+    regularisation: float = 1e-3
+    key: ClassVar[str] = "coulomb"
+    label: ClassVar[str] = "Coulomb friction"
+    reference: ClassVar[str] = "docs/friction.md"
+
+    def __post_init__(self) -> None:
+        owner = "friction"
+        real_option("mu", self.mu, owner=owner, low=0.0, low_open=False, why="particle friction coefficient")
+        choice_option("restitution", self.restitution, RESTITUTIONS, owner=owner)
+        choice_option("stress", self.stress, STRESSES, owner=owner)
+        choice_option("blend", self.blend, BLEND_CHOICES, owner=owner)
+        real_option("regularisation", self.regularisation, owner=owner, low=0.0, high=1.0,
+                    why="epsilon as a fraction of the shear-rate scale")
+        if self.blend_width is not None:
+            real_option("blend_width", self.blend_width, owner=owner, low=0.0, why="a blend of zero width is a step")
+        _ = self.law  # builds (and so validates) the restitution law
+        if self.blend != "none":
+            if not self.blend_phi_star > 0.0:
+                raise InputError(f"option blend_phi_star = {self.blend_phi_star!r} of friction is required with "
+                                 f"blend = {self.blend!r}: valid 0 < blend_phi_star < the packing limit")
+            _ = self.blend_part
+
+    # --- sub-parts ---------------------------------------------------------------------------
+    @cached_property
+    def law(self) -> Any:
+        """The restitution law object (:mod:`ktgf.closures.friction.collisions`)."""
+        if self.restitution == "walton":
+            return WaltonRestitution(beta0=self.beta0, q=self.q)
+        if self.restitution == "rough-sphere":
+            return RoughSphereRestitution(beta=self.tangential_beta, q=self.q)
+        return ChialvoSundaresanRestitution(amplitude=self.cs_amplitude, decay=self.cs_decay)
+
+    def pressure_part(self, phi_max: float) -> JohnsonJacksonPressure:
+        """The Johnson–Jackson pressure with φ_max = ``jj_phi_max`` or, when that is 0, the model's packing limit.
+
+        (An RDF without a divergence below φ = 1, Carnahan–Starling, gives random close packing 0.64 instead.)
+        """
+        top = self.jj_phi_max if self.jj_phi_max > 0.0 else (float(phi_max) if phi_max < 1.0 else RANDOM_CLOSE_PACKING)
+        return JohnsonJacksonPressure(Fr=self.jj_Fr, n=self.jj_n, p=self.jj_p, phi_min=self.jj_phi_min,
+                                      phi_max=top, delta_min=self.jj_delta_min)
+
+    @cached_property
+    def viscosity_part(self) -> Any:
+        """The frictional viscosity (Schaeffer or Srivastava–Sundaresan), ``None`` without a stress."""
+        if self.stress == "schaeffer":
+            return SchaefferViscosity(phi_fr_deg=self.phi_fr_deg)
+        if self.stress == "srivastava-sundaresan":
+            return SrivastavaSundaresanViscosity(phi_fr_deg=self.phi_fr_deg, n_compression=self.n_compression)
+        return None
+
+    @cached_property
+    def blend_part(self) -> Any:
+        """The blend w(φ) (``None``: w = 1)."""
+        if self.blend == "tanh":
+            return TanhBlend(self.blend_phi_star, relative_width=0.02 if self.blend_width is None else self.blend_width)
+        if self.blend == "sigmoid":
+            return SigmoidBlend(self.blend_phi_star, relative_width=0.04 if self.blend_width is None else self.blend_width)
+        return None
+
+    @property
+    def has_stress(self) -> bool:
+        return self.stress != "none"
+
+    # --- what the model and the solvers use -----------------------------------------------------
+    def zeta0_factor(self, e: Any) -> Any:
+        """(1 − e_eff²)/(1 − e²), the multiplier of ζ0* (Python 1.0 at μ = 0: bit-exact reduction).
+
+        The Walton law is a quadrature (SciPy), evaluated once per distinct value of e (under ``jax.jit``
+        through a host callback, so e cannot be differentiated); the other laws are NumPy/JAX formulas.
+        """
+        if self.mu == 0.0:
+            return 1.0
+        if isinstance(self.law, WaltonRestitution):
+            if "jax" in type(e).__module__ and not _is_concrete(e):  # traced (jit): a host callback
+                import jax
+
+                e = jax.numpy.asarray(e)
+                return jax.pure_callback(self._walton_factor, jax.ShapeDtypeStruct(e.shape, e.dtype), e,
+                                         vmap_method="expand_dims")
+            return self._walton_factor(e)
+        return self.law.inelasticity(e, self.mu) / (1.0 - e**2)
+
+    def _walton_factor(self, e: Any) -> Any:
+        values = np.asarray(e, dtype=float)
+        uniq, inverse = np.unique(values, return_inverse=True)
+        factors = np.array([self.law.inelasticity(float(v), self.mu) / (1.0 - float(v) ** 2) for v in uniq])
+        out = factors[inverse].reshape(values.shape)
+        return float(out) if out.ndim == 0 and not isinstance(e, np.ndarray) else out.astype(values.dtype)
+
+    def rotational_ratio(self, e: Any) -> Any:
+        """T_rot/T of steady homogeneous shear (``None`` if the law does not model rotation; 0 at μ = 0)."""
+        if self.restitution == "chialvo-sundaresan-2013":
+            return None
+        if self.mu == 0.0:
+            return 0.0
+        return self.law.rotational_ratio(e, self.mu)
+
+    def check_state(self, e: Any) -> None:
+        """Frictional dissipation at μ > 0 is written through 1/(1 − e²): e < 1 is required."""
+        if self.mu > 0.0 and np.any(np.asarray(e, dtype=float) >= 1.0):
+            raise InputError(f"restitution coefficient e = {float(np.max(e)):g} is out of range for friction mu = "
+                             f"{self.mu:g}: valid 0 < e < 1 (docs/friction.md Eq. 1.1)")
+        self.law.check(e, self.mu)
+
+    def check_model(self, model: Any) -> None:
+        """Thresholds must lie below the model's packing limit (one-line InputError naming the option)."""
+        limit = float(model.phi_max)
+        why = f"must lie below the packing limit {limit:.4g} of the model's RDF {model.rdf.describe()}"
+        if self.jj_phi_max > limit:
+            raise InputError(f"option jj_phi_max = {self.jj_phi_max:g} of friction is out of range: {why}")
+        if self.has_stress:
+            real_option("jj_phi_min", self.jj_phi_min, owner="friction", low=0.0, high=limit, high_open=True,
+                        low_open=False, why=why)
+            self.pressure_part(limit)  # validates n, p, δ_min against the band
+        if self.blend != "none":
+            real_option("blend_phi_star", self.blend_phi_star, owner="friction", low=0.0, high=limit,
+                        high_open=True, why=why)
+
+    def frictional_pressure(self, phi: Any, phi_max: float) -> Any:
+        """w(φ) p_f(φ) [Pa] (0 without a stress)."""
+        if not self.has_stress:
+            return 0.0 * phi
+        p_f = self.pressure_part(phi_max).pressure(phi)
+        return p_f if self.blend_part is None else self.blend_part.weight(phi) * p_f
+
+    def frictional_viscosity(self, p_f: Any, ss: Any, theta_over_d2: Any, reg2: Any, div_u: Any = 0.0) -> Any:
+        """μ_f [Pa s] from w p_f [Pa], S:S [1/s²], θ/d² [1/s²] and the regularisation (ε γ̇_ref)² [1/s²].
+
+        Schaeffer: p_f sin φ_fr/(2√(I2D + ε²γ̇_ref²)), I2D = S:S/2.  Srivastava–Sundaresan uses
+        √(S:S + θ/d²), already regular where θ > 0; ε² is added there too so that θ → 0 stays finite.
+        """
+        visc = self.viscosity_part
+        if visc is None:
+            return 0.0 * p_f
+        if isinstance(visc, SchaefferViscosity):
+            return visc.viscosity(p_f, 0.5 * ss + reg2)
+        return visc.viscosity(p_f, div_u, ss + 2.0 * reg2, theta_over_d2)
+
+    def simple_shear_stress_ratio(self, temperature_ratio: Any) -> Any:
+        """τ_f/(w p_f) in unregularised simple shear at θ/(γ̇d)²."""
+        visc = self.viscosity_part
+        if isinstance(visc, SrivastavaSundaresanViscosity):
+            return visc.simple_shear_stress_ratio(temperature_ratio)
+        return visc.shear_stress_ratio() + 0.0 * temperature_ratio
+
+    def params(self) -> dict[str, Any]:
+        from dataclasses import fields
+
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def options(self) -> dict[str, Any]:
+        return self.params()
+
+    def describe(self) -> str:
+        parts = [f"mu={self.mu:g}", self.restitution]
+        if self.has_stress:
+            parts.append(f"johnson-jackson+{self.stress}" + (f", {self.blend} blend" if self.blend != "none" else ""))
+        return "coulomb(" + ", ".join(parts) + ")"
+
+
+def _is_concrete(x: Any) -> bool:
+    try:
+        np.asarray(x)
+    except Exception:
+        return False
+    return True
+
+
+#: Friction parts by key (``Model.with_options(friction=KEY)``).
+FRICTIONS: dict[str, type] = {"none": NoFriction, "coulomb": Friction}
+
+__all__ = ["BLEND_CHOICES", "FRICTIONS", "Friction", "NoFriction", "RESTITUTIONS", "STRESSES"]

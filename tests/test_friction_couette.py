@@ -1,0 +1,131 @@
+"""Couette cell with frictional particles: frictional stress in the balances, regularisation, convergence from a naive start."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ktgf import get_model
+from ktgf.couette import PlanarCell, Wall
+from ktgf.couette.equations import Problem
+from ktgf.couette.geometry import stretched_nodes
+from ktgf.couette.run import Material, run
+from ktgf.couette.solver import naive_start, solve
+from ktgf.errors import InputError
+
+#: ρ_s V² [Pa] of the test cell (2500 kg/m³, V = 1 m/s): the Johnson–Jackson stress (Pa) in solver units.
+SCALE = 2500.0
+
+
+def _problem(mu, mean_phi, stress="schaeffer", eps=1e-3, n=80, e=0.7):
+    model = get_model("frictional", mu=mu, stress=stress, regularisation=eps)
+    g = PlanarCell(20.0, 1.0)
+    x0, x1 = g.bounds(1.0)
+    w = Wall(specularity=0.2, restitution=0.85)
+    return Problem(model, g, w, w, mean_phi, e, stretched_nodes(x0, x1, n, 1.5), v_scale=1.0, stress_scale=SCALE)
+
+
+def test_frictional_terms_are_the_closures():
+    """At a (non-solution) state the shear flux is (η + μ_f) γ̇ with Schaeffer's μ_f, and p includes w p_f."""
+    pr = _problem(0.5, 0.52)
+    rng = np.random.default_rng(3)
+    X = naive_start(pr) + 0.02 * rng.standard_normal(3 * pr.n)
+    t = pr.terms(X)
+    u, theta, phi = pr.unpack(X)
+    fr = pr.model.friction
+    pf_node = fr.pressure_part(pr.phi_max).pressure(phi) / SCALE
+    np.testing.assert_allclose(t["p_frictional"], pf_node, rtol=1e-14)
+    phi_f, rate = 0.5 * (phi[1:] + phi[:-1]), np.diff(u) / pr.dx
+    pf_face = fr.pressure_part(pr.phi_max).pressure(phi_f) / SCALE
+    sin = np.sin(np.radians(28.5))
+    mu_f = pf_face * sin / (2 * np.sqrt(rate**2 / 4 + (1e-3 * pr.reference_shear_rate) ** 2))
+    kin = pr.model.coefficients(phi_f, 0.7, 0.5 * (theta[1:] + theta[:-1]), d=1.0, rho_s=1.0, check=False).eta
+    np.testing.assert_allclose(t["F"], (kin + mu_f) * rate, rtol=1e-12)
+    assert np.any(t["p_frictional"] > 0)  # the state reaches above φ_min = 0.5
+
+
+def test_jacobian_with_the_frictional_stress_matches_directional_derivatives():
+    for stress in ("schaeffer", "srivastava-sundaresan"):
+        pr = _problem(0.25, 0.5, stress=stress, n=30)
+        rng = np.random.default_rng(1)
+        X = naive_start(pr) + 0.05 * rng.standard_normal(3 * pr.n)
+        R = pr.residual(X)
+        J = pr.jacobian(X, R)
+        v = rng.standard_normal(X.size)
+        fd = (pr.residual(X + 1e-5 * v) - pr.residual(X - 1e-5 * v)) / 2e-5
+        np.testing.assert_allclose(J @ v, fd, rtol=1e-4, atol=1e-6 * np.abs(fd).max())
+
+
+def test_a_model_with_a_frictional_stress_needs_the_stress_scale():
+    g = PlanarCell(20.0, 1.0)
+    w = Wall()
+    with pytest.raises(InputError, match="stress scale"):
+        Problem(get_model("frictional", stress="schaeffer"), g, w, w, 0.4, 0.7, np.linspace(-10, 10, 11))
+
+
+# cheap points of the convergence map (docs/friction.md §8): Newton from the naive start, < 1 s each
+@pytest.mark.parametrize("mu,mean_phi,stress", [(0.0, 0.3, "schaeffer"), (0.5, 0.5, "schaeffer"),
+                                                 (0.25, 0.4, "srivastava-sundaresan")])
+def test_converges_from_a_naive_start(mu, mean_phi, stress):
+    pr = _problem(mu, mean_phi, stress)
+    X, info = solve(pr)
+    u, theta, phi = pr.unpack(X)
+    assert info["residual"] < 1e-8
+    assert pr.V @ phi / pr.V.sum() == pytest.approx(mean_phi, abs=1e-10)
+    F = pr.terms(X)["F"]
+    assert np.ptp(F) < 1e-8 * np.abs(F).max()  # the shear stress (kinetic + frictional) is uniform
+
+
+def test_energy_budget_closes_with_the_frictional_work(tmp_path):
+    """Wall power = collisional dissipation + frictional work + slip work (the frictional work does not feed θ)."""
+    model = get_model("frictional", mu=0.5, stress="schaeffer")
+    w = Wall(specularity=0.2, restitution=0.85)
+    ds = run(model, PlanarCell(0.02, 1.0), w, w, 0.5, Material(1e-3, 2500.0, 0.7), n_cells=80)
+    assert ds.attrs["energy_budget_relative_error"] < 1e-8
+    assert float(ds["p_frictional"].max()) > 0.5 * float(ds["p"].max())  # the frictional stress dominates here
+    assert ds["p_frictional"].attrs["units"] == "Pa"
+
+
+def _halving(mu, mean_phi, eps):
+    """Profiles at ε and ε/2 (the second started from the first): max |Δu|/U, |Δφ|, |Δ ln θ|, |Δτ/τ|."""
+    a = _problem(mu, mean_phi, eps=eps)
+    Xa, _ = solve(a)
+    b = _problem(mu, mean_phi, eps=eps / 2)
+    Xb, info = solve(b, Xa)
+    assert info["residual"] < 1e-8
+    (ua, ta, pa), (ub, tb, pb) = a.unpack(Xa), b.unpack(Xb)
+    Fa, Fb = a.terms(Xa)["F"].mean(), b.terms(Xb)["F"].mean()
+    return np.abs(ua - ub).max(), np.abs(pa - pb).max(), np.abs(np.log(ta / tb)).max(), abs(Fb / Fa - 1)
+
+
+def test_halving_the_regularisation_does_not_change_a_sheared_profile():
+    """Sheared everywhere (μ = 0.5, φ̄ = 0.5: min γ̇ = 0.4 U/H): the change is O(ε²), below 1e-4 at ε = 1e-3."""
+    du, dphi, dlnt, dtau = _halving(0.5, 0.5, 1e-3)
+    assert du < 1e-4 and dphi < 1e-5 and dlnt < 1e-3 and dtau < 2e-4
+
+
+def test_halving_the_regularisation_with_a_creeping_plug():
+    """μ = 0, φ̄ = 0.5: a creeping core (γ̇ ~ ε U/H) where the frictional stress dominates.  The change is O(ε):
+    velocity 1e-3 U, φ 1e-4, wall stress 0.4 %, the temperature of the core ~1 % at ε = 1e-3 (docs/friction.md §8)."""
+    du, dphi, dlnt, dtau = _halving(0.0, 0.5, 1e-3)
+    assert du < 1.5e-3 and dphi < 1e-4 and dlnt < 1e-2 and dtau < 4e-3
+
+
+@pytest.mark.slow
+def test_convergence_map_from_a_naive_start():
+    """Mean φ 0.3–0.6 × μ 0–0.5 × {no, Schaeffer, Srivastava–Sundaresan} frictional stress: every state below φ_c(μ)
+    converges (Newton, or the solver's own fallbacks); states with φ̄ ≥ φ_c(μ) are refused.  About 2.5 min.
+    Residual bound 1e-6: μ = 0, φ̄ = 0.6 with the Schaeffer stress stops at 7e-8 (near-singular Jacobian)."""
+    failures = []
+    for stress in ("none", "schaeffer", "srivastava-sundaresan"):
+        for mu in (0.0, 0.1, 0.25, 0.5):
+            for mean_phi in (0.3, 0.4, 0.5, 0.55, 0.6):
+                pr = _problem(mu, mean_phi, stress)
+                if mean_phi >= pr.phi_max:
+                    continue
+                try:
+                    X, info = solve(pr)
+                    assert info["residual"] < 1e-6
+                except Exception as exc:  # noqa: BLE001 - collect, report all at once
+                    failures.append((stress, mu, mean_phi, str(exc)[:80]))
+    assert not failures, failures
