@@ -42,7 +42,7 @@ def test_shear_waves_decay_at_the_viscous_rate(name):
     phi, k = 0.3, 0.2 / D
     for ky, kz, comp in ((0.0, k, 1), (k, 0.0, 3)):
         m = _rates(name, phi, ky, kz)
-        nu_k2 = m.base.eta * k**2 / m.base.rho
+        nu_k2 = m.base.c.eta * k**2 / m.base.rho
         A = shear_matrix(m.base, 0.0, ky, kz)
         unit = np.zeros(5)
         unit[comp] = 1.0

@@ -52,6 +52,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..closures import get_model
+from ..closures.coefficients import Dimensional
 from ..couette.uniform_shear import uniform_shear
 from ..errors import InputError
 from ..validation import check_positive, check_range
@@ -66,22 +67,16 @@ class ShearBase(NamedTuple):
     """Steady uniform shear in SI units and the derivatives the linearisation needs.
 
     Attributes: solid fraction ``phi``, ``shear_rate`` γ̇ [1/s], ``theta`` [m²/s²], bulk density
-    ``rho`` [kg/m³], ``p`` [Pa], ``eta``, ``lambda_b`` [Pa s], ``kappa`` [kg/(m s)], ``omega``
-    [W/m], ``zeta0`` [1/s], ``zeta_u`` [–], ``p_phi`` = ∂p/∂φ [Pa], ``eta_phi`` = ∂η/∂φ [Pa s],
+    ``rho`` [kg/m³], the model's SI coefficients ``c`` (:class:`~ktgf.closures.coefficients.Dimensional`:
+    p, η, λ_b, κ, ω, ζ0, ζ_U), ``p_phi`` = ∂p/∂φ [Pa], ``eta_phi`` = ∂η/∂φ [Pa s],
     ``gamma`` = Γ = (3/2)ρθζ0 [W/m³] and ``gamma_phi`` = ∂Γ/∂φ [W/m³], all at fixed θ.
     """
 
-    phi: Any
-    shear_rate: Any
-    theta: Any
-    rho: Any
-    p: Any
-    eta: Any
-    lambda_b: Any
-    kappa: Any
-    omega: Any
-    zeta0: Any
-    zeta_u: Any
+    phi: float
+    shear_rate: float
+    theta: float
+    rho: float
+    c: Dimensional
     p_phi: Any
     eta_phi: Any
     gamma: Any
@@ -114,10 +109,8 @@ def shear_base_state(model: Any, phi: float, e: float, shear_rate: float, *, d: 
     rho = rho_s * phi
     gamma = 1.5 * rho * theta * float(c.zeta0)
     return ShearBase(
-        phi=float(phi), shear_rate=float(shear_rate), theta=theta, rho=rho, p=float(c.p), eta=float(c.eta),
-        lambda_b=float(c.lambda_b), kappa=float(c.kappa), omega=float(c.omega), zeta0=float(c.zeta0),
-        zeta_u=float(c.zeta_u), p_phi=rho_s * theta * float(r.C), eta_phi=float(deta), gamma=gamma,
-        gamma_phi=gamma * (1.0 + float(r.g)) / phi,
+        phi=float(phi), shear_rate=float(shear_rate), theta=theta, rho=rho, c=Dimensional(*(float(v) for v in c)),
+        p_phi=rho_s * theta * float(r.C), eta_phi=float(deta), gamma=gamma, gamma_phi=gamma * (1.0 + float(r.g)) / phi,
     )
 
 
@@ -127,12 +120,12 @@ def shear_matrix(base: ShearBase, kx: Any, ky: Any, kz: Any) -> np.ndarray:
     ``kx, ky, kz`` are wavenumbers [1/m] in the frame of the base flow.  For k_x = 0 the
     eigenvalues of A are the growth rates; for k_x ≠ 0 A holds only at one instant (Kelvin mode).
     """
-    b = base
+    b, c = base, base.c
     kx, ky, kz = np.broadcast_arrays(*(np.asarray(k, dtype=float) for k in (kx, ky, kz)))
     k2 = kx**2 + ky**2 + kz**2
     g, rho, th = b.shear_rate, b.rho, b.theta
-    eta_t, p_t, gam_t = b.eta / (2.0 * th), b.p / th, 1.5 * b.gamma / th  # θ-derivatives (∝ √θ scalings)
-    bulk = b.eta / 3.0 + b.lambda_b
+    eta_t, p_t, gam_t = c.eta / (2.0 * th), c.p / th, 1.5 * b.gamma / th  # θ-derivatives (∝ √θ scalings)
+    bulk = c.eta / 3.0 + c.lambda_b
     A = np.zeros(kx.shape + (5, 5), dtype=complex)
     kv = (kx, ky, kz)
     # mass: dδφ/dt = −iφ k·δu
@@ -145,17 +138,17 @@ def shear_matrix(base: ShearBase, kx: Any, ky: Any, kz: Any) -> np.ndarray:
         A[..., 1 + i, 4] = (-1j * kv[i] * p_t + shear_eta[i] * eta_t) / rho
         for j in range(3):
             A[..., 1 + i, 1 + j] = -bulk * kv[i] * kv[j] / rho
-        A[..., 1 + i, 1 + i] += -b.eta * k2 / rho
+        A[..., 1 + i, 1 + i] += -c.eta * k2 / rho
     A[..., 1, 2] += -g  # lift-up: the base velocity gradient advected by δu_y
     # energy: conduction, compression work and ζ_U, perturbed shear work, perturbed dissipation
     cv = 1.5 * rho
-    A[..., 4, 0] = (-b.omega * k2 + g**2 * b.eta_phi - b.gamma_phi) / cv
-    A[..., 4, 4] = (-b.kappa * k2 + g**2 * eta_t - gam_t) / cv
-    comp = b.p + 1.5 * rho * th * b.zeta_u
+    A[..., 4, 0] = (-c.omega * k2 + g**2 * b.eta_phi - b.gamma_phi) / cv
+    A[..., 4, 4] = (-c.kappa * k2 + g**2 * eta_t - gam_t) / cv
+    comp = c.p + 1.5 * rho * th * c.zeta_u
     for j in range(3):
         A[..., 4, 1 + j] = -1j * comp * kv[j] / cv
-    A[..., 4, 1] += 2j * b.eta * g * ky / cv
-    A[..., 4, 2] += 2j * b.eta * g * kx / cv
+    A[..., 4, 1] += 2j * c.eta * g * ky / cv
+    A[..., 4, 2] += 2j * c.eta * g * kx / cv
     return A
 
 
