@@ -5,8 +5,9 @@ Base state (model.md §9): u = γ̇ y e_x, uniform φ and θ with the steady ene
 
 Perturbations ∝ exp(i k·r) in the frame moving with the base flow.  With k_x = 0 the base
 advection γ̇ y ∂_x does not act on them and the problem has constant coefficients: normal modes
-exp(σt).  With k_x ≠ 0 the wavevector is sheared, k_y(t) = k_y(0) − γ̇ k_x t (Kelvin modes,
-Savage 1992 JFM 241 §3; Alam & Nott 1997 JFM 343 §3), and the amplitudes obey dy/dt = A(k(t)) y.
+exp(σt).  With k_x ≠ 0 the wavevector is sheared, k_y(t) = k_y(0) − γ̇ k_x t (Kelvin modes, the
+method of Savage 1992, JFM 241, 109, and Alam & Nott 1997, JFM 343, 267), and the amplitudes obey
+dy/dt = A(k(t)) y.
 
 State y = (δφ, δu_x, δu_y, δu_z, δθ) (SI: 1, m/s, m/s, m/s, m²/s²).  Linearising the balances of
 model.md §1 (P = pI − η(∇u + ∇uᵀ − (2/3)∇·u I) − λ_b ∇·u I, q = −κ∇θ − ω∇φ,
@@ -36,12 +37,21 @@ Limits (the oracles of the tests):
   and forms a Jordan block with δu_y (same rate; δu_y feeds δu_x by lift-up, algebraic growth);
   (δφ, δu_z, δθ) is a sound/heat system like the HCS longitudinal one;
 * k = (0, k_y, 0): δu_z decouples, σ = −η k²/ρ; (δφ, δu_x, δu_y, δθ) carry the layering
-  (shear-banding) mode, whose small-k sign follows the slope of the uniform-shear stress ratio
-  μ(φ) = |P_xy|/p: unstable where dμ/dφ < 0 (Alam & Nott 1998 JFM 377; Alam 2005 JFM 523, as the
-  criterion is usually quoted — measured here, see docs/uniform_shear_stability.md);
-* e → 1: no uniform shear steady state (γ̇ → 0 at fixed θ), so the elastic limit is taken at
-  γ̇ = 0, where the matrix is that of an elastic gas at rest: σ = −ηk²/ρ and sound with
-  the Navier–Stokes damping.
+  (shear-banding) mode.  At small k it is slow (σ = O(k²)) while pressure, shear stress and the
+  local energy balance relax fast, so the layers are a sequence of uniform-shear states at one
+  pressure; eliminating the fast variables gives (docs/uniform_shear_stability.md)
+
+      σ/γ̇ = (kd)² f_p μ'(φ) / (1 + (φ/2) (ln f_p)'),   μ = |P_xy|/p,   f_p = p/(ρ_s γ̇² d²) = φ p* T,
+
+  both from the closed form (model.md §9): unstable exactly where the stress ratio rises with φ
+  (the flow "cannot sustain increasing dynamic friction with increasing density", Alam, Shukla &
+  Luding 2008, arXiv:0811.2459, abstract);
+* k = (0, 0, k_z), the (δφ, δu_z, δθ) block: its k-dependent part is, in the HCS variables,
+  exactly the HCS longitudinal matrix of model.md §8 (tested); the two analyses differ only in
+  the homogeneous terms of their base states.  Dilute flows (φ = 0.05 and 0.1 at e = 0.9; not
+  0.2–0.5) are unstable to this vorticity-direction clustering, as the HCS is (docs table).
+
+There is no elastic limit at fixed γ̇ (uniform shear needs e < 1: θ/(γ̇d)² → ∞ as e → 1).
 """
 
 from __future__ import annotations
