@@ -75,3 +75,22 @@ def test_chute_jacobian_matches_directional_derivatives():
         v = rng.standard_normal(X.size)
         fd = (pr.residual(X + 1e-5 * v) - pr.residual(X - 1e-5 * v)) / 2e-5
         np.testing.assert_allclose(J @ v, fd, rtol=1e-4, atol=1e-6 * np.abs(fd).max())
+
+
+def test_cli_writes_the_layer_and_refuses_bad_input(tmp_path):
+    """``ktgf chute`` writes a netCDF whose base traction is the weight; a bad angle exits 2 with the field named."""
+    import xarray as xr
+    from typer.testing import CliRunner
+
+    from ktgf.cli import app
+
+    runner = CliRunner()
+    out = tmp_path / "chute.nc"
+    res = runner.invoke(app, ["chute", "--model", "proposed", "--depth", "0.02", "--angle", "20", "--mean-phi", "0.3",
+                              "--cells", "24", "--out", str(out), "--format", "json"])
+    assert res.exit_code == 0, res.output
+    with xr.open_dataset(out) as ds:
+        weight = 2500.0 * 9.81 * math.sin(math.radians(20.0)) * 0.3 * 0.02
+        assert float(ds["wall_shear_stress"][0]) == pytest.approx(weight, rel=1e-9)
+    bad = runner.invoke(app, ["chute", "--depth", "0.02", "--angle", "0", "--mean-phi", "0.3"])
+    assert bad.exit_code == 2 and "angle_deg" in bad.output
