@@ -190,6 +190,20 @@ def test_integrated_modes_evolve_as_their_eigenvalues(name):
         assert np.abs(y - exact).max() / scale < 1e-8, j
 
 
+def test_kelvin_spanwise_velocity_decays_with_the_sheared_wavenumber():
+    """k_z = 0: δu_z decouples exactly, δu_z(t) = δu_z(0) exp(−(η/ρ) ∫ |k(t)|² dt) with k_y(t) = k_y0 − γ̇k_x t."""
+    base = shear_base_state("proposed", 0.4, E, GDOT, d=D, rho_s=RHO_S)
+    kx, ky0 = 0.2 / D, 0.5 / D
+    times = np.linspace(0.0, 8.0 / GDOT, 9)
+    y0 = np.array([0.0, 0.0, 0.0, 1e-3, 0.0])
+    y = kelvin_evolution(base, (kx, ky0, 0.0), y0, times)
+    b = GDOT * kx
+    integral = kx**2 * times + (ky0**3 - (ky0 - b * times) ** 3) / (3 * b)
+    exact = 1e-3 * np.exp(-base.c.eta / base.rho * integral)
+    np.testing.assert_allclose(y[:, 3].real, exact, rtol=1e-7, atol=1e-15)
+    assert np.abs(np.delete(y, 3, axis=1)).max() < 1e-15
+
+
 def test_kelvin_mode_matches_a_product_of_matrix_exponentials():
     """k_x ≠ 0: the sheared wavevector; DOP853 against midpoint exponentials exp(A(k(t+h/2))h), error O(h²)."""
     base = shear_base_state("ret", 0.3, E, GDOT, d=D, rho_s=RHO_S)
