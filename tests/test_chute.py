@@ -86,12 +86,14 @@ def test_cli_writes_the_layer_and_refuses_bad_input(tmp_path):
 
     runner = CliRunner()
     out = tmp_path / "chute.nc"
-    res = runner.invoke(app, ["chute", "--model", "proposed", "--depth", "0.02", "--angle", "20", "--mean-phi", "0.3",
-                              "--cells", "24", "--out", str(out), "--format", "json"])
+    res = runner.invoke(app, ["chute", "--model", "proposed,enskog", "--depth", "0.02", "--angle", "20", "--mean-phi",
+                              "0.3", "--cells", "24", "--out", str(out), "--format", "json"])
     assert res.exit_code == 0, res.output
-    with xr.open_dataset(out) as ds:
-        weight = 2500.0 * 9.81 * math.sin(math.radians(20.0)) * 0.3 * 0.02
-        assert float(ds["wall_shear_stress"][0]) == pytest.approx(weight, rel=1e-9)
+    weight = 2500.0 * 9.81 * math.sin(math.radians(20.0)) * 0.3 * 0.02
+    for name in ("proposed", "enskog"):
+        with xr.open_dataset(tmp_path / f"chute_{name}.nc") as ds:
+            assert ds.attrs["model"] == name
+            assert float(ds["wall_shear_stress"][0]) == pytest.approx(weight, rel=1e-9)
     bad = runner.invoke(app, ["chute", "--depth", "0.02", "--angle", "0", "--mean-phi", "0.3"])
     assert bad.exit_code == 2 and "angle_deg" in bad.output
 

@@ -6,12 +6,13 @@ from pathlib import Path
 
 import typer
 
-from ._common import OutputFormat, emit, handle_errors
+from ._common import MODEL_HELP, OutputFormat, emit, handle_errors, model_file_option, resolve_models
 
 
 @handle_errors
 def chute(
-    model: str = typer.Option("ret", "--model", "-m", help="Registered model name."),
+    model: str = typer.Option(None, "--model", "--models", "-m", help=MODEL_HELP),
+    model_file: Path = model_file_option(),
     depth: float = typer.Option(..., "--depth", help="Column height H [m] (base at y = 0, free surface at H)."),
     angle: float = typer.Option(..., "--angle", help="Inclination of the base [degrees], 0 < angle < 90."),
     mean_phi: float = typer.Option(..., "--mean-phi", help="Mean solid fraction of the column (fixed inventory)."),
@@ -22,7 +23,7 @@ def chute(
     wall_restitution: float = typer.Option(0.9, "--wall-restitution", help="Particle-base restitution e_w."),
     gravity: float = typer.Option(9.81, "--gravity", help="g [m/s^2]."),
     n_cells: int = typer.Option(64, "--cells", help="Grid cells across the column (>= 8)."),
-    out: Path = typer.Option(None, "--out", "-o", help="Output netCDF (optional)."),
+    out: Path = typer.Option(None, "--out", "-o", help="Output netCDF (optional; with several models one file each, NAME_model.nc)."),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Steady fully developed layer on a bumpy inclined base: zero stress and energy flux at the top.
@@ -35,21 +36,30 @@ def chute(
     from ..couette.walls import Wall
     from ..io import write_netcdf
 
-    ds = solve_chute(model, depth=depth, angle_deg=angle, mean_phi=mean_phi, material=Material(d, rho_s, e),
-                     base=Wall(specularity=specularity, restitution=wall_restitution), gravity=gravity, n_cells=n_cells)
-    a = ds.attrs
-    row = {
-        "model": a["model"], "iterations": int(a["solver_iterations"]), "surface_velocity_m/s": a["surface_velocity"],
-        "base_slip_m/s": a["base_slip_velocity"], "base_traction_Pa": float(ds["wall_shear_stress"].values[0]),
-        "weight_tangential_Pa": a["weight_tangential"], "top_pressure_fraction": a["top_pressure_fraction"],
-        "max_phi": a["max_phi"], "valid": a["validity"],
-    }
+    models = resolve_models(model, model_file)
+    base = Wall(specularity=specularity, restitution=wall_restitution)
+    rows, written, warnings = [], [], []
+    for m in models:
+        ds = solve_chute(m, depth=depth, angle_deg=angle, mean_phi=mean_phi, material=Material(d, rho_s, e),
+                         base=base, gravity=gravity, n_cells=n_cells)
+        a = ds.attrs
+        rows.append({
+            "model": a["model"], "iterations": int(a["solver_iterations"]), "surface_velocity_m/s": a["surface_velocity"],
+            "base_slip_m/s": a["base_slip_velocity"], "base_traction_Pa": float(ds["wall_shear_stress"].values[0]),
+            "weight_tangential_Pa": a["weight_tangential"], "top_pressure_fraction": a["top_pressure_fraction"],
+            "max_phi": a["max_phi"], "valid": a["validity"],
+        })
+        if out is not None:
+            path = out if len(models) == 1 else out.with_name(f"{out.stem}_{m.name}{out.suffix or '.nc'}")
+            written.append(str(write_netcdf(ds, path)))
+        if not a["physically_valid"]:
+            warnings.append(f"Warning ({m.name}): {a['validity']}")
     title = f"chute: {angle:g} deg, H = {depth:g} m, mean phi {mean_phi:g}"
-    if out is not None:
-        title += f" -> {write_netcdf(ds, out)}"
-    emit([row], fmt, title=title)
-    if not a["physically_valid"]:
-        typer.echo(f"Warning: {a['validity']}", err=True)
+    if written:
+        title += " -> " + ", ".join(written)
+    emit(rows, fmt, title=title)
+    for w in warnings:
+        typer.echo(w, err=True)
 
 
 def register(app: typer.Typer, plot_app: typer.Typer) -> None:

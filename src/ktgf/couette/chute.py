@@ -19,8 +19,9 @@ Boundary conditions (choices, exposed as the ``base`` and ``top`` walls):
 
 * base: a Johnson–Jackson wall at rest (bumpy: large specularity), :mod:`ktgf.couette.walls`;
 * top: a *free surface* with zero shear stress and zero flux of fluctuation energy (the
-  ``zero-flux`` wall type, the default).  Zero energy flux is the condition of Johnson, Nott &
-  Jackson (1990, JFM 210, 501) and Anderson & Jackson (1992, JFM 241, 145) at the free surface;
+  ``zero-flux`` wall type, the default).  Zero energy flux is the free-surface condition of
+  Johnson, Nott & Jackson (1990, JFM 210, 501) and Anderson & Jackson (1992, JFM 241, 145) as we
+  recall them (their text is not in the project library);
   a prescribed small θ (``Wall(momentum="free-slip", energy="prescribed", temperature=…)``) is
   allowed but makes the surface an energy sink that has no physical counterpart.
   With θ finite at the top, p = ρ_s φ θ p* vanishes only where φ does: the continuum free
