@@ -254,7 +254,7 @@ def chute_dataset(problem: ChuteProblem, X: np.ndarray, material: Material, *, p
     power_in = float(problem.V @ (phi * u)) * problem.gravity[0]
     dissipation = float(problem.V @ t["gamma"])
     heat_in = ds["wall_heat_flux"].values / flux_scale
-    budget = power_in - dissipation + float(np.sum(heat_in - slip_work)) - 0.0
+    budget = power_in - dissipation + float(np.sum(heat_in - slip_work))
     inventory = float(problem.V @ phi)
     mass_above = np.concatenate([np.cumsum((0.5 * (phi[1:] + phi[:-1]) * problem.dx)[::-1])[::-1], [0.0]])
     shear_stress = ds["shear_stress"].values
