@@ -22,6 +22,17 @@ Example (``examples/hcs_3d.toml``)::
     unit = "tau"            # "tau" (collision units along Haff's law; outputs equally spaced in tau), "haff" (t/t0) or "s"
     outputs = 60
 
+Cases other than the cooling box (``examples/uniform_shear.toml``): ``[case] kind`` and one
+boundary per axis, e.g. a Lees–Edwards box sheared at γ̇ = 50/s along x with y the gradient::
+
+    [case]
+    kind = "uniform-shear"
+    [boundaries]
+    y = { kind = "lees-edwards", shear_rate = 50.0, flow = "x" }
+    [time]
+    end = 200.0
+    unit = "strain"         # gamma_dot * t
+
 Errors name the field (``grid.cells.0``, ``initial.solid_fraction``) and the valid range.
 """
 
@@ -127,7 +138,8 @@ class NumericsSection(_Section):
 
 class TimeSection(_Section):
     end: float = Field(..., gt=0.0)
-    unit: Literal["tau", "haff", "s"] = "tau"
+    unit: Literal["tau", "haff", "s", "strain"] = Field(
+        "tau", description="tau, haff: cooling box only; strain (shear rate x t): sheared cases only")
     outputs: int = Field(50, ge=1, le=100000)
     max_steps_per_call: int = Field(200, ge=1, le=2**31 - 1, description="steps per compiled call (progress granularity)")
     scheme: Literal["auto", "imex", "ssprk3"] = Field(
@@ -146,6 +158,49 @@ class ParallelSection(_Section):
     devices: int = Field(1, ge=1, description="JAX devices to shard the first grid axis over")
 
 
+#: Case kinds (:mod:`ktgf.solver.flows`) and the boundary kind each needs on some axis.
+CASE_KINDS = ("cooling", "uniform-shear")
+_AXES = ("x", "y", "z")
+
+
+class BoundarySection(_Section):
+    kind: Literal["periodic", "lees-edwards"] = "periodic"
+    shear_rate: float | None = Field(None, gt=0.0, description="Lees-Edwards shear rate du_flow/dx_axis [1/s]")
+    flow: Literal["x", "y", "z"] | None = Field(None, description="Lees-Edwards flow direction (not this axis)")
+
+    @model_validator(mode="after")
+    def _complete(self) -> BoundarySection:
+        if self.kind == "lees-edwards" and (self.shear_rate is None or self.flow is None):
+            raise ValueError("a lees-edwards boundary needs shear_rate (> 0, 1/s) and flow ('x', 'y' or 'z')")
+        if self.kind == "periodic" and (self.shear_rate is not None or self.flow is not None):
+            raise ValueError("a periodic boundary takes no shear_rate or flow (did you mean kind = 'lees-edwards'?)")
+        return self
+
+
+class BoundariesSection(_Section):
+    x: BoundarySection = BoundarySection()
+    y: BoundarySection = BoundarySection()
+    z: BoundarySection = BoundarySection()
+
+    @model_validator(mode="after")
+    def _one_shear(self) -> BoundariesSection:
+        le = [a for a in _AXES if getattr(self, a).kind == "lees-edwards"]
+        if len(le) > 1:
+            raise ValueError(f"at most one axis can be lees-edwards (one shear gradient); got {', '.join(le)}")
+        for a in le:
+            if getattr(self, a).flow == a:
+                raise ValueError(f"{a}.flow = {a!r} is the gradient axis itself: valid flow is another axis")
+        return self
+
+    def shear_axis(self) -> str | None:
+        return next((a for a in _AXES if getattr(self, a).kind == "lees-edwards"), None)
+
+
+class CaseSection(_Section):
+    kind: Literal["cooling", "uniform-shear"] = Field(
+        "cooling", description="cooling (periodic box), uniform-shear (Lees-Edwards box)")
+
+
 class Config(_Section):
     model: ModelSection = ModelSection()
     particles: ParticlesSection = ParticlesSection()
@@ -155,6 +210,8 @@ class Config(_Section):
     time: TimeSection
     output: OutputSection = OutputSection()
     parallel: ParallelSection = ParallelSection()
+    case: CaseSection = CaseSection()
+    boundaries: BoundariesSection = BoundariesSection()
 
 
 def _fmt_error(err: dict[str, Any]) -> str:
@@ -209,6 +266,7 @@ def check_physics(cfg: Config, source: str = "config") -> None:
     if cfg.initial.max_mode > max(cells) // 2:
         raise InputError(f"{source}: field initial.max_mode = {cfg.initial.max_mode} is out of range: valid "
                          f"1 <= max_mode <= {max(cells) // 2} (half the largest cell count)")
+    check_case(cfg, source)
     if cfg.grid.relative_to is not None:
         from ..hcs.stability import critical_wavenumbers
 
@@ -220,3 +278,32 @@ def check_physics(cfg: Config, source: str = "config") -> None:
                 f"phi = {phi0:g}, e = {cfg.model.restitution:g} has no {cfg.grid.relative_to} instability "
                 "(infinite critical size); give grid.length instead"
             )
+
+
+def check_case(cfg: Config, source: str = "config") -> None:
+    """The case and its boundaries fit together and fit the grid (one-line errors naming the field)."""
+    ndim, kind, b = len(cfg.grid.cells), cfg.case.kind, cfg.boundaries
+    for a in _AXES[ndim:]:
+        if getattr(b, a).kind != "periodic":
+            raise InputError(f"{source}: field boundaries.{a}.kind = {getattr(b, a).kind!r}: the grid has {ndim} "
+                             f"axis/axes ({', '.join(_AXES[:ndim])}); axis {a} has no boundary to set")
+    shear = b.shear_axis()
+    if kind == "cooling" and shear is not None:
+        raise InputError(f"{source}: field boundaries.{shear}.kind = 'lees-edwards' needs case.kind = "
+                         "'uniform-shear' (the cooling case is a periodic box)")
+    if kind == "uniform-shear" and shear is None:
+        raise InputError(f"{source}: field case.kind = 'uniform-shear' needs one boundaries.<axis> with kind = "
+                         f"'lees-edwards' (valid axes: {', '.join(_AXES[:ndim])})")
+    sheared = kind != "cooling"
+    if sheared and cfg.time.unit in ("tau", "haff"):
+        raise InputError(f"{source}: field time.unit = {cfg.time.unit!r} is for the cooling case (Haff's law); "
+                         f"valid for case.kind = {kind!r}: 's' or 'strain'")
+    if not sheared and cfg.time.unit == "strain":
+        raise InputError(f"{source}: field time.unit = 'strain' needs a sheared case; valid for the cooling case: "
+                         "'tau', 'haff' or 's'")
+    if sheared and cfg.grid.relative_to is not None:
+        raise InputError(f"{source}: field grid.relative_to sizes a cooling box (HCS critical size); "
+                         f"give grid.length or grid.length_d for case.kind = {kind!r}")
+    if sheared and cfg.initial.perturbation == "mode":
+        raise InputError(f"{source}: field initial.perturbation = 'mode' is an HCS eigenmode; valid for "
+                         f"case.kind = {kind!r}: 'random' or 'none'")

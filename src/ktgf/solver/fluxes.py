@@ -62,6 +62,16 @@ def materialise(x: Any) -> Any:
     return jax.lax.optimization_barrier(x) if MATERIALISE else x
 
 
+def pad_fields(W: Sequence[Any], grid: Grid, t: Any = 0.0, velocity: int | None = None,
+               affine: bool = True) -> tuple[Any, ...]:
+    """Fields with GHOST ghost cells per side, filled by the grid's boundaries (:func:`.boundaries.pad`)."""
+    from .boundaries import pad
+
+    if grid.boundaries is None or grid.boundaries.all_periodic:
+        return pad_periodic(W, grid.ndim)
+    return materialise(pad(W, grid, GHOST, t, velocity, affine))
+
+
 def pad_periodic(W: Sequence[Any], ndim: int) -> tuple[Any, ...]:
     """Fields with GHOST periodic ghost cells on each side of every grid axis.
 
@@ -226,14 +236,16 @@ def face_divergence(F: Any, grid: Grid, axis: int) -> Any:
 
 
 def flux_divergence(W: Sequence[Any], coefficients: tuple[tuple[Any, ...], tuple[Any, ...]], grid: Grid,
-                    phys: Physics, limiter: str, riemann: str, viscous: bool = True) -> tuple[list[Any], Any]:
+                    phys: Physics, limiter: str, riemann: str, viscous: bool = True,
+                    t: Any = 0.0) -> tuple[list[Any], Any]:
     """−∇·F per field of the convective (+ viscous and heat, if ``viscous``) flux, and the cell ∇·u.
 
-    ``coefficients`` = (eos, transport) cell fields of :func:`cell_fields`.
+    ``coefficients`` = (eos, transport) cell fields of :func:`cell_fields`; ``t`` the time (the
+    Lees–Edwards images move).
     """
     eos, transport = coefficients
-    P = pad_periodic((*W, *eos), grid.ndim)
-    Pk = pad_periodic(transport, grid.ndim) if viscous else ()
+    P = pad_fields((*W, *eos), grid, t, velocity=1)
+    Pk = pad_fields(transport, grid, t) if viscous else ()
     out: list[Any] = [0.0] * 5
     for a in range(grid.ndim):
         Fc = convective_flux(P, grid.cells, a, limiter, riemann)
