@@ -22,9 +22,33 @@ ghost cells per side; the boundaries only decide what the ghost cells hold (:fun
     an exact steady solution of the discrete momentum balance (a linear profile continues
     across the boundary).
 
-The velocity jump is the affine part of the boundary: an operator linear in the velocity
-(the implicit viscous operator of the IMEX stage solves) is applied with ``affine=False``
-and the jump goes into its right-hand side (:func:`~.imex.implicit_stage`).
+``wall``
+    Both ends of the axis are walls (:class:`WallSide`: a :class:`ktgf.couette.walls.Wall` and
+    its velocity), the Johnson & Jackson (1987, *J. Fluid Mech.* 176, 67) conditions of the 1D
+    Couette solver, evaluated by the same functions (:mod:`ktgf.couette.walls`).  With n the
+    normal into the medium, u_sl = u − U_w the slip at the wall and c = ρ_s (π√3/6) φ'(φ/φ_pk)χ√θ:
+
+        η ∂u_t/∂n = c u_sl,t        (tangential momentum: shear stress of the wall)
+        u_n = 0                     (no flux through the wall)
+        −q·n = D − G,  D = ρ_s (π√3/(4φ_pk))(1 − e_w²) φχθ^{3/2},  G = c|u_sl|²
+
+    The convective flux through the wall face is the HLL flux between the medium's face state
+    (reconstructed with a one-sided slope in the wall cell) and its mirror image (u_n odd): no
+    mass, tangential momentum or energy crosses the wall, the normal momentum flux is
+    ρu_n² + p − sρu_n (s = |u_n| + c: the wall pressure, p at rest) (:func:`~.fluxes.wall_flux`).
+    The viscous and heat fluxes see ghost cells that make the central face fluxes equal to the
+    conditions: the face velocity u_f solves η(u_c − u_f)/(Δ/2) = c(u_f − U_w) (u_c the wall
+    cell), u_ghost = 2u_f − u_c, and θ_ghost = θ_c − Δ(D − G)/κ, so the discrete wall stress is
+    exactly c(u_f − U_w) and the heat flux exactly D − G.  φ and θ in c, D and G are the values
+    at the wall extrapolated from the two nearest cells (second order), the slip the face u_f.
+    ``momentum = "prescribed"`` (no slip, c → ∞) and ``"free-slip"`` (c = 0), ``energy =
+    "adiabatic"`` (q·n = 0) and ``"prescribed"`` (θ_ghost = 2θ_w − θ_c) are the limits.
+
+Affine parts.  The Lees–Edwards velocity jump, the wall velocity and the wall heat flux G are the
+affine part of the boundary: an operator linear in the velocity or θ (the implicit operators of
+the IMEX stage solves) is applied with ``affine=False`` and the rest goes into its right-hand
+side (:func:`~.imex.implicit_stage`).  In those solves the coefficients c and D/θ of the walls
+are frozen with the transport coefficients (at the sweep's θ), so D is linear in θ there.
 """
 
 from __future__ import annotations
@@ -38,8 +62,20 @@ import jax.numpy as jnp
 
 PERIODIC = "periodic"
 LEES_EDWARDS = "lees-edwards"
-KINDS = (PERIODIC, LEES_EDWARDS)
+WALL = "wall"
+KINDS = (PERIODIC, LEES_EDWARDS, WALL)
 AXES = "xyz"
+#: Wall conditions the 3D solver applies (of :mod:`ktgf.couette.walls`).
+WALL_MOMENTUM = ("johnson-jackson", "prescribed", "free-slip")
+WALL_ENERGY = ("johnson-jackson", "adiabatic", "prescribed")
+
+
+@dataclass(frozen=True)
+class WallSide:
+    """One wall of the solver: its conditions (:class:`ktgf.couette.walls.Wall`) and velocity [m/s]."""
+
+    wall: Any
+    velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @jax.tree_util.register_pytree_node_class
@@ -57,11 +93,14 @@ class Boundaries:
         Lees–Edwards shear rate γ̇ [1/s] (du_f/dx_a of the images).
     flow : int
         Velocity component of the Lees–Edwards flow direction (0, 1, 2 = x, y, z; not the gradient axis).
+    walls : tuple
+        Per axis: None, or (lower, upper) :class:`WallSide` of a ``wall`` axis.
     """
 
     kinds: tuple[str, ...]
     shear_rate: float = 0.0
     flow: int = 0
+    walls: tuple = ()
 
     def __post_init__(self) -> None:
         from ..errors import InputError
@@ -80,15 +119,34 @@ class Boundaries:
                                  f"must differ from the gradient axis {AXES[a]}")
             if self.flow < len(kinds) and kinds[self.flow] != PERIODIC:
                 raise InputError(f"Lees-Edwards flow axis {AXES[self.flow]} must be periodic")
-
+        walls = tuple(self.walls) or (None,) * len(kinds)
+        object.__setattr__(self, "walls", walls)
+        for a, k in enumerate(kinds):
+            if (k == WALL) != (walls[a] is not None):
+                raise InputError(f"axis {AXES[a]}: a wall axis needs its two walls (lower, upper), other axes none")
+            for side in walls[a] or ():
+                w = side.wall
+                if w.momentum not in WALL_MOMENTUM or w.energy not in WALL_ENERGY:
+                    raise InputError(f"wall conditions {w.momentum!r}/{w.energy!r} on axis {AXES[a]}: the 3D solver "
+                                     f"applies momentum {', '.join(WALL_MOMENTUM)} and energy {', '.join(WALL_ENERGY)}")
+                if w.momentum == "prescribed" and w.slip != 0.0:
+                    raise InputError(f"wall slip = {w.slip:g} on axis {AXES[a]}: the 3D solver's prescribed wall is "
+                                     "no-slip (slip = 0)")
+                if w.heat_flux != "total":
+                    raise InputError(f"wall heat_flux = {w.heat_flux!r} on axis {AXES[a]}: the 3D solver applies the "
+                                     "JJ energy condition to the whole heat flux (heat_flux = 'total')")
+                if side.velocity[a] != 0.0:
+                    raise InputError(f"wall velocity {side.velocity} on axis {AXES[a]} has a normal component: "
+                                     "walls move tangentially")
     def tree_flatten(self) -> tuple[tuple, tuple]:
-        return (self.shear_rate,), (self.kinds, self.flow)
+        return (self.shear_rate,), (self.kinds, self.flow, self.walls)
 
     @classmethod
     def tree_unflatten(cls, aux: tuple, leaves: tuple) -> Boundaries:
         obj = object.__new__(cls)
         object.__setattr__(obj, "kinds", aux[0])
         object.__setattr__(obj, "flow", aux[1])
+        object.__setattr__(obj, "walls", aux[2])
         object.__setattr__(obj, "shear_rate", leaves[0])
         return obj
 
@@ -105,12 +163,9 @@ class Boundaries:
         """The Lees–Edwards gradient axis, or None."""
         return self.kinds.index(LEES_EDWARDS) if LEES_EDWARDS in self.kinds else None
 
-
-def base_velocity(grid: Any, x_a: Any) -> Any:
-    """Velocity of the Lees–Edwards base flow γ̇(x_a − L_a/2) along the flow direction at coordinate x_a."""
-    bc = grid.boundaries
-    a = bc.shear_axis
-    return bc.shear_rate * (x_a - 0.5 * grid.lengths[a])
+    @property
+    def wall_axes(self) -> tuple[int, ...]:
+        return tuple(a for a, k in enumerate(self.kinds) if k == WALL)
 
 
 def _shifted(f: Any, s: Any, axis: int) -> Any:
@@ -141,13 +196,116 @@ def _lees_edwards(f: Any, grid: Any, t: Any, jump: Any, G: int) -> Any:
     return jnp.concatenate([low, f, high], axis=a)
 
 
+def _side(f: Any, axis: int, n: int, side: int, layer: int) -> Any:
+    """The cell ``layer`` away from wall ``side`` (0 lower, 1 upper), kept as a slab of width 1."""
+    i = layer if side == 0 else n - 1 - layer
+    return jax.lax.slice_in_dim(f, i, i + 1, axis=axis)
+
+
+def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any], grid: Any, phys: Any) -> dict:
+    """Ghost-cell coefficients of every wall, from the state (θ: the temperature of the coefficients).
+
+    Per (axis, side): ``ratio``, ``offset`` (3 components) with u_ghost = ratio_j u_c + offset_j;
+    ``heat`` = (a, b, g) with θ_ghost = θ_c − Δ(a θ_w − g)/κ_c, θ_w = (3θ_0 − θ_1)/2 and a = D/θ_w,
+    g = G; ``stress`` = c(u_f − U_w) per component and ``slip`` = u_f − U_w (diagnostics).
+    The coefficients depend on ``theta`` and on u; :func:`pad` applies them.
+    """
+    from ..couette.walls import jj_dissipation, jj_friction
+
+    bc = grid.boundaries
+    rho_s = phys.material_density
+    eta, kappa = transport[0], transport[2]
+    out = {}
+    for a in bc.wall_axes:
+        n, h = grid.cells[a], grid.spacing[a]
+        for side, ws in enumerate(bc.walls[a]):
+            wall = ws.wall
+            c0, c1 = (_side(x, a, n, side, 0) for x in (rho, theta)), (_side(x, a, n, side, 1) for x in (rho, theta))
+            (r0, t0), (r1, t1) = c0, c1
+            phi_w = jnp.clip((1.5 * r0 - 0.5 * r1) / rho_s, 0.5 * r0 / rho_s, 2.0 * r0 / rho_s)
+            theta_w = jnp.clip(1.5 * t0 - 0.5 * t1, 0.5 * t0, 2.0 * t0)
+            chi = phys.model.chi(phi_w)
+            eta_c = _side(eta, a, n, side, 0)
+            beta = 2.0 * eta_c / h
+            if wall.momentum == "johnson-jackson":
+                c = rho_s * jj_friction(wall, phi_w, chi, theta_w)
+                ratio_t, weight = (beta - c) / (beta + c), 2.0 * c / (beta + c)
+            elif wall.momentum == "prescribed":
+                ratio_t, weight = -jnp.ones_like(beta), 2.0 * jnp.ones_like(beta)
+                c = None
+            else:
+                ratio_t, weight = jnp.ones_like(beta), jnp.zeros_like(beta)
+                c = jnp.zeros_like(beta)
+            ratio = tuple(-jnp.ones_like(beta) if j == a else ratio_t for j in range(3))
+            offset = tuple(jnp.zeros_like(beta) if j == a else weight * ws.velocity[j] for j in range(3))
+            uc = [_side(x, a, n, side, 0) for x in u]
+            u_face = [0.5 * (uc[j] * (1.0 + ratio[j]) + offset[j]) for j in range(3)]
+            slip = tuple(jnp.zeros_like(beta) if j == a else u_face[j] - ws.velocity[j] for j in range(3))
+            if c is None:  # no slip: the stress is the viscous one, η(u_c − u_f)/(Δ/2) toward the medium
+                stress = tuple(beta * (uc[j] - u_face[j]) if j != a else jnp.zeros_like(beta) for j in range(3))
+            else:
+                stress = tuple(c * s_ for s_ in slip)
+            if wall.energy == "johnson-jackson":
+                d_over_theta = rho_s * jj_dissipation(wall, phi_w, chi, theta_w) / theta_w
+                work = sum(st * sl for st, sl in zip(stress, slip)) if c is not None else jnp.zeros_like(beta)
+                heat = ("jj", d_over_theta, work)
+            elif wall.energy == "prescribed":
+                heat = ("fixed", jnp.full_like(beta, wall.temperature), jnp.zeros_like(beta))
+            else:
+                heat = ("adiabatic", jnp.zeros_like(beta), jnp.zeros_like(beta))
+            out[a, side] = {"ratio": ratio, "offset": offset, "heat": heat[1:], "stress": stress, "slip": slip,
+                            "kappa": _side(kappa, a, n, side, 0)}
+    return out
+
+
+def _wall_ghosts(f: Any, grid: Any, a: int, G: int, role: Any, terms: dict | None, affine: bool) -> Any:
+    """f with G ghost layers on each side of wall axis a.
+
+    ``role``: "even" (ρ, closures), ("u", j) a velocity component, "theta"; ``terms`` None: the
+    ghosts of the convective fluxes (a linear extrapolation: the wall cell's slope is one-sided;
+    the wall face flux itself is :func:`~.fluxes.wall_flux`), else the viscous ghosts.
+    """
+    n, h = grid.cells[a], grid.spacing[a]
+    bc = grid.boundaries
+    slabs = []
+    for side in (0, 1):
+        layers = [_side(f, a, n, side, g) for g in range(G)]
+        if terms is None:  # convective: linear extrapolation (second-order one-sided slope of the wall cell)
+            ghost = [layers[0] + (g + 1) * (layers[0] - layers[1]) for g in range(G)]
+        elif role == "even":
+            ghost = layers
+        elif role == "theta":
+            T = terms[a, side]
+            kind = bc.walls[a][side].wall.energy
+            t0, t1 = layers[0], layers[1]
+            if kind == "johnson-jackson":
+                d_over_theta, work = T["heat"]
+                theta_w = 1.5 * t0 - 0.5 * t1
+                g0 = t0 - h * (d_over_theta * theta_w - (work if affine else 0.0)) / T["kappa"]
+            elif kind == "prescribed":
+                g0 = -t0 + (2.0 * T["heat"][0] if affine else 0.0)
+            else:
+                g0 = t0
+            ghost = [g0] + [t0 + g0 - layers[g] for g in range(1, G)]
+        else:
+            T = terms[a, side]
+            j = role[1]
+            g0 = T["ratio"][j] * layers[0] + (T["offset"][j] if affine else 0.0)
+            ghost = [g0] + [layers[0] + g0 - layers[g] for g in range(1, G)]
+        ghost = ghost[::-1]  # outermost first
+        slabs.append(ghost if side == 0 else ghost[::-1])
+    return jnp.concatenate([*slabs[0], f, *slabs[1]], axis=a)
+
+
 def pad(fields: Sequence[Any], grid: Any, G: int, t: Any = 0.0, velocity: int | None = None,
-        affine: bool = True) -> tuple[Any, ...]:
+        affine: bool = True, theta: int | None = None, walls: dict | None = None) -> tuple[Any, ...]:
     """Fields with G ghost cells per side of every grid axis, filled as the boundaries say.
 
     ``velocity``: index in ``fields`` of the x velocity component (the three components follow
-    it), so that the Lees–Edwards jump reaches the flow component; None if the fields hold no
-    velocity.  ``affine=False`` leaves out the jump (the linear part of the boundary operator).
+    it), so that the Lees–Edwards jump and the wall conditions reach them; None if the fields
+    hold no velocity.  ``theta``: index of θ (wall heat conditions).  ``walls``: the
+    :func:`wall_terms` of the viscous and heat fluxes, or None for the mirror image the convective
+    fluxes see.  ``affine=False`` leaves out the affine parts (the linear part of the operator).
     """
     bc = grid.boundaries
     ndim = grid.ndim
@@ -155,8 +313,12 @@ def pad(fields: Sequence[Any], grid: Any, G: int, t: Any = 0.0, velocity: int | 
         return tuple(jnp.pad(f, [(G, G)] * ndim, mode="wrap") for f in fields)
     out = []
     for i, f in enumerate(fields):
-        flow_comp = velocity is not None and affine and i == velocity + bc.flow
-        f = _lees_edwards(f, grid, t, 1.0 if flow_comp else None, G)
-        widths = [(0, 0) if b == bc.shear_axis else (G, G) for b in range(ndim)]
+        is_velocity = velocity is not None and 0 <= i - velocity < 3
+        role = ("u", i - velocity) if is_velocity else ("theta" if i == theta else "even")
+        for a in bc.wall_axes:
+            f = _wall_ghosts(f, grid, a, G, role, walls, affine)
+        if bc.shear_axis is not None:
+            f = _lees_edwards(f, grid, t, 1.0 if (is_velocity and affine and i == velocity + bc.flow) else None, G)
+        widths = [(0, 0) if b == bc.shear_axis or bc.kinds[b] == WALL else (G, G) for b in range(ndim)]
         out.append(jnp.pad(f, widths, mode="wrap"))
     return tuple(out)

@@ -44,6 +44,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from ..couette.config import WallsConfig
 from ..errors import InputError, KtgfError
 from ..io import plain, read_toml
 from .fluxes import LIMITERS, RIEMANN_SOLVERS
@@ -158,22 +159,30 @@ class ParallelSection(_Section):
     devices: int = Field(1, ge=1, description="JAX devices to shard the first grid axis over")
 
 
-#: Case kinds (:mod:`ktgf.solver.flows`) and the boundary kind each needs on some axis.
-CASE_KINDS = ("cooling", "uniform-shear")
+#: Case kinds (:mod:`ktgf.solver.flows`).
+CASE_KINDS = ("cooling", "uniform-shear", "couette")
 _AXES = ("x", "y", "z")
 
 
 class BoundarySection(_Section):
-    kind: Literal["periodic", "lees-edwards"] = "periodic"
+    kind: Literal["periodic", "lees-edwards", "wall"] = "periodic"
     shear_rate: float | None = Field(None, gt=0.0, description="Lees-Edwards shear rate du_flow/dx_axis [1/s]")
-    flow: Literal["x", "y", "z"] | None = Field(None, description="Lees-Edwards flow direction (not this axis)")
+    flow: Literal["x", "y", "z"] | None = Field(None, description="Lees-Edwards flow / wall motion direction (not this axis)")
+    wall_speed: float | None = Field(None, ge=0.0, description="relative wall speed U [m/s]: lower wall at -U/2, upper at +U/2")
+    walls: WallsConfig | None = Field(None, description="wall conditions (as in ktgf couette): both, or lower/upper via bottom/top")
 
     @model_validator(mode="after")
     def _complete(self) -> BoundarySection:
         if self.kind == "lees-edwards" and (self.shear_rate is None or self.flow is None):
             raise ValueError("a lees-edwards boundary needs shear_rate (> 0, 1/s) and flow ('x', 'y' or 'z')")
-        if self.kind == "periodic" and (self.shear_rate is not None or self.flow is not None):
-            raise ValueError("a periodic boundary takes no shear_rate or flow (did you mean kind = 'lees-edwards'?)")
+        if self.kind == "wall" and (self.walls is None or self.flow is None or self.wall_speed is None):
+            raise ValueError("a wall boundary needs walls (e.g. {type = 'johnson-jackson', specularity = 0.1}), "
+                             "flow ('x', 'y' or 'z') and wall_speed (>= 0, m/s)")
+        extra = {"shear_rate": self.kind != "lees-edwards", "flow": self.kind == "periodic",
+                 "wall_speed": self.kind != "wall", "walls": self.kind != "wall"}
+        bad = [k for k, refused in extra.items() if refused and getattr(self, k) is not None]
+        if bad:
+            raise ValueError(f"a {self.kind} boundary takes no {', '.join(bad)}")
         return self
 
 
@@ -185,20 +194,29 @@ class BoundariesSection(_Section):
     @model_validator(mode="after")
     def _one_shear(self) -> BoundariesSection:
         le = [a for a in _AXES if getattr(self, a).kind == "lees-edwards"]
+        walls = [a for a in _AXES if getattr(self, a).kind == "wall"]
         if len(le) > 1:
             raise ValueError(f"at most one axis can be lees-edwards (one shear gradient); got {', '.join(le)}")
-        for a in le:
-            if getattr(self, a).flow == a:
+        if len(walls) > 1 or (le and walls):
+            raise ValueError(f"one sheared axis at most: lees-edwards on {le or 'none'}, walls on {walls or 'none'}")
+        for a in le + walls:
+            flow = getattr(self, a).flow
+            if flow == a:
                 raise ValueError(f"{a}.flow = {a!r} is the gradient axis itself: valid flow is another axis")
+            if getattr(self, flow).kind != "periodic":
+                raise ValueError(f"{a}.flow = {flow!r}: the flow axis must be periodic")
         return self
+
+    def wall_axis(self) -> str | None:
+        return next((a for a in _AXES if getattr(self, a).kind == "wall"), None)
 
     def shear_axis(self) -> str | None:
         return next((a for a in _AXES if getattr(self, a).kind == "lees-edwards"), None)
 
 
 class CaseSection(_Section):
-    kind: Literal["cooling", "uniform-shear"] = Field(
-        "cooling", description="cooling (periodic box), uniform-shear (Lees-Edwards box)")
+    kind: Literal["cooling", "uniform-shear", "couette"] = Field(
+        "cooling", description="cooling (periodic box), uniform-shear (Lees-Edwards box), couette (two walls)")
 
 
 class Config(_Section):
@@ -287,13 +305,28 @@ def check_case(cfg: Config, source: str = "config") -> None:
         if getattr(b, a).kind != "periodic":
             raise InputError(f"{source}: field boundaries.{a}.kind = {getattr(b, a).kind!r}: the grid has {ndim} "
                              f"axis/axes ({', '.join(_AXES[:ndim])}); axis {a} has no boundary to set")
-    shear = b.shear_axis()
-    if kind == "cooling" and shear is not None:
-        raise InputError(f"{source}: field boundaries.{shear}.kind = 'lees-edwards' needs case.kind = "
-                         "'uniform-shear' (the cooling case is a periodic box)")
+    shear, wall = b.shear_axis(), b.wall_axis()
+    if kind == "cooling" and (shear or wall):
+        raise InputError(f"{source}: field boundaries.{shear or wall}.kind = {getattr(b, shear or wall).kind!r} needs "
+                         "case.kind = 'uniform-shear' or 'couette' (the cooling case is a periodic box)")
     if kind == "uniform-shear" and shear is None:
         raise InputError(f"{source}: field case.kind = 'uniform-shear' needs one boundaries.<axis> with kind = "
                          f"'lees-edwards' (valid axes: {', '.join(_AXES[:ndim])})")
+    if kind == "couette" and wall is None:
+        raise InputError(f"{source}: field case.kind = 'couette' needs one boundaries.<axis> with kind = 'wall' "
+                         f"(valid axes: {', '.join(_AXES[:ndim])})")
+    if kind == "couette" and not getattr(b, wall).wall_speed > 0:
+        raise InputError(f"{source}: field boundaries.{wall}.wall_speed = {getattr(b, wall).wall_speed:g} is out of "
+                         "range: valid wall_speed > 0 m/s for a Couette cell")
+    if kind != "uniform-shear" and shear is not None:
+        raise InputError(f"{source}: field boundaries.{shear}.kind = 'lees-edwards' needs case.kind = 'uniform-shear'")
+    if kind != "couette" and wall is not None:
+        raise InputError(f"{source}: field boundaries.{wall}.kind = 'wall' needs case.kind = 'couette'")
+    if wall is not None:
+        try:
+            getattr(b, wall).walls.build_pair()
+        except KtgfError as exc:
+            raise InputError(f"{source}: field boundaries.{wall}.walls: {exc}") from None
     sheared = kind != "cooling"
     if sheared and cfg.time.unit in ("tau", "haff"):
         raise InputError(f"{source}: field time.unit = {cfg.time.unit!r} is for the cooling case (Haff's law); "

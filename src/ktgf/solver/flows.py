@@ -4,7 +4,13 @@
 ``cooling``         periodic box cooling freely (the homogeneous cooling state, model.md §8)
 ``uniform-shear``   Lees–Edwards box sheared at rate γ̇ (:mod:`.boundaries`); its steady
                     homogeneous state is the closed form :func:`ktgf.couette.uniform_shear`
+``couette``         planar Couette cell: Johnson–Jackson walls on one axis moving at ∓U/2
+                    along the flow direction; its steady state is the 1D Couette solver's
+                    (:func:`ktgf.couette.run.run`, same model, same walls, same inventory)
 ==================  ======================================================================
+
+Both sheared cases start from the linear profile u_f = γ̇(x_a − L_a/2) (γ̇ = U/L_a in the
+Couette cell) plus the configured perturbation.
 
 A case adds its own columns to the time series (:func:`case_diagnostics`) and, at the end of
 a run, a comparison with its reference (:func:`verification`, written as ``verification.json``).
@@ -25,20 +31,25 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..closures.coefficients import eta0
-from .boundaries import AXES, LEES_EDWARDS, PERIODIC, Boundaries, base_velocity
-from .fluxes import cell_divergence, pad_fields, window
+from .boundaries import AXES, LEES_EDWARDS, PERIODIC, WALL, Boundaries, WallSide, wall_terms
+from .fluxes import cell_divergence, has_walls, pad_fields, pad_viscous, window
 from .grid import Grid
 from .physics import Physics
 from .state import conservative, primitive_fields
 
 #: Time-series columns added by each case.
 STRESS_COMPONENTS = ("xx", "yy", "zz", "xy", "xz", "yz")
+WALL_COLUMNS = ("wall_shear_stress_lower", "wall_shear_stress_upper", "wall_slip_lower", "wall_slip_upper")
+PROFILES = ("u_profile", "phi_profile", "theta_profile")
 CASE_COLUMNS = {
     "cooling": (),
     "uniform-shear": (*(f"stress_{c}" for c in STRESS_COMPONENTS), "viscosity", "pressure", "peculiar_energy"),
+    "couette": (*(f"stress_{c}" for c in STRESS_COMPONENTS), *WALL_COLUMNS, *PROFILES),
 }
 CASE_UNITS = {**{f"stress_{c}": "Pa" for c in STRESS_COMPONENTS}, "viscosity": "Pa s", "pressure": "Pa",
-              "peculiar_energy": "m2 s-2"}
+              "peculiar_energy": "m2 s-2", "wall_shear_stress_lower": "Pa", "wall_shear_stress_upper": "Pa",
+              "wall_slip_lower": "m s-1", "wall_slip_upper": "m s-1", "u_profile": "m s-1", "phi_profile": "1",
+              "theta_profile": "m2 s-2"}
 VERIFICATION_FILE = "verification.json"
 
 
@@ -48,34 +59,69 @@ def boundaries(cfg: Any) -> Boundaries:
     sections = [getattr(cfg.boundaries, a) for a in AXES[:ndim]]
     kinds = tuple(s.kind for s in sections)
     le = next((s for s in sections if s.kind == LEES_EDWARDS), None)
-    if le is None:
-        return Boundaries(kinds)
-    return Boundaries(kinds, shear_rate=float(le.shear_rate), flow=AXES.index(le.flow))
+    wall = next((s for s in sections if s.kind == WALL), None)
+    if le is not None:
+        return Boundaries(kinds, shear_rate=float(le.shear_rate), flow=AXES.index(le.flow))
+    if wall is not None:
+        f = AXES.index(wall.flow)
+        lower, upper = wall.walls.build_pair()
+        sides = []
+        for w, sign in ((lower, -1.0), (upper, 1.0)):
+            v = [0.0, 0.0, 0.0]
+            v[f] = sign * 0.5 * float(wall.wall_speed)
+            sides.append(WallSide(w, tuple(v)))
+        return Boundaries(kinds, flow=f, walls=tuple(tuple(sides) if s.kind == WALL else None for s in sections))
+    return Boundaries(kinds)
+
+
+def gradient_axis(grid: Grid) -> int | None:
+    """The Lees–Edwards or wall axis (the direction of the velocity gradient), or None."""
+    bc = grid.boundaries
+    if bc is None:
+        return None
+    return bc.shear_axis if bc.shear_axis is not None else (bc.wall_axes[0] if bc.wall_axes else None)
 
 
 def shear_rate(grid: Grid) -> float:
-    """The imposed shear rate γ̇ [1/s] of a sheared case (0 for a periodic box)."""
+    """The imposed shear rate [1/s]: γ̇ of Lees–Edwards, U/L of the walls (0 for a periodic box)."""
     bc = grid.boundaries
-    return float(bc.shear_rate) if bc is not None and bc.shear_axis is not None else 0.0
+    a = gradient_axis(grid)
+    if a is None:
+        return 0.0
+    if bc.shear_axis is not None:
+        return float(bc.shear_rate)
+    lower, upper = bc.walls[a]
+    return (upper.velocity[bc.flow] - lower.velocity[bc.flow]) / grid.lengths[a]
+
+
+def linear_profile(grid: Grid) -> np.ndarray:
+    """u_f = γ̇(x_a − L_a/2) at the cells (the Lees–Edwards base flow; the Couette start)."""
+    a = gradient_axis(grid)
+    return shear_rate(grid) * (grid.mesh()[a] - 0.5 * grid.lengths[a])
 
 
 def add_base_flow(U: Any, grid: Grid) -> Any:
-    """A state plus the Lees–Edwards base flow u_f = γ̇(x_a − L_a/2) (kinetic energy included)."""
+    """A state plus the linear shear profile of :func:`linear_profile` (kinetic energy included)."""
     bc = grid.boundaries
-    if bc is None or bc.shear_axis is None:
+    if gradient_axis(grid) is None:
         return U
     W = [np.asarray(f) for f in primitive_fields(tuple(jnp.asarray(U)))]
-    x_a = grid.mesh()[bc.shear_axis]
-    W[1 + bc.flow] = W[1 + bc.flow] + np.asarray(base_velocity(grid, x_a))
+    W[1 + bc.flow] = W[1 + bc.flow] + linear_profile(grid)
     return conservative(jnp.asarray(W[0]), jnp.asarray(np.stack(W[1:4])), jnp.asarray(W[4]))
 
 
-def _gradients(u: tuple, grid: Grid, t: Any) -> list[list[Any]]:
-    """∂u_j/∂x_b at the cells (central differences; 0 along missing axes), rows b, columns j."""
-    Pu = pad_fields(u, grid, t, velocity=0)
-    zero = jnp.zeros_like(u[0])
+def _gradients(Pu: tuple, grid: Grid) -> list[list[Any]]:
+    """∂u_j/∂x_b at the cells (central differences of padded u; 0 along missing axes), rows b, columns j."""
+    zero = jnp.zeros(grid.cells, Pu[0].dtype)
     return [[(window(Pu[j], grid.cells, b, 1, 0) - window(Pu[j], grid.cells, b, -1, 0)) * (0.5 / grid.spacing[b])
              if b < grid.ndim else zero for j in range(3)] for b in range(3)]
+
+
+def _velocity_pad(W: Any, transport: Any, grid: Grid, phys: Physics, t: Any) -> tuple:
+    """Velocities padded as the viscous fluxes see them (with walls: their ghost cells)."""
+    if has_walls(grid):
+        return pad_viscous(W, transport, grid, phys, t)[1:4]
+    return pad_fields(W[1:4], grid, t, velocity=0)
 
 
 @jax.jit
@@ -85,9 +131,11 @@ def stress_tensor(U: Any, t: Any, grid: Grid, phys: Physics) -> Any:
     rho, u, theta = W[0], W[1:4], W[4]
     r = phys.reduced(rho)
     p = phys.pressure(rho, theta, r)
-    eta, lam, _, _ = phys.transport(rho, theta, r)
-    g = _gradients(u, grid, t)
-    divu = cell_divergence(pad_fields(u, grid, t, velocity=0), grid)
+    transport = phys.transport(rho, theta, r)
+    eta, lam, _, _ = transport
+    Pu = _velocity_pad(W, transport, grid, phys, t)
+    g = _gradients(Pu, grid)
+    divu = cell_divergence(Pu, grid)
     out = []
     for i, j in ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)):
         tau = eta * (g[i][j] + g[j][i])
@@ -102,7 +150,7 @@ def _peculiar_energy(U: Any, grid: Grid) -> float:
     bc = grid.boundaries
     W = [np.asarray(f) for f in primitive_fields(tuple(jnp.asarray(U)))]
     u = np.stack(W[1:4])
-    u[bc.flow] = u[bc.flow] - np.asarray(base_velocity(grid, grid.mesh()[bc.shear_axis]))
+    u[bc.flow] = u[bc.flow] - linear_profile(grid)
     return float(0.5 * np.sum(W[0] * np.sum(u * u, axis=0)) / np.sum(W[0]))
 
 
@@ -112,6 +160,10 @@ def case_diagnostics(kind: str, U: Any, t: float, grid: Grid, phys: Physics) -> 
         return {}
     P = np.asarray(stress_tensor(U, t, grid, phys))
     out = {f"stress_{c}": float(v) for c, v in zip(STRESS_COMPONENTS, P)}
+    if kind == "couette":
+        out.update({k: float(v) for k, v in zip(WALL_COLUMNS, np.asarray(wall_diagnostics(U, grid, phys)))})
+        out.update(profiles(U, grid, phys.material_density))
+        return out
     bc = grid.boundaries
     f, a = bc.flow, bc.shear_axis
     comp = {(0, 1): 3, (1, 0): 3, (0, 2): 4, (2, 0): 4, (1, 2): 5, (2, 1): 5}[(f, a)]
@@ -119,6 +171,32 @@ def case_diagnostics(kind: str, U: Any, t: float, grid: Grid, phys: Physics) -> 
     out["pressure"] = float(P[:3].mean())
     out["peculiar_energy"] = _peculiar_energy(U, grid)
     return out
+
+
+@jax.jit
+def wall_diagnostics(U: Any, grid: Grid, phys: Physics) -> Any:
+    """Mean over each wall of the shear stress η∂u_f/∂x_a [Pa] (lower, upper) and the slip u_f − U_w [m/s]."""
+    W = primitive_fields(tuple(U))
+    r = phys.reduced(W[0])
+    transport = phys.transport(W[0], W[4], r)
+    terms = wall_terms(W[0], W[1:4], W[4], transport, grid, phys)
+    a, f = gradient_axis(grid), grid.boundaries.flow
+    # the stress is η∂u/∂n with n into the medium: +x_a at the lower wall, −x_a at the upper one
+    stress = [jnp.mean(terms[a, 0]["stress"][f]), -jnp.mean(terms[a, 1]["stress"][f])]
+    slip = [jnp.mean(terms[a, side]["slip"][f]) for side in (0, 1)]
+    return jnp.stack([*stress, *slip])
+
+
+def profiles(U: Any, grid: Grid, rho_s: float) -> dict[str, list[float]]:
+    """u_f, φ and θ averaged over the planes parallel to the walls (mass-weighted u and θ)."""
+    W = [np.asarray(f) for f in primitive_fields(tuple(jnp.asarray(U)))]
+    a, f = gradient_axis(grid), grid.boundaries.flow
+    others = tuple(b for b in range(grid.ndim) if b != a)
+    rho = W[0]
+    mass = rho.sum(axis=others)
+    return {"u_profile": list((rho * W[1 + f]).sum(axis=others) / mass),
+            "phi_profile": list(rho.mean(axis=others) / rho_s),
+            "theta_profile": list((rho * W[4]).sum(axis=others) / mass)}
 
 
 def uniform_shear_reference(phys: Physics, phi: float, rate: float) -> dict[str, float]:
@@ -136,8 +214,54 @@ def uniform_shear_reference(phys: Physics, phi: float, rate: float) -> dict[str,
     return {"theta": theta, "eta": float(eta0(theta, d, rho_s) * r.eta), "p": float(rho_s * phi * theta * r.p)}
 
 
+def couette_reference(phys: Physics, grid: Grid, phi0: float, n_cells: int = 400) -> Any:
+    """Steady planar Couette profile of the 1D solver for the 3D cell (same model, walls, inventory, gap)."""
+    from ..couette.geometry import PlanarCell
+    from ..couette.run import Material, run
+
+    a, f = gradient_axis(grid), grid.boundaries.flow
+    lower, upper = grid.boundaries.walls[a]
+    U = upper.velocity[f] - lower.velocity[f]
+    material = Material(float(phys.diameter), float(phys.material_density), float(phys.restitution))
+    return run(phys.model, PlanarCell(grid.lengths[a], U), lower.wall, upper.wall, phi0, material,
+               n_cells=n_cells, stretch=1.5)
+
+
+def compare_couette(history: dict[str, list], phys: Physics, grid: Grid, phi0: float) -> dict[str, Any]:
+    """Max relative deviation of the last profiles from the 1D steady solution at the cell centres.
+
+    u relative to the wall speed U/2 (u changes sign mid-gap), φ and θ pointwise.
+    """
+    ref = couette_reference(phys, grid, phi0)
+    a, f = gradient_axis(grid), grid.boundaries.flow
+    y = grid.centres(a) - 0.5 * grid.lengths[a]  # the 1D cell spans −H/2 … H/2
+    yr = np.asarray(ref["y"].values)
+    lower, upper = grid.boundaries.walls[a]
+    half_u = 0.5 * (upper.velocity[f] - lower.velocity[f])
+    interp = {k: np.interp(y, yr, np.asarray(ref[k].values)) for k in ("u", "phi", "theta")}
+    got = {"u": np.asarray(history["u_profile"][-1]), "phi": np.asarray(history["phi_profile"][-1]),
+           "theta": np.asarray(history["theta_profile"][-1])}
+    err = {"u": float(np.max(np.abs(got["u"] - interp["u"])) / half_u),
+           "phi": float(np.max(np.abs(got["phi"] / interp["phi"] - 1.0))),
+           "theta": float(np.max(np.abs(got["theta"] / interp["theta"] - 1.0)))}
+    tau_ref = np.asarray(ref["wall_shear_stress"].values)
+    slip_ref = np.asarray(ref["wall_slip"].values)
+    return {
+        "reference": "1D steady planar Couette solver ktgf.couette (same model, walls, inventory and gap; 400 cells)",
+        "max_rel_error": err,
+        "wall_shear_stress_Pa": {"run": [history["wall_shear_stress_lower"][-1], history["wall_shear_stress_upper"][-1]],
+                                 "reference": tau_ref.tolist()},
+        "wall_slip_m_per_s": {"run": [history["wall_slip_lower"][-1], history["wall_slip_upper"][-1]],
+                              "reference": slip_ref.tolist()},
+        "cells_across_gap": grid.cells[a],
+    }
+
+
 def verification(kind: str, history: dict[str, list], phys: Physics, grid: Grid, phi0: float) -> dict[str, Any] | None:
     """The case's comparison with its reference at the last output (None for the cooling box)."""
+    if kind == "couette":
+        return {"case": kind, "model": phys.model.name, "solid_fraction": phi0,
+                "restitution": float(phys.restitution), **compare_couette(history, phys, grid, phi0)}
     if kind != "uniform-shear":
         return None
     ref = uniform_shear_reference(phys, phi0, shear_rate(grid))
@@ -165,6 +289,10 @@ def describe(grid: Grid) -> str:
     for a, k in enumerate(bc.kinds):
         if k == LEES_EDWARDS:
             parts.append(f"{AXES[a]}: lees-edwards (shear rate {float(bc.shear_rate):g}/s, flow {AXES[bc.flow]})")
+        elif k == WALL:
+            lo, hi = bc.walls[a]
+            parts.append(f"{AXES[a]}: walls moving along {AXES[bc.flow]} at {lo.velocity[bc.flow]:g} and "
+                         f"{hi.velocity[bc.flow]:g} m/s ({lo.wall.describe()}; {hi.wall.describe()})")
         else:
             parts.append(f"{AXES[a]}: {k}")
     return ", ".join(parts)

@@ -50,7 +50,8 @@ import numpy as np
 from jax.scipy.sparse.linalg import bicgstab, cg
 
 from ..closures.coefficients import Reduced
-from .fluxes import face_coefficients, face_divergence, face_jump, pad_fields, stress, viscous_flux
+from .fluxes import face_coefficients, face_divergence, face_jump, has_walls, pad_fields, pad_viscous, stress, viscous_flux
+from .boundaries import wall_terms
 from .grid import Grid
 from .physics import Physics
 from .state import primitive_fields
@@ -120,9 +121,11 @@ def heat_preconditioner(grid: Grid, rho: Any, kappa: Any, adt: Any, dtype: Any):
     return lambda r: _ifft(_fft(r, grid) / D, grid, dtype)
 
 
-def viscous_divergence(W: tuple, transport: tuple, grid: Grid, phys: Physics, t: Any = 0.0) -> list[Any]:
-    """f_I = −∇·(viscous + heat flux) at the cells: (0, ∇·τ, ∇·(τ·u) − ∇·q) (``t``: time of the boundaries)."""
-    P = pad_fields(W, grid, t, velocity=1)
+def viscous_divergence(W: tuple, transport: tuple, grid: Grid, phys: Physics, t: Any = 0.0,
+                       walls: Any = None) -> list[Any]:
+    """f_I = −∇·(viscous + heat flux) at the cells: (0, ∇·τ, ∇·(τ·u) − ∇·q) (``t``: time of the boundaries;
+    ``walls``: frozen wall coefficients, else from W)."""
+    P = pad_viscous(W, transport, grid, phys, t, walls)
     Pk = pad_fields(transport, grid, t)
     out: list[Any] = [0.0] * 5
     for a in range(grid.ndim):
@@ -191,8 +194,11 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         c_f = [f[0] / 3.0 + f[1] for f in faces]
         kap_f = [f[2] for f in faces]
 
+        # Wall coefficients frozen with the transport ones (their momentum part does not depend on u).
+        walls = wall_terms(rho, u, theta, transport, grid, phys) if has_walls(grid) else None
+
         def div_tau(v: tuple, affine: bool = False) -> list[Any]:
-            Pu = pad_fields(v, grid, t, velocity=0, affine=affine)
+            Pu = pad_fields(v, grid, t, velocity=0, affine=affine, walls=walls)
             out: list[Any] = [0.0, 0.0, 0.0]
             for a in range(grid.ndim):
                 dF = face_divergence(jnp.stack(stress(Pu, faces[a][0], faces[a][1], a, grid)), grid, a)
@@ -222,15 +228,17 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         sb = _unit(b)
         du, _ = bicgstab(A, tuple(x / sb for x in b), tol=tol, atol=atol_m / sb, maxiter=RESTART * maxiter, M=M)
         u = tuple(x + sb * dx for x, dx in zip(u, du))
+        if walls is not None:  # the wall heat terms need the slip of the new u
+            walls = wall_terms(rho, u, theta, transport, grid, phys)
 
         def B(th: Any) -> Any:
-            Pt = pad_fields((th,), grid, t)[0]
+            Pt = pad_fields((th,), grid, t, affine=False, theta=0, walls=walls)[0]
             div = sum(face_divergence(-kap_f[a] * face_jump(Pt, grid.cells, a) / grid.spacing[a], grid, a)
                       for a in range(grid.ndim))
             return 1.5 * rho * th - adt * div
 
         # Right-hand side: Ê − ρ̂|u|²/2 + aΔt∇·(τ·u + ω∇φ), i.e. the stage equation with κ = 0.
-        fI0 = viscous_divergence((rho, *u, jnp.zeros_like(theta)), transport, grid, phys, t)
+        fI0 = viscous_divergence((rho, *u, jnp.zeros_like(theta)), transport, grid, phys, t, walls)
         rhs_E = E_hat - 0.5 * rho * sum(x * x for x in u) + adt * fI0[4]
         kap_m = jnp.mean(transport[2])
         hscale = jnp.sqrt((1.5 * rho + adt * sum(_face_sum(kap_f, grid, a) * inv_dx2[a] for a in range(grid.ndim)))
@@ -244,7 +252,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         theta = th0 + sE * dth
 
         # The conservative stage state and the residual of its two linear problems.
-        fI = viscous_divergence((rho, *u, theta), transport, grid, phys, t)
+        fI = viscous_divergence((rho, *u, theta), transport, grid, phys, t, walls)
         U = (rho, *(m + adt * f for m, f in zip(m_hat, fI[1:4])), E_hat + adt * fI[4])
         res_m = _norm(tuple(rho * x - m for x, m in zip(u, U[1:4])))
         res_E = _norm(U[4] - rho * (0.5 * sum(x * x for x in u) + 1.5 * theta))

@@ -39,7 +39,8 @@ from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
 from ..io import write_netcdf
 from .config import Config
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
-from .flows import CASE_COLUMNS, CASE_UNITS, VERIFICATION_FILE, add_base_flow, case_diagnostics, shear_rate, verification
+from .flows import (CASE_COLUMNS, CASE_UNITS, PROFILES, VERIFICATION_FILE, add_base_flow, case_diagnostics, gradient_axis,
+                    shear_rate, verification)
 from .flows import boundaries as case_boundaries
 from .flows import describe as describe_boundaries
 from .grid import Grid
@@ -553,14 +554,22 @@ class Simulation:
         cooling = self.case == "cooling"
         if cooling:
             data["theta_haff"] = ("time", theta_haff)
+        coords = {"time": t, "axis": list("xyz"[: self.grid.ndim])}
         for name in CASE_COLUMNS[self.case]:
-            data[name] = ("time", np.asarray(history[name], dtype=float))
+            values = np.asarray(history[name], dtype=float)
+            if name in PROFILES:  # profiles across the gap, one row per output
+                a = gradient_axis(self.grid)
+                data[name] = (("time", "normal"), values.reshape(len(t), self.grid.cells[a]))
+                coords["normal"] = ("normal", self.grid.centres(a), {"units": "m", "long_name":
+                                    f"cell centres along the wall-normal axis {'xyz'[a]}"})
+            else:
+                data[name] = ("time", values)
         limit_names = [n for n in LIMIT_NAMES if len(history.get(f"dt_{n}", [])) == len(t)]
         for name in limit_names:
             data[f"dt_{name}"] = ("time", np.asarray(history[f"dt_{name}"], dtype=float))
         if cooling:
             data["tau"] = ("time", np.asarray(tau_of_t(t, self.phys, self.phi0, self.theta0), dtype=float))
-        ds = xr.Dataset(data, coords={"time": t, "axis": list("xyz"[: self.grid.ndim])})
+        ds = xr.Dataset(data, coords=coords)
         units = {"time": "s", "theta_mean": "m2 s-2", "theta_haff": "m2 s-2", "theta_min": "m2 s-2",
                  "kinetic_energy": "m2 s-2", "ke_transverse": "m2 s-2", "ke_longitudinal": "m2 s-2",
                  "tau": "1", "density_variance": "1", "phi_max": "1", "mode_density": "1", "mode_velocity": "1"}
