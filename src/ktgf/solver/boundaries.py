@@ -37,9 +37,10 @@ ghost cells per side; the boundaries only decide what the ghost cells hold (:fun
     mass, tangential momentum or energy crosses the wall, the normal momentum flux is
     ρu_n² + p − sρu_n (s = |u_n| + c: the wall pressure, p at rest) (:func:`~.fluxes.wall_flux`).
     The viscous and heat fluxes see ghost cells that make the central face fluxes equal to the
-    conditions: the face velocity u_f solves η(u_c − u_f)/(Δ/2) = c(u_f − U_w) (u_c the wall
-    cell), u_ghost = 2u_f − u_c, and θ_ghost = θ_c − Δ(D − G)/κ, so the discrete wall stress is
-    exactly c(u_f − U_w) and the heat flux exactly D − G.  φ and θ in c, D and G are the values
+    conditions: the face velocity u_f solves η_f(u_c − u_f)/(Δ/2) = c(u_f − U_w) (u_c the wall
+    cell), u_ghost = 2u_f − u_c, and θ_ghost = θ_c − Δ(D − G)/κ_f, so the discrete wall stress is
+    exactly c(u_f − U_w) and the heat flux exactly D − G (η_f, κ_f: the face coefficients of the
+    fluxes, the mean of the wall cell and a limited linear extrapolation).  φ and θ in c, D and G are the values
     at the wall extrapolated from the two nearest cells (second order), the slip the face u_f.
     ``momentum = "prescribed"`` (no slip, c → ∞) and ``"free-slip"`` (c = 0), ``energy =
     "adiabatic"`` (q·n = 0) and ``"prescribed"`` (θ_ghost = 2θ_w − θ_c) are the limits.
@@ -202,12 +203,29 @@ def _side(f: Any, axis: int, n: int, side: int, layer: int) -> Any:
     return jax.lax.slice_in_dim(f, i, i + 1, axis=axis)
 
 
+def _extrapolated(layers: Sequence[Any], G: int, positive: bool) -> list[Any]:
+    """Ghost layers continuing the two wall cells linearly; for a positive field (ρ, θ, closures)
+    the first is kept within [f_0/2, 3f_0/2], so face means stay positive."""
+    f0, f1 = layers[0], layers[1]
+    g0 = 2.0 * f0 - f1
+    if positive:
+        g0 = jnp.clip(g0, 0.5 * f0, 1.5 * f0)
+    return [f0 + (g + 1) * (g0 - f0) for g in range(G)]
+
+
+def wall_face(f: Any, axis: int, n: int, side: int) -> Any:
+    """The face value at wall ``side`` of a positive cell field as the fluxes see it: the mean of the
+    wall cell and its :func:`_extrapolated` ghost (the coefficients η, κ at the wall)."""
+    layers = [_side(f, axis, n, side, g) for g in range(2)]
+    return 0.5 * (layers[0] + _extrapolated(layers, 1, positive=True)[0])
+
+
 def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any], grid: Any, phys: Any) -> dict:
     """Ghost-cell coefficients of every wall, from the state (θ: the temperature of the coefficients).
 
     Per (axis, side): ``ratio``, ``offset`` (3 components) with u_ghost = ratio_j u_c + offset_j;
-    ``heat`` = (a, b, g) with θ_ghost = θ_c − Δ(a θ_w − g)/κ_c, θ_w = (3θ_0 − θ_1)/2 and a = D/θ_w,
-    g = G; ``stress`` = c(u_f − U_w) per component and ``slip`` = u_f − U_w (diagnostics).
+    ``heat`` = (a, g) with θ_ghost = θ_c − Δ(a θ_w − g)/κ_f, θ_w = (3θ_0 − θ_1)/2 and a = D/θ_w,
+    g = G (κ_f, and η_f in the velocity ghosts, are the wall-face coefficients the fluxes use); ``stress`` = c(u_f − U_w) per component and ``slip`` = u_f − U_w (diagnostics).
     The coefficients depend on ``theta`` and on u; :func:`pad` applies them.
     """
     from ..couette.walls import jj_dissipation, jj_friction
@@ -225,8 +243,7 @@ def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any],
             phi_w = jnp.clip((1.5 * r0 - 0.5 * r1) / rho_s, 0.5 * r0 / rho_s, 2.0 * r0 / rho_s)
             theta_w = jnp.clip(1.5 * t0 - 0.5 * t1, 0.5 * t0, 2.0 * t0)
             chi = phys.model.chi(phi_w)
-            eta_c = _side(eta, a, n, side, 0)
-            beta = 2.0 * eta_c / h
+            beta = 2.0 * wall_face(eta, a, n, side) / h  # the face η of the viscous flux
             if wall.momentum == "johnson-jackson":
                 c = rho_s * jj_friction(wall, phi_w, chi, theta_w)
                 ratio_t, weight = (beta - c) / (beta + c), 2.0 * c / (beta + c)
@@ -254,7 +271,7 @@ def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any],
             else:
                 heat = ("adiabatic", jnp.zeros_like(beta), jnp.zeros_like(beta))
             out[a, side] = {"ratio": ratio, "offset": offset, "heat": heat[1:], "stress": stress, "slip": slip,
-                            "kappa": _side(kappa, a, n, side, 0)}
+                            "kappa": wall_face(kappa, a, n, side)}
     return out
 
 
@@ -270,8 +287,8 @@ def _wall_ghosts(f: Any, grid: Any, a: int, G: int, role: Any, terms: dict | Non
     slabs = []
     for side in (0, 1):
         layers = [_side(f, a, n, side, g) for g in range(G)]
-        if terms is None:  # convective: linear extrapolation (second-order one-sided slope of the wall cell)
-            ghost = [layers[0] + (g + 1) * (layers[0] - layers[1]) for g in range(G)]
+        if terms is None:  # convective and coefficients: extrapolation (one-sided slope in the wall cell)
+            ghost = _extrapolated(layers, G, positive=not isinstance(role, tuple))
         elif role == "even":
             ghost = layers
         elif role == "theta":

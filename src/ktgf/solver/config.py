@@ -78,6 +78,7 @@ class InitialSection(_Section):
     mode: list[int] | None = None
     kind: Literal["transverse", "longitudinal"] = "transverse"
     branch: int = Field(0, ge=0, le=2)
+    shear_rate: float | None = Field(None, gt=0.0, description="chute: initial u = shear_rate * height above the base [1/s]")
 
 
 class GridSection(_Section):
@@ -160,7 +161,7 @@ class ParallelSection(_Section):
 
 
 #: Case kinds (:mod:`ktgf.solver.flows`).
-CASE_KINDS = ("cooling", "uniform-shear", "couette")
+CASE_KINDS = ("cooling", "uniform-shear", "couette", "chute")
 _AXES = ("x", "y", "z")
 
 
@@ -215,8 +216,11 @@ class BoundariesSection(_Section):
 
 
 class CaseSection(_Section):
-    kind: Literal["cooling", "uniform-shear", "couette"] = Field(
-        "cooling", description="cooling (periodic box), uniform-shear (Lees-Edwards box), couette (two walls)")
+    kind: Literal["cooling", "uniform-shear", "couette", "chute"] = Field(
+        "cooling", description="cooling (periodic box), uniform-shear (Lees-Edwards box), couette (two moving walls), "
+                               "chute (gravity-driven layer on an inclined base)")
+    inclination_deg: float | None = Field(None, gt=0.0, lt=90.0, description="chute: base inclination [degrees]")
+    gravity: float = Field(9.81, gt=0.0, description="chute: acceleration of gravity g [m/s^2]")
 
 
 class Config(_Section):
@@ -306,22 +310,34 @@ def check_case(cfg: Config, source: str = "config") -> None:
             raise InputError(f"{source}: field boundaries.{a}.kind = {getattr(b, a).kind!r}: the grid has {ndim} "
                              f"axis/axes ({', '.join(_AXES[:ndim])}); axis {a} has no boundary to set")
     shear, wall = b.shear_axis(), b.wall_axis()
+    if kind != "chute" and cfg.case.inclination_deg is not None:
+        raise InputError(f"{source}: field case.inclination_deg applies to case.kind = 'chute' only")
     if kind == "cooling" and (shear or wall):
         raise InputError(f"{source}: field boundaries.{shear or wall}.kind = {getattr(b, shear or wall).kind!r} needs "
                          "case.kind = 'uniform-shear' or 'couette' (the cooling case is a periodic box)")
     if kind == "uniform-shear" and shear is None:
         raise InputError(f"{source}: field case.kind = 'uniform-shear' needs one boundaries.<axis> with kind = "
                          f"'lees-edwards' (valid axes: {', '.join(_AXES[:ndim])})")
-    if kind == "couette" and wall is None:
-        raise InputError(f"{source}: field case.kind = 'couette' needs one boundaries.<axis> with kind = 'wall' "
+    if kind in ("couette", "chute") and wall is None:
+        raise InputError(f"{source}: field case.kind = {kind!r} needs one boundaries.<axis> with kind = 'wall' "
                          f"(valid axes: {', '.join(_AXES[:ndim])})")
     if kind == "couette" and not getattr(b, wall).wall_speed > 0:
         raise InputError(f"{source}: field boundaries.{wall}.wall_speed = {getattr(b, wall).wall_speed:g} is out of "
                          "range: valid wall_speed > 0 m/s for a Couette cell")
+    if kind == "chute" and getattr(b, wall).wall_speed != 0:
+        raise InputError(f"{source}: field boundaries.{wall}.wall_speed = {getattr(b, wall).wall_speed:g} is out of "
+                         "range: valid wall_speed = 0 for a chute (the base is at rest)")
+    if kind == "chute" and cfg.case.inclination_deg is None:
+        raise InputError(f"{source}: field case.inclination_deg is missing: a chute needs the base inclination "
+                         "(0 < inclination_deg < 90 degrees)")
+    if kind != "chute" and cfg.initial.shear_rate is not None:
+        raise InputError(f"{source}: field initial.shear_rate sets the start of a chute only (other cases: the boundaries)")
+    if kind == "chute" and cfg.time.unit == "strain":
+        raise InputError(f"{source}: field time.unit = 'strain': a chute has no imposed shear rate; valid 's'")
     if kind != "uniform-shear" and shear is not None:
         raise InputError(f"{source}: field boundaries.{shear}.kind = 'lees-edwards' needs case.kind = 'uniform-shear'")
-    if kind != "couette" and wall is not None:
-        raise InputError(f"{source}: field boundaries.{wall}.kind = 'wall' needs case.kind = 'couette'")
+    if kind not in ("couette", "chute") and wall is not None:
+        raise InputError(f"{source}: field boundaries.{wall}.kind = 'wall' needs case.kind = 'couette' or 'chute'")
     if wall is not None:
         try:
             getattr(b, wall).walls.build_pair()

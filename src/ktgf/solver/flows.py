@@ -7,6 +7,10 @@
 ``couette``         planar Couette cell: Johnson–Jackson walls on one axis moving at ∓U/2
                     along the flow direction; its steady state is the 1D Couette solver's
                     (:func:`ktgf.couette.run.run`, same model, same walls, same inventory)
+``chute``           gravity-driven layer: a base wall at rest (bumpy Johnson–Jackson) at
+                    x_a = 0, a lid at x_a = H (default zero-flux: free slip, adiabatic), and
+                    g = g(sin ζ e_f − cos ζ e_a); its steady state is the 1D inclined-layer
+                    solver's (:func:`ktgf.couette.chute.solve_chute`, same column and walls)
 ==================  ======================================================================
 
 Both sheared cases start from the linear profile u_f = γ̇(x_a − L_a/2) (γ̇ = U/L_a in the
@@ -24,6 +28,7 @@ pressure p = ⟨tr P⟩/3.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import jax
@@ -45,6 +50,7 @@ CASE_COLUMNS = {
     "cooling": (),
     "uniform-shear": (*(f"stress_{c}" for c in STRESS_COMPONENTS), "viscosity", "pressure", "peculiar_energy"),
     "couette": (*(f"stress_{c}" for c in STRESS_COMPONENTS), *WALL_COLUMNS, *PROFILES),
+    "chute": (*(f"stress_{c}" for c in STRESS_COMPONENTS), *WALL_COLUMNS, *PROFILES),
 }
 CASE_UNITS = {**{f"stress_{c}": "Pa" for c in STRESS_COMPONENTS}, "viscosity": "Pa s", "pressure": "Pa",
               "peculiar_energy": "m2 s-2", "wall_shear_stress_lower": "Pa", "wall_shear_stress_upper": "Pa",
@@ -74,6 +80,19 @@ def boundaries(cfg: Any) -> Boundaries:
     return Boundaries(kinds)
 
 
+def gravity(cfg: Any) -> tuple[float, float, float] | None:
+    """The body force per unit mass of a chute, g(sin ζ e_flow − cos ζ e_normal) [m/s²] (None otherwise)."""
+    if cfg.case.kind != "chute":
+        return None
+    axis = cfg.boundaries.wall_axis()
+    a, f = AXES.index(axis), AXES.index(getattr(cfg.boundaries, axis).flow)
+    z = math.radians(cfg.case.inclination_deg)
+    g = [0.0, 0.0, 0.0]
+    g[f] = cfg.case.gravity * math.sin(z)
+    g[a] = -cfg.case.gravity * math.cos(z)
+    return tuple(g)
+
+
 def gradient_axis(grid: Grid) -> int | None:
     """The Lees–Edwards or wall axis (the direction of the velocity gradient), or None."""
     bc = grid.boundaries
@@ -100,13 +119,15 @@ def linear_profile(grid: Grid) -> np.ndarray:
     return shear_rate(grid) * (grid.mesh()[a] - 0.5 * grid.lengths[a])
 
 
-def add_base_flow(U: Any, grid: Grid) -> Any:
-    """A state plus the linear shear profile of :func:`linear_profile` (kinetic energy included)."""
+def add_base_flow(U: Any, grid: Grid, base_shear: float | None = None) -> Any:
+    """A state plus the linear shear profile of :func:`linear_profile` (kinetic energy included);
+    ``base_shear``: instead, u_f = base_shear · x_a (a chute's start, zero at the base)."""
     bc = grid.boundaries
     if gradient_axis(grid) is None:
         return U
     W = [np.asarray(f) for f in primitive_fields(tuple(jnp.asarray(U)))]
-    W[1 + bc.flow] = W[1 + bc.flow] + linear_profile(grid)
+    profile = linear_profile(grid) if base_shear is None else base_shear * grid.mesh()[gradient_axis(grid)]
+    W[1 + bc.flow] = W[1 + bc.flow] + profile
     return conservative(jnp.asarray(W[0]), jnp.asarray(np.stack(W[1:4])), jnp.asarray(W[4]))
 
 
@@ -160,7 +181,7 @@ def case_diagnostics(kind: str, U: Any, t: float, grid: Grid, phys: Physics) -> 
         return {}
     P = np.asarray(stress_tensor(U, t, grid, phys))
     out = {f"stress_{c}": float(v) for c, v in zip(STRESS_COMPONENTS, P)}
-    if kind == "couette":
+    if kind in ("couette", "chute"):
         out.update({k: float(v) for k, v in zip(WALL_COLUMNS, np.asarray(wall_diagnostics(U, grid, phys)))})
         out.update(profiles(U, grid, phys.material_density))
         return out
@@ -257,8 +278,49 @@ def compare_couette(history: dict[str, list], phys: Physics, grid: Grid, phi0: f
     }
 
 
+def chute_reference(phys: Physics, grid: Grid, phi0: float, n_cells: int = 256) -> Any:
+    """Steady inclined layer of the 1D solver for the 3D column (same model, base, lid, inventory, depth)."""
+    from ..couette.chute import solve_chute
+    from ..couette.run import Material
+
+    a, f = gradient_axis(grid), grid.boundaries.flow
+    g = phys.gravity
+    gmag = math.hypot(g[a], g[f])
+    angle = math.degrees(math.atan2(g[f], -g[a]))
+    base, lid = grid.boundaries.walls[a]
+    material = Material(float(phys.diameter), float(phys.material_density), float(phys.restitution))
+    return solve_chute(phys.model, depth=grid.lengths[a], angle_deg=angle, mean_phi=phi0, material=material,
+                       base=base.wall, top=lid.wall, gravity=gmag, n_cells=n_cells)
+
+
+def compare_chute(history: dict[str, list], phys: Physics, grid: Grid, phi0: float) -> dict[str, Any]:
+    """Max relative deviation of the last profiles from the 1D steady layer (u relative to its maximum)."""
+    ref = chute_reference(phys, grid, phi0)
+    a = gradient_axis(grid)
+    y = grid.centres(a)
+    yr = np.asarray(ref["y"].values)
+    interp = {k: np.interp(y, yr, np.asarray(ref[k].values)) for k in ("u", "phi", "theta")}
+    got = {"u": np.asarray(history["u_profile"][-1]), "phi": np.asarray(history["phi_profile"][-1]),
+           "theta": np.asarray(history["theta_profile"][-1])}
+    err = {"u": float(np.max(np.abs(got["u"] - interp["u"])) / np.max(np.abs(interp["u"]))),
+           "phi": float(np.max(np.abs(got["phi"] / interp["phi"] - 1.0))),
+           "theta": float(np.max(np.abs(got["theta"] / interp["theta"] - 1.0)))}
+    return {
+        "reference": "1D steady inclined layer ktgf.couette.chute.solve_chute (same model, base, lid, inventory "
+                     "and depth; 256 cells)",
+        "max_rel_error": err,
+        "base_shear_stress_Pa": {"run": history["wall_shear_stress_lower"][-1],
+                                 "reference": float(ref["wall_shear_stress"].values[0])},
+        "base_slip_m_per_s": {"run": history["wall_slip_lower"][-1], "reference": float(ref["wall_slip"].values[0])},
+        "cells_across_depth": grid.cells[a],
+    }
+
+
 def verification(kind: str, history: dict[str, list], phys: Physics, grid: Grid, phi0: float) -> dict[str, Any] | None:
     """The case's comparison with its reference at the last output (None for the cooling box)."""
+    if kind == "chute":
+        return {"case": kind, "model": phys.model.name, "solid_fraction": phi0,
+                "restitution": float(phys.restitution), **compare_chute(history, phys, grid, phi0)}
     if kind == "couette":
         return {"case": kind, "model": phys.model.name, "solid_fraction": phi0,
                 "restitution": float(phys.restitution), **compare_couette(history, phys, grid, phi0)}

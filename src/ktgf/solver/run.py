@@ -42,6 +42,7 @@ from .diagnostics import PER_AXIS, SCALARS, diagnostics
 from .flows import (CASE_COLUMNS, CASE_UNITS, PROFILES, VERIFICATION_FILE, add_base_flow, case_diagnostics, gradient_axis,
                     shear_rate, verification)
 from .flows import boundaries as case_boundaries
+from .flows import gravity as case_gravity
 from .flows import describe as describe_boundaries
 from .grid import Grid
 from .initial import haff_time, random_velocity, single_mode, t_of_tau, tau_of_t, uniform_fields
@@ -174,7 +175,8 @@ class Simulation:
         check_memory(tuple(cfg.grid.cells), cfg.numerics.precision)
         self.model = get_model(cfg.model.name, **cfg.model.options)
         phi_stop = cfg.numerics.phi_stop if cfg.numerics.phi_stop is not None else 0.99 * self.model.phi_max
-        self.phys = Physics(self.model, cfg.model.restitution, cfg.particles.diameter, cfg.particles.density, phi_stop)
+        self.phys = Physics(self.model, cfg.model.restitution, cfg.particles.diameter, cfg.particles.density, phi_stop,
+                            case_gravity(cfg))
         self.case = cfg.case.kind
         bc = case_boundaries(cfg)
         self.grid = Grid(tuple(cfg.grid.cells), box_lengths(cfg), None if bc.all_periodic else bc)
@@ -242,7 +244,7 @@ class Simulation:
             )
         else:
             U = conservative(*(jnp.asarray(f) for f in uniform_fields(self.grid, self.phys, self.phi0, self.theta0)))
-        return self.place(add_base_flow(U, self.grid))
+        return self.place(add_base_flow(U, self.grid, ini.shear_rate))
 
     @_in_precision
     def place(self, U: Any) -> Any:
