@@ -151,10 +151,6 @@ class Boundaries:
         object.__setattr__(obj, "shear_rate", leaves[0])
         return obj
 
-    @classmethod
-    def periodic(cls, ndim: int) -> Boundaries:
-        return cls((PERIODIC,) * ndim)
-
     @property
     def all_periodic(self) -> bool:
         return all(k == PERIODIC for k in self.kinds)
@@ -224,8 +220,9 @@ def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any],
     """Ghost-cell coefficients of every wall, from the state (θ: the temperature of the coefficients).
 
     Per (axis, side): ``ratio``, ``offset`` (3 components) with u_ghost = ratio_j u_c + offset_j;
-    ``heat`` = (a, g) with θ_ghost = θ_c − Δ(a θ_w − g)/κ_f, θ_w = (3θ_0 − θ_1)/2 and a = D/θ_w,
-    g = G (κ_f, and η_f in the velocity ghosts, are the wall-face coefficients the fluxes use); ``stress`` = c(u_f − U_w) per component and ``slip`` = u_f − U_w (diagnostics).
+    ``heat`` = (a, g) with θ_ghost = θ_c − Δ(a θ_w − g)/κ_f, θ_w = (3θ_0 − θ_1)/2, a = D/θ_w and
+    g = G (κ_f, and η_f in the velocity ghosts, are the wall-face coefficients the fluxes use);
+    ``stress`` = η∂u/∂n = c(u_f − U_w) and ``slip`` = u_f − U_w per component (diagnostics).
     The coefficients depend on ``theta`` and on u; :func:`pad` applies them.
     """
     from ..couette.walls import jj_dissipation, jj_friction
@@ -321,8 +318,8 @@ def pad(fields: Sequence[Any], grid: Any, G: int, t: Any = 0.0, velocity: int | 
     ``velocity``: index in ``fields`` of the x velocity component (the three components follow
     it), so that the Lees–Edwards jump and the wall conditions reach them; None if the fields
     hold no velocity.  ``theta``: index of θ (wall heat conditions).  ``walls``: the
-    :func:`wall_terms` of the viscous and heat fluxes, or None for the mirror image the convective
-    fluxes see.  ``affine=False`` leaves out the affine parts (the linear part of the operator).
+    :func:`wall_terms` of the viscous and heat fluxes, or None for the extrapolated ghosts of the
+    convective fluxes and of the cell coefficients.  ``affine=False`` leaves out the affine parts (the linear part of the operator).
     """
     bc = grid.boundaries
     ndim = grid.ndim
