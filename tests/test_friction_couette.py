@@ -114,7 +114,7 @@ def test_halving_the_regularisation_with_a_creeping_plug():
 @pytest.mark.slow
 def test_convergence_map_from_a_naive_start():
     """Mean φ 0.3–0.6 × μ 0–0.5 × {no, Schaeffer, Srivastava–Sundaresan} frictional stress: every state below φ_c(μ)
-    converges (Newton, or the solver's own fallbacks); states with φ̄ ≥ φ_c(μ) are refused.  About 2.5 min.
+    converges (Newton, or the solver's own fallbacks); states with φ̄ ≥ φ_c(μ) are refused.  61 s (load 4) to 2.5 min (load 6).
     Residual bound 1e-6: μ = 0, φ̄ = 0.6 with the Schaeffer stress stops at 7e-8 (near-singular Jacobian)."""
     failures = []
     for stress in ("none", "schaeffer", "srivastava-sundaresan"):
