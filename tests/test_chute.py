@@ -28,7 +28,9 @@ def _first_integral_error(ds):
     return float(r[1:-1].max())
 
 
-@pytest.mark.parametrize("model", [m.name for m in list_models()])
+# Frictionless models: `frictional` (stress ratio 0.6-0.7 in dense flow, above tan 19° = 0.34) has
+# no steady layer found at this angle (Newton and pseudo-transient both fail; docs/chute.md).
+@pytest.mark.parametrize("model", [m.name for m in list_models() if m.friction.key == "none"])
 def test_column_carries_its_weight(model):
     """Base traction = ρ_s g sin ζ × solid depth, p(0) − p(H) = ρ_s g cos ζ × solid depth, energy closes."""
     ds = _layer(model, 32)
