@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import os
 import shutil
 from pathlib import Path
@@ -42,6 +44,7 @@ def quick_report(tmp_path_factory):
     Under pytest-xdist the first worker that needs it builds it in the run's shared temporary
     folder (behind a file lock); every worker then rebuilds its own copy from the report's cache,
     which recomputes nothing, so the minute-long build happens once per run, not once per worker.
+    The copy reports the statuses of that one build ("computed"), not "cached".
     """
     from ktgf.report import ReportSettings, build_report
 
@@ -57,10 +60,14 @@ def quick_report(tmp_path_factory):
         return build(own)
     shared = tmp_path_factory.getbasetemp().parent / "quick_report"
     shared.mkdir(exist_ok=True)
+    record = shared / "statuses.json"
     with open(shared / "lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        if not (shared / "done").exists():
-            build(shared / "r")
-            (shared / "done").touch()
+        if not record.exists():
+            record.write_text(json.dumps(build(shared / "r").statuses))
+    statuses = json.loads(record.read_text())
     shutil.copytree(shared / "r", own)
-    return build(own)
+    report = build(own)
+    report.results = [dataclasses.replace(r, status=statuses[r.key]) if r.status == "cached" else r
+                      for r in report.results]
+    return report
