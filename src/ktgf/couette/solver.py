@@ -12,10 +12,11 @@ solver first tries pseudo-transient continuation, then follows homotopies from a
 (mean φ ≤ 0.3, e ≥ 0.9, specularity ≥ 0.1, no centripetal term in the annular cell) to the
 target with adaptive steps: one parameter group per stage, then all at once
 (:func:`homotopy_paths`).  Natural-parameter steps cannot pass a turning point (fold) of the
-solution curve; when a stage's step falls below 1e-3 the rest of that stage is followed by
-pseudo-arclength continuation (:mod:`ktgf.couette.arclength`), which can (``continuation=
-"arclength"`` uses it for every stage; the fallback is the default because it leaves every case
-that natural steps solve on its old path and time, docs/dense.md §5.2).  Near-jammed plug states (φ within ~1e-4 of φ_c, θ ~ 1e-8 U²) have
+solution curve; if every path stalls (a stage's step below 1e-3), each path is resumed where it
+stalled and the rest of that stage is followed by pseudo-arclength continuation
+(:mod:`ktgf.couette.arclength`), which can (``continuation="arclength"`` uses it for every stage).
+The fallback is the default because it leaves every case that natural steps solve on its old
+path, solution and time (docs/dense.md §5.2).  Near-jammed plug states (φ within ~1e-4 of φ_c, θ ~ 1e-8 U²) have
 Jacobian condition numbers of 1e12–1e13 and are where the solver can stop.  If it fails it raises :class:`~ktgf.errors.ConvergenceError`
 carrying the residual history and the last iterate.
 """
@@ -266,25 +267,43 @@ def homotopy_paths(problem: Problem) -> list[list[dict[str, Any]]]:
 
 
 def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: float, max_iter: int,
-            ptc_max_iter: int, continuation: str = "natural"):
-    """Continuation through ``stages`` with adaptive steps; returns (X, iterations, steps, folds passed)."""
-    sub = _staged_problem(problem, stages[0])
-    X, rep = newton(sub, naive_start(sub), tol=tol, max_iter=max_iter)
-    history += rep.history
-    total_it = rep.iterations
-    if not rep.converged:
-        raise CouetteConvergenceError(
-            f"Couette solver did not converge from the naive start nor from the easy state ({rep.message}); "
-            f"last relative residual {rep.residual:.3g}", history, X, sub)
+            ptc_max_iter: int, continuation: str = "natural", resume: tuple | None = None):
+    """Continuation through ``stages`` with adaptive steps; returns (X, iterations, steps, folds passed).
+
+    ``continuation``: "natural" (raise where a stage stalls; the error's ``resume`` holds the stage,
+    its fraction and the last solution there), "fallback" (from a stall on by arclength; with
+    ``resume``, straight from where a natural run stalled) or "arclength" (every stage by arclength).
+    """
     steps = 0
     folds: list[float] = []
-    for a, b in zip(stages[:-1], stages[1:]):
-        s, ds = 0.0, 0.25
-        if continuation == "arclength":
-            X, path = _arclength_stage(problem, a, b, s, X, history, tol)
-            total_it += path.corrector_iterations
-            steps += len(path.lam) - 1 + path.rejected_steps
-            folds += path.folds
+
+    def by_arclength(a, b, s, X, why):
+        nonlocal total_it, steps
+        X, path = _arclength_stage(problem, a, b, s, X, history, tol, why)
+        total_it += path.corrector_iterations
+        steps += len(path.lam) - 1 + path.rejected_steps
+        folds.extend(path.folds)
+        return X
+
+    if resume is None:
+        first, s_first, resume_why = 0, 0.0, ""
+        sub = _staged_problem(problem, stages[0])
+        X, rep = newton(sub, naive_start(sub), tol=tol, max_iter=max_iter)
+        history += rep.history
+        total_it = rep.iterations
+        if not rep.converged:
+            raise CouetteConvergenceError(
+                f"Couette solver did not converge from the naive start nor from the easy state ({rep.message}); "
+                f"last relative residual {rep.residual:.3g}", history, X, sub)
+    else:
+        first, s_first, X, resume_why = resume
+        total_it = 0
+    for k, (a, b) in enumerate(zip(stages[:-1], stages[1:])):
+        if k < first:
+            continue
+        s, ds = (s_first if k == first else 0.0), 0.25
+        if continuation == "arclength" or (resume is not None and k == first):
+            X = by_arclength(a, b, s, X, resume_why if k == first else "")
             continue
         while s < 1.0:
             s_try = min(1.0, s + ds)
@@ -296,19 +315,22 @@ def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: 
             if rep.converged:
                 s, X = s_try, Xt
                 ds = min(1.0, 1.5 * ds)
-            else:
-                ds *= 0.5
-                if ds < 1e-3:
-                    # natural-parameter steps cannot pass a turning point of the solution curve:
-                    # follow the rest of this stage by pseudo-arclength continuation
-                    why = (f"natural-parameter continuation stalled at mean phi {sub.mean_phi:.4f}, e {sub.e:.4f}, "
-                           f"specularity {[round(w.specularity, 5) for w in sub.walls]} ({rep.message}, last "
-                           f"relative residual {rep.residual:.3g}); then ")
-                    X, path = _arclength_stage(problem, a, b, s, X, history, tol, why)
-                    total_it += path.corrector_iterations
-                    steps += len(path.lam) - 1 + path.rejected_steps
-                    folds += path.folds
-                    break
+                continue
+            ds *= 0.5
+            if ds >= 1e-3:
+                continue
+            where = (f"mean phi {sub.mean_phi:.4f}, e {sub.e:.4f}, specularity "
+                     f"{[round(w.specularity, 5) for w in sub.walls]}")
+            if continuation == "natural":
+                err = CouetteConvergenceError(
+                    f"Couette continuation stalled ({where}): {rep.message}; last relative residual "
+                    f"{rep.residual:.3g}", history, Xt, sub)
+                err.resume = (k, s, X, f"natural-parameter continuation stalled at {where} ({rep.message}); then ")
+                raise err
+            # natural-parameter steps cannot pass a turning point of the solution curve:
+            # follow the rest of this stage by pseudo-arclength continuation
+            X = by_arclength(a, b, s, X, f"natural-parameter continuation stalled at {where} ({rep.message}); then ")
+            break
     return X, total_it, steps, folds
 
 
@@ -342,7 +364,8 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
     """Solve the steady problem; returns the unknowns and a dict of solver diagnostics.
 
     ``max_iter`` bounds each Newton solve, ``ptc_max_iter`` each pseudo-transient run.
-    ``continuation``: ``"natural"`` (default; pseudo-arclength only where natural steps stall) or
+    ``continuation``: ``"natural"`` (default: natural-parameter homotopy paths; only if every one
+    stalls, each resumed where it stalled with pseudo-arclength continuation) or
     ``"arclength"`` (pseudo-arclength for every homotopy stage).  The diagnostics hold
     ``folds``: the stage fractions of the turning points passed.
 
@@ -365,18 +388,29 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
         return X, {"iterations": rep.iterations + rep2.iterations, "continuation_steps": 0,
                    "residual": rep2.residual, "history": history, "method": "pseudo-transient"}
 
-    failure: CouetteConvergenceError | None = None
     total_it = rep.iterations + rep2.iterations
     steps = 0
-    for stages in homotopy_paths(problem):
-        try:
-            X, it, st, folds = _follow(problem, stages, history, tol, max_iter, ptc_max_iter, continuation)
-        except CouetteConvergenceError as exc:
-            failure = failure or exc
-            continue
-        total_it, steps = total_it + it, steps + st
-        break
-    else:
+    # natural-parameter paths first, so that every case they solve keeps its solution (a fold passed
+    # by arclength can lead to another branch: docs/dense.md §5.2); arclength only where they stall
+    rounds = ("natural", "fallback") if continuation == "natural" else ("arclength",)
+    done = False
+    paths = homotopy_paths(problem)
+    resumes: list[tuple | None] = [None] * len(paths)
+    for mode in rounds:
+        failure: CouetteConvergenceError | None = None
+        for i, stages in enumerate(paths):
+            try:
+                X, it, st, folds = _follow(problem, stages, history, tol, max_iter, ptc_max_iter, mode,
+                                           resumes[i] if mode == "fallback" else None)
+            except CouetteConvergenceError as exc:
+                failure = failure or exc
+                resumes[i] = getattr(exc, "resume", None)
+                continue
+            total_it, steps, done = total_it + it, steps + st, True
+            break
+        if done:
+            break
+    if not done:
         assert failure is not None
         raise failure
     return X, {"iterations": total_it, "continuation_steps": steps, "residual": relative_residual(problem, X),
