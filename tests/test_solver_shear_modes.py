@@ -158,6 +158,7 @@ def test_shear_mode_seed_from_a_config_decays_at_the_eigenvalue_rate() -> None:
     ("uniform-shear", 2, "shear-mode", "y", "initial.mode"),  # k along the flow: a Kelvin mode, not a normal mode
     ("cooling", 2, "shear-mode", "z", "initial.perturbation"),
     ("cooling", 3, "mode", "z", "initial.branch"),  # three HCS longitudinal modes
+    ("elastic", 2, "shear-mode", "z", "initial.perturbation"),  # e = 1: no steady uniform shear
 ])
 def test_bad_shear_mode_config_names_the_field(kind: str, branch: int, pert: str, flow: str, field: str) -> None:
     import tomllib
@@ -165,7 +166,10 @@ def test_bad_shear_mode_config_names_the_field(kind: str, branch: int, pert: str
     from ktgf.errors import InputError
     from ktgf.solver.config import parse_config
 
-    text = _config([0, 1], kind=kind, branch=branch, flow=flow).replace('"shear-mode"', f'"{pert}"')
+    text = _config([0, 1], kind="uniform-shear" if kind == "elastic" else kind, branch=branch, flow=flow)
+    if kind == "elastic":
+        text = text.replace(f"restitution = {E}", "restitution = 1.0")
+    text = text.replace('"shear-mode"', f'"{pert}"')
     if kind == "cooling":
         text = text.replace('x = { kind = "lees-edwards", shear_rate = 100.0, flow = "z" }', "").replace(
             'unit = "strain"', 'unit = "s"')

@@ -374,3 +374,12 @@ def check_shear_mode(cfg: Config, source: str = "config") -> None:
     if flow < len(ini.mode) and ini.mode[flow] != 0:
         raise InputError(f"{source}: field initial.mode = {ini.mode} varies along the flow axis {_AXES[flow]}: "
                          f"valid mode[{flow}] = 0 (a normal mode of uniform shear has k_flow = 0)")
+    from ..closures import get_model
+    from ..shear.stability import shear_base_state
+
+    le = getattr(b, b.shear_axis())
+    try:  # the analysis refuses e = 1 and shear-dependent dissipation
+        shear_base_state(get_model(cfg.model.name, **cfg.model.options), ini.solid_fraction, cfg.model.restitution,
+                         float(le.shear_rate), d=cfg.particles.diameter, rho_s=cfg.particles.density)
+    except KtgfError as exc:
+        raise InputError(f"{source}: field initial.perturbation = 'shear-mode': {exc}") from None
