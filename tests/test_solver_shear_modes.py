@@ -95,7 +95,7 @@ def test_shear_growth_rates(direction: str, n: int, branch: int, strain: float) 
 def test_layering_rate_converges_with_resolution() -> None:
     """The layering mode's error falls faster than second order (measured: 22 %, 2.9 %, 0.42 % at
     16, 32, 64 cells per wavelength: the upwind dissipation of the convective scheme on a mode
-    whose rate is a small difference of large terms).  Default IMEX scheme.  About 2 min under load."""
+    whose rate is a small difference of large terms).  Default IMEX scheme.  145 s at load 8 on 2 cores."""
     errors = []
     for n in (16, 32, 64):
         measured, theory = measure_shear_rate("gradient", n, 0, 10.0)
@@ -137,7 +137,7 @@ vtk = false
 def test_shear_mode_seed_from_a_config_decays_at_the_eigenvalue_rate() -> None:
     """``perturbation = "shear-mode"`` through the run machinery (``ktgf run``): the peculiar kinetic
     energy of a real mode decays as exp(2σt) (heat mode along the vorticity, σ/γ̇ = −0.516).
-    Slow only for its own compilation (~25 s under load)."""
+    Slow only for its own compilation (49 s at load 8 on 2 cores)."""
     import tomllib
 
     from ktgf.solver.config import parse_config
