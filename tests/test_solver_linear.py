@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 import pytest
+from _growth import fit_rate
 
 from ktgf.closures import get_model
 from ktgf.closures.coefficients import mean_free_path
@@ -57,9 +58,7 @@ def measure_rate(model: str, cells: tuple[int, ...], mode: tuple[int, ...], ksta
             fourier_coefficient(u_dir / math.sqrt(2.0 * th), grid, mode),
         ])
         proj.append(np.vdot(vec, y) / np.vdot(vec, vec))
-    logp = np.log(np.array(proj) / proj[0])
-    rate = np.polyfit(taus, logp.real, 1)[0] + 1j * np.polyfit(taus, np.unwrap(logp.imag), 1)[0]
-    return complex(rate), s
+    return fit_rate(taus, np.array(proj)), s
 
 
 @pytest.mark.parametrize(

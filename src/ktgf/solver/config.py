@@ -11,7 +11,7 @@ Example (``examples/hcs_3d.toml``)::
     [initial]
     solid_fraction = 0.25
     temperature = 1e-4      # m^2/s^2
-    perturbation = "random" # "random", "mode" or "none"
+    perturbation = "random" # "random", "mode" (HCS eigenmode), "shear-mode" (uniform-shear normal mode) or "none"
     amplitude = 0.05        # rms velocity / sqrt(theta0), or mode amplitude
     [grid]
     cells = [32, 32, 32]    # 1, 2 or 3 entries: the dimension
@@ -71,13 +71,13 @@ class ParticlesSection(_Section):
 class InitialSection(_Section):
     solid_fraction: float = Field(..., gt=0.0, lt=1.0, description="phi0")
     temperature: float = Field(..., gt=0.0, description="theta0 [m^2/s^2]")
-    perturbation: Literal["random", "mode", "none"] = "random"
+    perturbation: Literal["random", "mode", "shear-mode", "none"] = "random"
     amplitude: float = Field(1e-2, ge=0.0, le=0.5)
     seed: int = Field(0, ge=0, le=2**63 - 1, description="seed of NumPy's default_rng")
     max_mode: int = Field(2, ge=1, description="random field: Fourier modes |n| <= max_mode")
     mode: list[int] | None = None
     kind: Literal["transverse", "longitudinal"] = "transverse"
-    branch: int = Field(0, ge=0, le=2)
+    branch: int = Field(0, ge=0, le=4, description="eigenmode by decreasing growth rate: HCS 0-2, shear 0-4")
     shear_rate: float | None = Field(None, gt=0.0, description="chute: initial u = shear_rate * height above the base [1/s]")
 
 
@@ -278,7 +278,7 @@ def check_physics(cfg: Config, source: str = "config") -> None:
     if phi0 >= stop:
         raise InputError(f"{source}: field initial.solid_fraction = {phi0:g} is at or above numerics.phi_stop = {stop:g}")
     mode, cells = cfg.initial.mode, cfg.grid.cells
-    if cfg.initial.perturbation == "mode" and (mode is None or len(mode) != len(cells) or not any(mode)):
+    if cfg.initial.perturbation in ("mode", "shear-mode") and (mode is None or len(mode) != len(cells) or not any(mode)):
         raise InputError(
             f"{source}: field initial.mode = {mode} must have {len(cells)} integers, not all 0"
         )
@@ -355,4 +355,31 @@ def check_case(cfg: Config, source: str = "config") -> None:
                          f"give grid.length or grid.length_d for case.kind = {kind!r}")
     if sheared and cfg.initial.perturbation == "mode":
         raise InputError(f"{source}: field initial.perturbation = 'mode' is an HCS eigenmode; valid for "
-                         f"case.kind = {kind!r}: 'random' or 'none'")
+                         f"case.kind = {kind!r}: 'random', 'none'" + (" or 'shear-mode'" if shear else ""))
+    check_shear_mode(cfg, source)
+
+
+def check_shear_mode(cfg: Config, source: str = "config") -> None:
+    """A uniform-shear normal-mode seed (``perturbation = "shear-mode"``) fits its case and box."""
+    ini, b = cfg.initial, cfg.boundaries
+    if ini.perturbation == "mode" and ini.branch > 2:
+        raise InputError(f"{source}: field initial.branch = {ini.branch} is out of range: valid 0 <= branch <= 2 "
+                         "for an HCS longitudinal mode")
+    if ini.perturbation != "shear-mode":
+        return
+    if cfg.case.kind != "uniform-shear":
+        raise InputError(f"{source}: field initial.perturbation = 'shear-mode' needs case.kind = 'uniform-shear' "
+                         f"(got {cfg.case.kind!r})")
+    flow = _AXES.index(getattr(b, b.shear_axis()).flow)
+    if flow < len(ini.mode) and ini.mode[flow] != 0:
+        raise InputError(f"{source}: field initial.mode = {ini.mode} varies along the flow axis {_AXES[flow]}: "
+                         f"valid mode[{flow}] = 0 (a normal mode of uniform shear has k_flow = 0)")
+    from ..closures import get_model
+    from ..shear.stability import shear_base_state
+
+    le = getattr(b, b.shear_axis())
+    try:  # the analysis refuses e = 1 and shear-dependent dissipation
+        shear_base_state(get_model(cfg.model.name, **cfg.model.options), ini.solid_fraction, cfg.model.restitution,
+                         float(le.shear_rate), d=cfg.particles.diameter, rho_s=cfg.particles.density)
+    except KtgfError as exc:
+        raise InputError(f"{source}: field initial.perturbation = 'shear-mode': {exc}") from None

@@ -1,7 +1,8 @@
-"""Initial states of the homogeneous-cooling (HCS) case (model.md §§8–9).
+"""Initial states of the solver's cases (model.md §§8–9).
 
 Uniform φ0, θ0, u = 0, plus either a single Fourier mode shaped as an eigenvector of the
-linear stability problem (:mod:`ktgf.hcs.stability`), or a seeded random velocity field
+linear stability problem of the HCS (:mod:`ktgf.hcs.stability`), or one of uniform shear
+(:func:`shear_mode`, :mod:`ktgf.shear.stability`), or a seeded random velocity field
 built from the lowest Fourier modes (so that it does not depend on the resolution).
 
 Linear-theory variables: ρ_k = δn/n, θ_k = δθ/θ_H, w = δu/√(2θ_H), τ = ∫ν0 dt, k* = kℓ.
@@ -18,6 +19,7 @@ import numpy as np
 from ..closures.coefficients import mean_free_path, nu0
 from ..errors import InputError
 from ..hcs.stability import longitudinal_growth_rates, longitudinal_matrix, transverse_growth_rate
+from ..shear.stability import ShearModes, shear_modes
 from .grid import Grid
 from .physics import Physics
 from .state import conservative
@@ -92,6 +94,53 @@ def single_mode(
     else:
         raise InputError(f"mode kind {kind!r} is not valid: choose 'transverse' or 'longitudinal'")
     return conservative(jnp.asarray(rho), jnp.asarray(u), jnp.asarray(theta)), s, vec
+
+
+def shear_axes(grid: Grid) -> tuple[int, int, int]:
+    """Velocity components (flow, gradient, vorticity) of a Lees–Edwards grid: the x, y, z of
+    :mod:`ktgf.shear.stability`."""
+    bc = grid.boundaries
+    if bc is None or bc.shear_axis is None:
+        raise InputError("a uniform-shear mode needs a grid with a Lees-Edwards axis")
+    f, a = bc.flow, bc.shear_axis
+    return f, a, 3 - f - a
+
+
+def shear_mode(
+    grid: Grid, phys: Physics, phi0: float, mode: tuple[int, ...], amplitude: float, branch: int = 0,
+) -> tuple[Any, ShearModes]:
+    """Steady uniform shear (without its base flow) plus one normal mode of :func:`ktgf.shear.stability.shear_modes`.
+
+    The wave vector k = 2πn/L must have no component along the flow direction (k_x = 0 of the
+    analysis: normal modes exp(σt); a sheared k_x ≠ 0 wave is a Kelvin mode).  θ is the steady θ
+    of the closed form at the box's γ̇ (the base state of the analysis, not a configured θ0).
+    The fields are f = f_0 + ``amplitude``·Re(v e^{ik·r}) with v = ``vectors[:, branch]`` (SI
+    amplitudes, unit norm in (δφ/φ, δu/√θ, δθ/θ)), the velocity components mapped by
+    :func:`shear_axes`.  ``branch`` orders the modes by decreasing Re σ.  The base flow is added
+    by :func:`ktgf.solver.flows.add_base_flow`.  Returns the conservative state and the modes
+    (σ of the seeded one: ``growth_rates[branch]``).
+    """
+    if len(mode) != grid.ndim or not any(mode):
+        raise InputError(f"mode {tuple(mode)} must have {grid.ndim} integer entries, not all zero")
+    f, a, v = shear_axes(grid)
+    k = grid.wavevector(tuple(mode))
+    if k[f] != 0.0:
+        raise InputError(f"mode {tuple(mode)} varies along the flow direction (axis {'xyz'[f]}): a uniform-shear "
+                         "normal mode needs k_flow = 0")
+    if not 0 <= branch <= 4:
+        raise InputError(f"branch = {branch} is out of range: valid 0 <= branch <= 4 (five uniform-shear modes)")
+    rate = float(grid.boundaries.shear_rate)
+    modes = shear_modes(phys.model, phi0, float(phys.restitution), rate, ky=k[a], kz=k[v],
+                        d=float(phys.diameter), rho_s=float(phys.material_density))
+    vec = modes.vectors[:, branch]
+    x = grid.mesh()
+    wave = np.exp(1j * sum(k[b] * x[b] for b in range(grid.ndim)))
+    rho, u, theta = uniform_fields(grid, phys, phi0, modes.base.theta)
+    rho = rho + phys.material_density * amplitude * np.real(vec[0] * wave)
+    for j, comp in enumerate((f, a, v)):
+        u[comp] = u[comp] + amplitude * np.real(vec[1 + j] * wave)
+    theta = theta + amplitude * np.real(vec[4] * wave)
+    return conservative(jnp.asarray(rho), jnp.asarray(u), jnp.asarray(theta)), modes
 
 
 def random_velocity(

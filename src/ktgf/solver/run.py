@@ -45,7 +45,7 @@ from .flows import boundaries as case_boundaries
 from .flows import gravity as case_gravity
 from .flows import describe as describe_boundaries
 from .grid import Grid
-from .initial import haff_time, random_velocity, single_mode, t_of_tau, tau_of_t, uniform_fields
+from .initial import haff_time, random_velocity, shear_mode, single_mode, t_of_tau, tau_of_t, uniform_fields
 from .interrupt import STOP, Interrupted, fault_hook
 from .io import load_checkpoint, save_checkpoint, save_slices, write_vti
 from .physics import Physics
@@ -242,6 +242,8 @@ class Simulation:
             U, _, _ = single_mode(
                 self.grid, self.phys, self.phi0, self.theta0, tuple(ini.mode), ini.kind, ini.amplitude, ini.branch
             )
+        elif ini.perturbation == "shear-mode":  # about the steady state: θ of the closed form, not θ0
+            U, _ = shear_mode(self.grid, self.phys, self.phi0, tuple(ini.mode), ini.amplitude, ini.branch)
         else:
             U = conservative(*(jnp.asarray(f) for f in uniform_fields(self.grid, self.phys, self.phi0, self.theta0)))
         return self.place(add_base_flow(U, self.grid, ini.shear_rate))
