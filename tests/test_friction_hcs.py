@@ -123,3 +123,18 @@ def test_no_finite_hcs_ratio_is_a_one_line_error():
     assert np.isfinite(WaltonRestitution().hcs_rotational_ratio(0.7, threshold + 2e-3))
     with pytest.raises(InputError, match="chialvo-sundaresan-2013.*no homogeneous cooling state"):
         cooling_rate(get_model("frictional", restitution="chialvo-sundaresan-2013"), 0.3, 0.7, THETA0, d=D)
+
+
+def test_hcs_cli_without_a_finite_ratio_exits_2_with_one_line(tmp_path):
+    from typer.testing import CliRunner
+
+    from ktgf.calibration.model_file import dumps
+    from ktgf.cli import app
+
+    path = tmp_path / "weak.toml"
+    path.write_text(dumps("frictional", {"mu": 0.3}, name="weak"))
+    res = CliRunner().invoke(app, ["hcs", "haff", "--model-file", str(path), "--phi", "0.3", "--e", "0.7",
+                                   "--theta0", "0.01", "--d", "0.001", "--n", "3"])
+    assert res.exit_code == 2
+    lines = [ln for ln in res.output.strip().splitlines() if ln.strip()]
+    assert len(lines) == 1 and "no homogeneous cooling state" in lines[0] and "valid mu >=" in lines[0]
