@@ -1,4 +1,4 @@
-"""``ktgf run case.toml`` (the JAX HCS solver) and ``ktgf plot run hcs.nc``."""
+"""``ktgf run case.toml`` (the JAX finite-volume solver: every case) and ``ktgf plot run hcs.nc``."""
 
 from __future__ import annotations
 
@@ -17,7 +17,8 @@ def run(
     progress: bool = typer.Option(True, "--progress/--no-progress", help="Show the progress bar."),
     overwrite: bool = typer.Option(False, "--overwrite", help="Delete the files of an earlier run in the output folder first."),
 ) -> None:
-    """Run a homogeneous-cooling-gas case; writes hcs.nc, checkpoint.npz, .vti and .png files.
+    """Run a solver case (cooling box, uniform shear); writes hcs.nc, checkpoint.npz, .vti, .png files
+    and, for a case with a reference, verification.json.
 
     Ctrl-C stops after the current chunk with a checkpoint that matches the files written
     (exit code 130); `--resume` continues bit for bit.
@@ -40,11 +41,21 @@ def run(
             typer.echo("interrupted; nothing written", err=True)
             raise typer.Exit(130) from None
     last = ds.isel(time=-1)
+    if sim.case == "cooling":
+        typer.echo(
+            f"done: {sim.steps} steps, t = {float(last.time):.6g} s (tau = {float(last.tau):.4g}); "
+            f"theta/theta_Haff = {float(last.theta_mean / last.theta_haff):.4f}, "
+            f"density variance = {float(last.density_variance):.3g}, max phi = {float(last.phi_max):.4f}; "
+            f"time series in {sim.directory / TIMESERIES}"
+        )
+        return
+    check = ""
+    if sim.verification is not None:
+        errors = ", ".join(f"{k} {v:.2e}" for k, v in sim.verification["max_rel_error"].items())
+        check = f"; relative error against the {sim.verification['reference'].split(' (')[0]}: {errors}"
     typer.echo(
-        f"done: {sim.steps} steps, t = {float(last.time):.6g} s (tau = {float(last.tau):.4g}); "
-        f"theta/theta_Haff = {float(last.theta_mean / last.theta_haff):.4f}, "
-        f"density variance = {float(last.density_variance):.3g}, max phi = {float(last.phi_max):.4f}; "
-        f"time series in {sim.directory / TIMESERIES}"
+        f"done ({sim.case}): {sim.steps} steps, t = {float(last.time):.6g} s; theta = {float(last.theta_mean):.4g} "
+        f"m2/s2, max phi = {float(last.phi_max):.4f}{check}; time series in {sim.directory / TIMESERIES}"
     )
 
 

@@ -3,7 +3,8 @@
 Modules: :mod:`.geometry` (cells, grids, metrics), :mod:`.walls` (Johnson–Jackson, prescribed,
 zero-flux walls), :mod:`.equations` (discrete balances), :mod:`.solver` (Newton, pseudo-transient
 and homotopy continuation), :mod:`.uniform_shear` (closed forms), :mod:`.run` (Dataset output),
-:mod:`.config` (validated TOML configs), :mod:`.compare` (four models, DEM data).
+:mod:`.config` (validated TOML configs), :mod:`.compare` (four models, DEM data), :mod:`.chute`
+(steady gravity-driven inclined layer, :func:`solve_chute`).
 
 Example::
 
@@ -20,6 +21,7 @@ Command line: ``ktgf couette run examples/couette_planar.toml``, ``ktgf couette 
 --wall-restitution 0.8,0.9 --workers 2``, ``ktgf plot couette out.nc``.
 """
 
+from .chute import InclinedLayer, solve_chute
 from .compare import report_profiles
 from .equations import Problem
 from .geometry import AnnularCell, PlanarCell, stretched_nodes
@@ -28,6 +30,6 @@ from .uniform_shear import UniformShear, uniform_shear
 from .walls import Wall
 
 __all__ = [
-    "AnnularCell", "CouetteConvergenceError", "PlanarCell", "Problem", "report_profiles", "UniformShear", "Wall",
-    "solve", "stretched_nodes", "uniform_shear",
+    "AnnularCell", "CouetteConvergenceError", "InclinedLayer", "PlanarCell", "Problem", "report_profiles", "UniformShear", "Wall",
+    "solve", "solve_chute", "stretched_nodes", "uniform_shear",
 ]

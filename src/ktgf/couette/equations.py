@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from .frictional_stress import frictional_terms
-from .walls import Wall, jj_dissipation, jj_friction
+from .walls import Wall, jj_friction, jj_heat_loss
 
 N_VARS = 3  # u, ln θ, ψ per node
 
@@ -162,9 +162,7 @@ class Problem:
             if wall.momentum == "johnson-jackson":
                 F_wall[k] = sign * self.S_wall[k] * cf * slip[k]
             if wall.energy == "johnson-jackson":
-                D = jj_dissipation(wall, phi[i], chi_w[k], theta[i])
-                G = cf * slip[k] ** 2
-                E_wall[k] = sign * self.B_wall[k] * (D - G)
+                E_wall[k] = sign * self.B_wall[k] * jj_heat_loss(wall, phi[i], chi_w[k], theta[i], slip[k])
                 if wall.heat_flux == "conductive":  # JJ set κ∂θ/∂n only: add the ω∂φ/∂x part
                     E_wall[k] += self.B_wall[k] * c.omega[node][i] * self._wall_gradient(phi, k)
         p = c.p[node] + p_fric

@@ -26,6 +26,10 @@ Choices made here (documented defaults, exposed as options):
   the model's RDF limit, so the same wall is applied to every model (the CS-based models have
   φ_max = 1).
 * In the annular cell the shear stress is τ_rθ = η r d(u/r)/dr (the frame-invariant form).
+
+The formulas below are pure functions of array arguments written with arithmetic operators only,
+so the same code serves NumPy (the 1D Couette solver, :mod:`ktgf.couette.equations`) and JAX
+(the walls of the 3D solver, :mod:`ktgf.solver.boundaries`).
 """
 
 from __future__ import annotations
@@ -111,10 +115,26 @@ class Wall:
 
 
 def jj_friction(wall: Wall, phi, chi, theta):
-    """Coefficient c of the JJ shear stress τ_w = c u_sl (ρ_s = 1 units): (π√3/6) φ' (φ/φ_pk) χ √θ."""
+    """Coefficient c of the JJ shear stress τ_w = c u_sl (ρ_s = 1 units): (π√3/6) φ' (φ/φ_pk) χ √θ.
+
+    Johnson & Jackson (1987), JFM 176, 67 (their momentum wall condition; model.md §7).
+    """
     return (SQRT3_PI / 6.0) * wall.specularity * (phi / wall.packing_limit) * chi * theta**0.5
 
 
 def jj_dissipation(wall: Wall, phi, chi, theta):
-    """Collisional dissipation at the wall D = (π√3/(4φ_pk)) (1 − e_w²) φ χ θ^{3/2} (ρ_s = 1 units)."""
+    """Collisional dissipation at the wall D = (π√3/(4φ_pk)) (1 − e_w²) φ χ θ^{3/2} (ρ_s = 1 units).
+
+    Johnson & Jackson (1987), JFM 176, 67 (dissipation term of their energy wall condition; model.md §7).
+    """
     return (SQRT3_PI / (4.0 * wall.packing_limit)) * (1.0 - wall.restitution**2) * phi * chi * theta**1.5
+
+
+def jj_heat_loss(wall: Wall, phi, chi, theta, slip):
+    """Heat flux out of the medium into the wall, D − G (ρ_s = 1 units): −q·n with n into the medium.
+
+    G = c u_sl² is the slip work (c of :func:`jj_friction`), D the wall dissipation
+    (:func:`jj_dissipation`); Johnson & Jackson (1987), model.md §7.  ``slip`` = u − u_wall (its square
+    is used, so any tangential sign convention).
+    """
+    return jj_dissipation(wall, phi, chi, theta) - jj_friction(wall, phi, chi, theta) * slip * slip

@@ -1,4 +1,8 @@
-"""Finite-volume JAX solver of the granular Navier–Stokes equations (model.md §1) in periodic boxes.
+"""Finite-volume JAX solver of the granular Navier–Stokes equations (model.md §1).
+
+Boxes with per-axis boundaries — periodic, Lees–Edwards (uniform shear) or Johnson–Jackson walls —
+and an optional body force; the case (cooling box, uniform shear, planar Couette, chute) is data
+(:mod:`.flows`, :mod:`.boundaries`, docs/solver.md "Cases and boundaries").
 
 Conservative variables (ρ, ρu, E = ρ(|u|²/2 + 3θ/2)) on a uniform periodic grid in 1, 2 or 3
 dimensions (one code path; the velocity always has three components).  MUSCL-reconstructed
@@ -9,7 +13,8 @@ collisional sink −(3/2)ρθ(ζ0 + ζ_U∇·u), and an adaptive step: IMEX ARS(
 viscous and heat fluxes (acoustic CFL and cooling limits, :mod:`.imex`) or SSP-RK3 (plus the
 diffusive limits).  Any registered closure model can be used; the solver never branches on its name.
 
-Modules: :mod:`.grid` (periodic grid, a pytree), :mod:`.state` (variables), :mod:`.physics`
+Modules: :mod:`.grid` (grid and its boundaries, a pytree), :mod:`.boundaries` (ghost cells of
+each boundary kind), :mod:`.flows` (the cases: start, diagnostics, references), :mod:`.state` (variables), :mod:`.physics`
 (EoS, sound speed, SI transport from the Model), :mod:`.fluxes`, :mod:`.sources`,
 :mod:`.stepping` (RHS, Δt, IMEX/SSP-RK3, compiled ``advance`` with failure detection), :mod:`.imex`,
 :mod:`.initial` (HCS states), :mod:`.diagnostics`, :mod:`.io` (netCDF, checkpoints, VTK .vti,

@@ -22,6 +22,17 @@ Example (``examples/hcs_3d.toml``)::
     unit = "tau"            # "tau" (collision units along Haff's law; outputs equally spaced in tau), "haff" (t/t0) or "s"
     outputs = 60
 
+Cases other than the cooling box (``examples/uniform_shear.toml``): ``[case] kind`` and one
+boundary per axis, e.g. a Lees–Edwards box sheared at γ̇ = 50/s along x with y the gradient::
+
+    [case]
+    kind = "uniform-shear"
+    [boundaries]
+    y = { kind = "lees-edwards", shear_rate = 50.0, flow = "x" }
+    [time]
+    end = 200.0
+    unit = "strain"         # gamma_dot * t
+
 Errors name the field (``grid.cells.0``, ``initial.solid_fraction``) and the valid range.
 """
 
@@ -33,6 +44,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from ..couette.config import WallsConfig
 from ..errors import InputError, KtgfError
 from ..io import plain, read_toml
 from .fluxes import LIMITERS, RIEMANN_SOLVERS
@@ -66,6 +78,7 @@ class InitialSection(_Section):
     mode: list[int] | None = None
     kind: Literal["transverse", "longitudinal"] = "transverse"
     branch: int = Field(0, ge=0, le=2)
+    shear_rate: float | None = Field(None, gt=0.0, description="chute: initial u = shear_rate * height above the base [1/s]")
 
 
 class GridSection(_Section):
@@ -127,7 +140,8 @@ class NumericsSection(_Section):
 
 class TimeSection(_Section):
     end: float = Field(..., gt=0.0)
-    unit: Literal["tau", "haff", "s"] = "tau"
+    unit: Literal["tau", "haff", "s", "strain"] = Field(
+        "tau", description="tau, haff: cooling box only; strain (shear rate x t): sheared cases only")
     outputs: int = Field(50, ge=1, le=100000)
     max_steps_per_call: int = Field(200, ge=1, le=2**31 - 1, description="steps per compiled call (progress granularity)")
     scheme: Literal["auto", "imex", "ssprk3"] = Field(
@@ -146,6 +160,69 @@ class ParallelSection(_Section):
     devices: int = Field(1, ge=1, description="JAX devices to shard the first grid axis over")
 
 
+#: Case kinds (:mod:`ktgf.solver.flows`).
+CASE_KINDS = ("cooling", "uniform-shear", "couette", "chute")
+_AXES = ("x", "y", "z")
+
+
+class BoundarySection(_Section):
+    kind: Literal["periodic", "lees-edwards", "wall"] = "periodic"
+    shear_rate: float | None = Field(None, gt=0.0, description="Lees-Edwards shear rate du_flow/dx_axis [1/s]")
+    flow: Literal["x", "y", "z"] | None = Field(None, description="Lees-Edwards flow / wall motion direction (not this axis)")
+    wall_speed: float | None = Field(None, ge=0.0, description="relative wall speed U [m/s]: lower wall at -U/2, upper at +U/2")
+    walls: WallsConfig | None = Field(None, description="wall conditions (as in ktgf couette): both, or lower/upper via bottom/top")
+
+    @model_validator(mode="after")
+    def _complete(self) -> BoundarySection:
+        if self.kind == "lees-edwards" and (self.shear_rate is None or self.flow is None):
+            raise ValueError("a lees-edwards boundary needs shear_rate (> 0, 1/s) and flow ('x', 'y' or 'z')")
+        if self.kind == "wall" and (self.walls is None or self.flow is None or self.wall_speed is None):
+            raise ValueError("a wall boundary needs walls (e.g. {type = 'johnson-jackson', specularity = 0.1}), "
+                             "flow ('x', 'y' or 'z') and wall_speed (>= 0, m/s)")
+        extra = {"shear_rate": self.kind != "lees-edwards", "flow": self.kind == "periodic",
+                 "wall_speed": self.kind != "wall", "walls": self.kind != "wall"}
+        bad = [k for k, refused in extra.items() if refused and getattr(self, k) is not None]
+        if bad:
+            raise ValueError(f"a {self.kind} boundary takes no {', '.join(bad)}")
+        return self
+
+
+class BoundariesSection(_Section):
+    x: BoundarySection = BoundarySection()
+    y: BoundarySection = BoundarySection()
+    z: BoundarySection = BoundarySection()
+
+    @model_validator(mode="after")
+    def _one_shear(self) -> BoundariesSection:
+        le = [a for a in _AXES if getattr(self, a).kind == "lees-edwards"]
+        walls = [a for a in _AXES if getattr(self, a).kind == "wall"]
+        if len(le) > 1:
+            raise ValueError(f"at most one axis can be lees-edwards (one shear gradient); got {', '.join(le)}")
+        if len(walls) > 1 or (le and walls):
+            raise ValueError(f"one sheared axis at most: lees-edwards on {le or 'none'}, walls on {walls or 'none'}")
+        for a in le + walls:
+            flow = getattr(self, a).flow
+            if flow == a:
+                raise ValueError(f"{a}.flow = {a!r} is the gradient axis itself: valid flow is another axis")
+            if getattr(self, flow).kind != "periodic":
+                raise ValueError(f"{a}.flow = {flow!r}: the flow axis must be periodic")
+        return self
+
+    def wall_axis(self) -> str | None:
+        return next((a for a in _AXES if getattr(self, a).kind == "wall"), None)
+
+    def shear_axis(self) -> str | None:
+        return next((a for a in _AXES if getattr(self, a).kind == "lees-edwards"), None)
+
+
+class CaseSection(_Section):
+    kind: Literal["cooling", "uniform-shear", "couette", "chute"] = Field(
+        "cooling", description="cooling (periodic box), uniform-shear (Lees-Edwards box), couette (two moving walls), "
+                               "chute (gravity-driven layer on an inclined base)")
+    inclination_deg: float | None = Field(None, gt=0.0, lt=90.0, description="chute: base inclination [degrees]")
+    gravity: float = Field(9.81, gt=0.0, description="chute: acceleration of gravity g [m/s^2]")
+
+
 class Config(_Section):
     model: ModelSection = ModelSection()
     particles: ParticlesSection = ParticlesSection()
@@ -155,6 +232,8 @@ class Config(_Section):
     time: TimeSection
     output: OutputSection = OutputSection()
     parallel: ParallelSection = ParallelSection()
+    case: CaseSection = CaseSection()
+    boundaries: BoundariesSection = BoundariesSection()
 
 
 def _fmt_error(err: dict[str, Any]) -> str:
@@ -209,6 +288,7 @@ def check_physics(cfg: Config, source: str = "config") -> None:
     if cfg.initial.max_mode > max(cells) // 2:
         raise InputError(f"{source}: field initial.max_mode = {cfg.initial.max_mode} is out of range: valid "
                          f"1 <= max_mode <= {max(cells) // 2} (half the largest cell count)")
+    check_case(cfg, source)
     if cfg.grid.relative_to is not None:
         from ..hcs.stability import critical_wavenumbers
 
@@ -220,3 +300,59 @@ def check_physics(cfg: Config, source: str = "config") -> None:
                 f"phi = {phi0:g}, e = {cfg.model.restitution:g} has no {cfg.grid.relative_to} instability "
                 "(infinite critical size); give grid.length instead"
             )
+
+
+def check_case(cfg: Config, source: str = "config") -> None:
+    """The case and its boundaries fit together and fit the grid (one-line errors naming the field)."""
+    ndim, kind, b = len(cfg.grid.cells), cfg.case.kind, cfg.boundaries
+    for a in _AXES[ndim:]:
+        if getattr(b, a).kind != "periodic":
+            raise InputError(f"{source}: field boundaries.{a}.kind = {getattr(b, a).kind!r}: the grid has {ndim} "
+                             f"axis/axes ({', '.join(_AXES[:ndim])}); axis {a} has no boundary to set")
+    shear, wall = b.shear_axis(), b.wall_axis()
+    if kind != "chute" and cfg.case.inclination_deg is not None:
+        raise InputError(f"{source}: field case.inclination_deg applies to case.kind = 'chute' only")
+    if kind == "cooling" and (shear or wall):
+        raise InputError(f"{source}: field boundaries.{shear or wall}.kind = {getattr(b, shear or wall).kind!r} needs "
+                         "case.kind = 'uniform-shear' or 'couette' (the cooling case is a periodic box)")
+    if kind == "uniform-shear" and shear is None:
+        raise InputError(f"{source}: field case.kind = 'uniform-shear' needs one boundaries.<axis> with kind = "
+                         f"'lees-edwards' (valid axes: {', '.join(_AXES[:ndim])})")
+    if kind in ("couette", "chute") and wall is None:
+        raise InputError(f"{source}: field case.kind = {kind!r} needs one boundaries.<axis> with kind = 'wall' "
+                         f"(valid axes: {', '.join(_AXES[:ndim])})")
+    if kind == "couette" and not getattr(b, wall).wall_speed > 0:
+        raise InputError(f"{source}: field boundaries.{wall}.wall_speed = {getattr(b, wall).wall_speed:g} is out of "
+                         "range: valid wall_speed > 0 m/s for a Couette cell")
+    if kind == "chute" and getattr(b, wall).wall_speed != 0:
+        raise InputError(f"{source}: field boundaries.{wall}.wall_speed = {getattr(b, wall).wall_speed:g} is out of "
+                         "range: valid wall_speed = 0 for a chute (the base is at rest)")
+    if kind == "chute" and cfg.case.inclination_deg is None:
+        raise InputError(f"{source}: field case.inclination_deg is missing: a chute needs the base inclination "
+                         "(0 < inclination_deg < 90 degrees)")
+    if kind != "chute" and cfg.initial.shear_rate is not None:
+        raise InputError(f"{source}: field initial.shear_rate sets the start of a chute only (other cases: the boundaries)")
+    if kind == "chute" and cfg.time.unit == "strain":
+        raise InputError(f"{source}: field time.unit = 'strain': a chute has no imposed shear rate; valid 's'")
+    if kind != "uniform-shear" and shear is not None:
+        raise InputError(f"{source}: field boundaries.{shear}.kind = 'lees-edwards' needs case.kind = 'uniform-shear'")
+    if kind not in ("couette", "chute") and wall is not None:
+        raise InputError(f"{source}: field boundaries.{wall}.kind = 'wall' needs case.kind = 'couette' or 'chute'")
+    if wall is not None:
+        try:
+            getattr(b, wall).walls.build_pair()
+        except KtgfError as exc:
+            raise InputError(f"{source}: field boundaries.{wall}.walls: {exc}") from None
+    sheared = kind != "cooling"
+    if sheared and cfg.time.unit in ("tau", "haff"):
+        raise InputError(f"{source}: field time.unit = {cfg.time.unit!r} is for the cooling case (Haff's law); "
+                         f"valid for case.kind = {kind!r}: 's' or 'strain'")
+    if not sheared and cfg.time.unit == "strain":
+        raise InputError(f"{source}: field time.unit = 'strain' needs a sheared case; valid for the cooling case: "
+                         "'tau', 'haff' or 's'")
+    if sheared and cfg.grid.relative_to is not None:
+        raise InputError(f"{source}: field grid.relative_to sizes a cooling box (HCS critical size); "
+                         f"give grid.length or grid.length_d for case.kind = {kind!r}")
+    if sheared and cfg.initial.perturbation == "mode":
+        raise InputError(f"{source}: field initial.perturbation = 'mode' is an HCS eigenmode; valid for "
+                         f"case.kind = {kind!r}: 'random' or 'none'")

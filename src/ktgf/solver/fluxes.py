@@ -62,6 +62,33 @@ def materialise(x: Any) -> Any:
     return jax.lax.optimization_barrier(x) if MATERIALISE else x
 
 
+def pad_fields(W: Sequence[Any], grid: Grid, t: Any = 0.0, velocity: int | None = None,
+               affine: bool = True, theta: int | None = None, walls: Any = None) -> tuple[Any, ...]:
+    """Fields with GHOST ghost cells per side, filled by the grid's boundaries (:func:`.boundaries.pad`)."""
+    from .boundaries import pad
+
+    if grid.boundaries is None or grid.boundaries.all_periodic:
+        return pad_periodic(W, grid.ndim)
+    return materialise(pad(W, grid, GHOST, t, velocity, affine, theta, walls))
+
+
+def has_walls(grid: Grid) -> bool:
+    return grid.boundaries is not None and bool(grid.boundaries.wall_axes)
+
+
+def pad_viscous(W: Sequence[Any], transport: Sequence[Any], grid: Grid, phys: Physics, t: Any = 0.0,
+                walls: Any = None) -> tuple[Any, ...]:
+    """Primitive fields (ρ, u, θ) padded for the viscous and heat fluxes: with walls, the ghost cells
+    of the wall conditions (``walls``: frozen :func:`.boundaries.wall_terms`, else from W)."""
+    if not has_walls(grid):
+        return pad_fields(W, grid, t, velocity=1)
+    from .boundaries import wall_terms
+
+    if walls is None:
+        walls = wall_terms(W[0], W[1:4], W[4], transport, grid, phys)
+    return pad_fields(W, grid, t, velocity=1, theta=4, walls=walls)
+
+
 def pad_periodic(W: Sequence[Any], ndim: int) -> tuple[Any, ...]:
     """Fields with GHOST periodic ghost cells on each side of every grid axis.
 
@@ -116,12 +143,40 @@ def _euler_flux(W: Sequence[Any], U: Sequence[Any], p: Any, a: int) -> list[Any]
     return [U[0] * un, *mom, (U[4] + p) * un]
 
 
-def convective_flux(P: Sequence[Any], cells: tuple[int, ...], axis: int, limiter: str, riemann: str) -> list[Any]:
+def wall_flux(W: Sequence[Any], axis: int, side: int) -> list[Any]:
+    """Convective flux through a wall face from the medium's face state W = (ρ, u, θ, p*, g) there.
+
+    The HLL (and Rusanov) flux between W and its mirror image (u_n → −u_n): with s = |u_n| + c
+    it is (0, ρu_n² + p ∓ sρu_n on the normal component, 0, 0) — − for the lower wall (medium on
+    the right), + for the upper one.  At rest the wall pressure p; nothing else crosses.
+    """
+    rho, un = W[0], W[1 + axis]
+    p = rho * W[4] * W[5]
+    s = jnp.abs(un) + jnp.sqrt(W[4] * W[6])
+    normal = rho * un * un + p + (-1.0 if side == 0 else 1.0) * s * rho * un
+    zero = jnp.zeros_like(rho)
+    return [zero, *(normal if j == axis else zero for j in range(3)), zero]
+
+
+def convective_flux(P: Sequence[Any], cells: tuple[int, ...], axis: int, limiter: str, riemann: str,
+                    walls: bool = False) -> list[Any]:
     """Upwind flux (HLL or Rusanov) of the Euler part at the N+1 faces along ``axis``.
 
-    ``P`` = padded (ρ, u_x, u_y, u_z, θ, p*, g) cell fields (:func:`pad_periodic`).
+    ``P`` = padded (ρ, u_x, u_y, u_z, θ, p*, g) cell fields (:func:`pad_periodic`); ``walls``:
+    the first and last faces are walls (:func:`wall_flux` from the medium's side).
     """
     WL, WR = materialise(reconstruct(P, cells, axis, limiter))
+    F = riemann_flux(WL, WR, axis, riemann)
+    if not walls:
+        return F
+    n = cells[axis]
+    lo = wall_flux([jax.lax.slice_in_dim(w, 0, 1, axis=axis) for w in WR], axis, 0)
+    hi = wall_flux([jax.lax.slice_in_dim(w, n, n + 1, axis=axis) for w in WL], axis, 1)
+    return [jnp.concatenate([a, jax.lax.slice_in_dim(f, 1, n, axis=axis), b], axis=axis) for a, f, b in zip(lo, F, hi)]
+
+
+def riemann_flux(WL: Sequence[Any], WR: Sequence[Any], axis: int, riemann: str) -> list[Any]:
+    """HLL or Rusanov flux between the left and right face states (ρ, u, θ, p*, g)."""
     pL, pR = WL[0] * WL[4] * WL[5], WR[0] * WR[4] * WR[5]
     cL, cR = jnp.sqrt(WL[4] * WL[6]), jnp.sqrt(WR[4] * WR[6])
     UL, UR = conservative_fields(WL[:5]), conservative_fields(WR[:5])
@@ -226,19 +281,22 @@ def face_divergence(F: Any, grid: Grid, axis: int) -> Any:
 
 
 def flux_divergence(W: Sequence[Any], coefficients: tuple[tuple[Any, ...], tuple[Any, ...]], grid: Grid,
-                    phys: Physics, limiter: str, riemann: str, viscous: bool = True) -> tuple[list[Any], Any]:
+                    phys: Physics, limiter: str, riemann: str, viscous: bool = True,
+                    t: Any = 0.0) -> tuple[list[Any], Any]:
     """−∇·F per field of the convective (+ viscous and heat, if ``viscous``) flux, and the cell ∇·u.
 
-    ``coefficients`` = (eos, transport) cell fields of :func:`cell_fields`.
+    ``coefficients`` = (eos, transport) cell fields of :func:`cell_fields`; ``t`` the time (the
+    Lees–Edwards images move).
     """
     eos, transport = coefficients
-    P = pad_periodic((*W, *eos), grid.ndim)
-    Pk = pad_periodic(transport, grid.ndim) if viscous else ()
+    P = pad_fields((*W, *eos), grid, t, velocity=1)
+    Pk = pad_fields(transport, grid, t) if viscous else ()
+    Pv = (pad_viscous(W, transport, grid, phys, t) if has_walls(grid) else P[:5]) if viscous else ()
     out: list[Any] = [0.0] * 5
     for a in range(grid.ndim):
-        Fc = convective_flux(P, grid.cells, a, limiter, riemann)
+        Fc = convective_flux(P, grid.cells, a, limiter, riemann, walls=has_walls(grid) and a in grid.boundaries.wall_axes)
         if viscous:
-            Fv = viscous_flux(P[:5], Pk, a, grid, phys.material_density)
+            Fv = viscous_flux(Pv, Pk, a, grid, phys.material_density)
             Fc = [Fc[i] + Fv[i] for i in range(5)]
         # One stacked array of face fluxes: XLA then computes all five components in one
         # loop and materialises them, instead of recomputing the face state in each consumer.

@@ -1,7 +1,9 @@
-"""Uniform periodic Cartesian grids in 1, 2 or 3 dimensions (the dimension is data).
+"""Uniform Cartesian grids in 1, 2 or 3 dimensions (the dimension is data), with their boundaries.
 
 A :class:`Grid` is a JAX pytree: the cell counts are static (they fix array shapes), the
-box lengths are traced leaves, so boxes of different size share one compiled kernel.  Cell ``i`` along axis ``a`` covers ``[i Δx_a, (i+1) Δx_a)``; its centre is
+box lengths are traced leaves, so boxes of different size share one compiled kernel.  The
+boundary kind of every axis (:class:`~ktgf.solver.boundaries.Boundaries`; default periodic)
+travels with the grid, so every stencil that pads fields sees it.  Cell ``i`` along axis ``a`` covers ``[i Δx_a, (i+1) Δx_a)``; its centre is
 ``(i + 1/2) Δx_a``.  Fields are stored as arrays of shape ``grid.cells`` (one axis per
 spatial dimension); the velocity always has three components (a 1D or 2D grid is a
 3D flow that does not vary along the missing axes), so transverse modes exist in 1D.
@@ -11,6 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import jax
 import numpy as np
@@ -24,7 +27,7 @@ MIN_CELLS = 4
 @jax.tree_util.register_pytree_node_class
 @dataclass(frozen=True)
 class Grid:
-    """Periodic box of ``cells[a]`` cells of width ``lengths[a]/cells[a]`` along axis ``a``.
+    """Box of ``cells[a]`` cells of width ``lengths[a]/cells[a]`` along axis ``a``.
 
     Parameters
     ----------
@@ -32,10 +35,13 @@ class Grid:
         Number of cells per axis (1 to 3 entries).
     lengths : tuple of float
         Box side per axis [m].
+    boundaries : Boundaries or None
+        Boundary kind per axis (None: periodic on every axis).
     """
 
     cells: tuple[int, ...]
     lengths: tuple[float, ...]
+    boundaries: Any = None
 
     def __post_init__(self) -> None:
         cells = tuple(int(n) for n in self.cells)
@@ -52,15 +58,18 @@ class Grid:
         for a, v in enumerate(lengths):
             if not (math.isfinite(v) and v > 0):
                 raise InputError(f"grid lengths[{a}] = {v:g} is out of range: valid 0 < length (m)")
+        if self.boundaries is not None and len(self.boundaries.kinds) != len(cells):
+            raise InputError(f"grid boundaries has {len(self.boundaries.kinds)} axes but cells has {len(cells)}")
 
-    def tree_flatten(self) -> tuple[tuple[float, ...], tuple[int, ...]]:
-        return self.lengths, self.cells
+    def tree_flatten(self) -> tuple[tuple, tuple[int, ...]]:
+        return (self.lengths, self.boundaries), self.cells
 
     @classmethod
-    def tree_unflatten(cls, cells: tuple[int, ...], lengths: tuple) -> Grid:
+    def tree_unflatten(cls, cells: tuple[int, ...], children: tuple) -> Grid:
         obj = object.__new__(cls)  # no validation: leaves may be tracers
         object.__setattr__(obj, "cells", cells)
-        object.__setattr__(obj, "lengths", tuple(lengths))
+        object.__setattr__(obj, "lengths", tuple(children[0]))
+        object.__setattr__(obj, "boundaries", children[1])
         return obj
 
     @property

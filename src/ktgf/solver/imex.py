@@ -50,7 +50,8 @@ import numpy as np
 from jax.scipy.sparse.linalg import bicgstab, cg
 
 from ..closures.coefficients import Reduced
-from .fluxes import face_coefficients, face_divergence, face_jump, pad_periodic, stress, viscous_flux
+from .fluxes import face_coefficients, face_divergence, face_jump, has_walls, pad_fields, pad_viscous, stress, viscous_flux
+from .boundaries import wall_terms
 from .grid import Grid
 from .physics import Physics
 from .state import primitive_fields
@@ -120,10 +121,12 @@ def heat_preconditioner(grid: Grid, rho: Any, kappa: Any, adt: Any, dtype: Any):
     return lambda r: _ifft(_fft(r, grid) / D, grid, dtype)
 
 
-def viscous_divergence(W: tuple, transport: tuple, grid: Grid, phys: Physics) -> list[Any]:
-    """f_I = −∇·(viscous + heat flux) at the cells: (0, ∇·τ, ∇·(τ·u) − ∇·q)."""
-    P = pad_periodic(W, grid.ndim)
-    Pk = pad_periodic(transport, grid.ndim)
+def viscous_divergence(W: tuple, transport: tuple, grid: Grid, phys: Physics, t: Any = 0.0,
+                       walls: Any = None) -> list[Any]:
+    """f_I = −∇·(viscous + heat flux) at the cells: (0, ∇·τ, ∇·(τ·u) − ∇·q) (``t``: time of the boundaries;
+    ``walls``: frozen wall coefficients, else from W)."""
+    P = pad_viscous(W, transport, grid, phys, t, walls)
+    Pk = pad_fields(transport, grid, t)
     out: list[Any] = [0.0] * 5
     for a in range(grid.ndim):
         F = viscous_flux(P, Pk, a, grid, phys.material_density)
@@ -158,10 +161,14 @@ def _unit(x: Any) -> Any:
 
 
 def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced, tol: Any, maxiter: int,
-                   sweeps: int) -> tuple[tuple, list[Any], Any]:
-    """Solve U = Û + aΔt f_I(U) (see the module docstring).
+                   sweeps: int, t: Any = 0.0) -> tuple[tuple, list[Any], Any]:
+    """Solve U = Û + aΔt f_I(U) (see the module docstring) at the stage time ``t``.
 
     Returns the stage state, f_I at it, and the largest relative residual divided by ``tol``.
+    Boundaries: the Krylov operators are the linear part of the discrete operator (ghost cells
+    without the Lees–Edwards velocity jump); the jump enters through the right-hand side, which
+    is built from the full (affine) operator.  The FFT preconditioner stays the periodic one
+    (an approximation of the operator, so only the iteration count depends on it).
     """
     dtype = Uhat[0].dtype
     Wh = primitive_fields(Uhat)
@@ -174,29 +181,32 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     # Coefficient temperature: θ of Û plus the explicit implicit-part increment, an O(Δt²)
     # estimate of the stage θ (kept within a factor 2 of θ̂, which only matters far outside the
     # asymptotic range).
-    fI = viscous_divergence(Wh, phys.transport(rho, theta, r), grid, phys)
+    fI = viscous_divergence(Wh, phys.transport(rho, theta, r), grid, phys, t)
     heat = fI[4] - sum(x * f for x, f in zip(u, fI[1:4]))
     theta = jnp.clip(theta + adt * heat / (1.5 * rho), 0.5 * theta, 2.0 * theta)
 
     worst = jnp.zeros((), dtype)
     for _ in range(sweeps):
         transport = phys.transport(rho, theta, r)
-        Pk = pad_periodic(transport, grid.ndim)
+        Pk = pad_fields(transport, grid, t)
         faces = [face_coefficients(Pk, grid.cells, a) for a in range(grid.ndim)]
         eta_f = [f[0] for f in faces]
         c_f = [f[0] / 3.0 + f[1] for f in faces]
         kap_f = [f[2] for f in faces]
 
-        def div_tau(v: tuple) -> list[Any]:
-            Pu = pad_periodic(v, grid.ndim)
+        # Wall coefficients frozen with the transport ones (their momentum part does not depend on u).
+        walls = wall_terms(rho, u, theta, transport, grid, phys) if has_walls(grid) else None
+
+        def div_tau(v: tuple, affine: bool = False) -> list[Any]:
+            Pu = pad_fields(v, grid, t, velocity=0, affine=affine, walls=walls)
             out: list[Any] = [0.0, 0.0, 0.0]
             for a in range(grid.ndim):
                 dF = face_divergence(jnp.stack(stress(Pu, faces[a][0], faces[a][1], a, grid)), grid, a)
                 out = [o - dF[j] for j, o in enumerate(out)]
             return out
 
-        def A(v: tuple) -> tuple:
-            d = div_tau(v)
+        def A(v: tuple, affine: bool = False) -> tuple:
+            d = div_tau(v, affine)
             return tuple(rho * v[j] - adt * d[j] for j in range(3))
 
         eta_m, lam_m = jnp.mean(transport[0]), jnp.mean(transport[1])
@@ -208,7 +218,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
                      / (rho_mean + adt * (iso_m + (2.0 * c_m * inv_dx2[j] if j < grid.ndim else 0.0))))
             for j in range(3))
         M = _scaled(momentum_preconditioner(grid, rho_mean, eta_m, lam_m, adt, dtype), scale)
-        b = tuple(m - a for m, a in zip(m_hat, A(u)))  # solve for the correction to the current u
+        b = tuple(m - a for m, a in zip(m_hat, A(u, True)))  # solve for the correction to the current u
         # Absolute floors from the scale of the state (thermal momentum ρ√θ, energy Ê), not of
         # the correction: in a nearly uniform gas the correction itself is round-off.
         atol_m = floor * _norm(rho) * jnp.sqrt(jnp.mean(theta))
@@ -218,15 +228,17 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         sb = _unit(b)
         du, _ = bicgstab(A, tuple(x / sb for x in b), tol=tol, atol=atol_m / sb, maxiter=RESTART * maxiter, M=M)
         u = tuple(x + sb * dx for x, dx in zip(u, du))
+        if walls is not None:  # the wall heat terms need the slip of the new u
+            walls = wall_terms(rho, u, theta, transport, grid, phys)
 
         def B(th: Any) -> Any:
-            Pt = pad_periodic((th,), grid.ndim)[0]
+            Pt = pad_fields((th,), grid, t, affine=False, theta=0, walls=walls)[0]
             div = sum(face_divergence(-kap_f[a] * face_jump(Pt, grid.cells, a) / grid.spacing[a], grid, a)
                       for a in range(grid.ndim))
             return 1.5 * rho * th - adt * div
 
         # Right-hand side: Ê − ρ̂|u|²/2 + aΔt∇·(τ·u + ω∇φ), i.e. the stage equation with κ = 0.
-        fI0 = viscous_divergence((rho, *u, jnp.zeros_like(theta)), transport, grid, phys)
+        fI0 = viscous_divergence((rho, *u, jnp.zeros_like(theta)), transport, grid, phys, t, walls)
         rhs_E = E_hat - 0.5 * rho * sum(x * x for x in u) + adt * fI0[4]
         kap_m = jnp.mean(transport[2])
         hscale = jnp.sqrt((1.5 * rho + adt * sum(_face_sum(kap_f, grid, a) * inv_dx2[a] for a in range(grid.ndim)))
@@ -240,7 +252,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         theta = th0 + sE * dth
 
         # The conservative stage state and the residual of its two linear problems.
-        fI = viscous_divergence((rho, *u, theta), transport, grid, phys)
+        fI = viscous_divergence((rho, *u, theta), transport, grid, phys, t, walls)
         U = (rho, *(m + adt * f for m, f in zip(m_hat, fI[1:4])), E_hat + adt * fI[4])
         res_m = _norm(tuple(rho * x - m for x, m in zip(u, U[1:4])))
         res_E = _norm(U[4] - rho * (0.5 * sum(x * x for x in u) + 1.5 * theta))

@@ -38,6 +38,8 @@ class Physics:
         Material density ρ_s [kg/m³].
     phi_stop : float
         A run stops with a diagnosis once any cell reaches this solid fraction.
+    gravity : tuple of 3 floats or None
+        Body force per unit mass g [m/s²] (None: none; :func:`~ktgf.solver.sources.body_force`).
     """
 
     model: Model
@@ -45,9 +47,10 @@ class Physics:
     diameter: float
     material_density: float
     phi_stop: float
+    gravity: Any = None
 
     def tree_flatten(self) -> tuple[tuple, Model]:
-        return (self.restitution, self.diameter, self.material_density, self.phi_stop), self.model
+        return (self.restitution, self.diameter, self.material_density, self.phi_stop, self.gravity), self.model
 
     @classmethod
     def tree_unflatten(cls, model: Model, leaves: tuple) -> Physics:

@@ -1,4 +1,5 @@
-"""Run an HCS case from a :class:`~ktgf.solver.config.Config`: outputs, checkpoints, progress, resume.
+"""Run a case (cooling box, uniform shear: :mod:`.flows`) from a :class:`~ktgf.solver.config.Config`:
+outputs, checkpoints, progress, resume.
 
 The host loop calls the compiled :func:`~ktgf.solver.stepping.advance` up to each output
 time in chunks of ``time.max_steps_per_call`` steps.  The step sequence depends only on the
@@ -38,6 +39,11 @@ from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
 from ..io import write_netcdf
 from .config import Config
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
+from .flows import (CASE_COLUMNS, CASE_UNITS, PROFILES, VERIFICATION_FILE, add_base_flow, case_diagnostics, gradient_axis,
+                    shear_rate, verification)
+from .flows import boundaries as case_boundaries
+from .flows import gravity as case_gravity
+from .flows import describe as describe_boundaries
 from .grid import Grid
 from .initial import haff_time, random_velocity, single_mode, t_of_tau, tau_of_t, uniform_fields
 from .interrupt import STOP, Interrupted, fault_hook
@@ -154,7 +160,7 @@ def _in_precision(method: Callable[..., Any]) -> Callable[..., Any]:
 
 
 class Simulation:
-    """An HCS run described by a config (everything validated here, before any compilation)."""
+    """A run of any case described by a config (everything validated here, before any compilation)."""
 
     def precision(self) -> Any:
         """Context manager of the run: JAX's x64 mode on inside it only (the state's dtype follows numerics.precision)."""
@@ -169,8 +175,12 @@ class Simulation:
         check_memory(tuple(cfg.grid.cells), cfg.numerics.precision)
         self.model = get_model(cfg.model.name, **cfg.model.options)
         phi_stop = cfg.numerics.phi_stop if cfg.numerics.phi_stop is not None else 0.99 * self.model.phi_max
-        self.phys = Physics(self.model, cfg.model.restitution, cfg.particles.diameter, cfg.particles.density, phi_stop)
-        self.grid = Grid(tuple(cfg.grid.cells), box_lengths(cfg))
+        self.phys = Physics(self.model, cfg.model.restitution, cfg.particles.diameter, cfg.particles.density, phi_stop,
+                            case_gravity(cfg))
+        self.case = cfg.case.kind
+        bc = case_boundaries(cfg)
+        self.grid = Grid(tuple(cfg.grid.cells), box_lengths(cfg), None if bc.all_periodic else bc)
+        self.history_keys = (*HISTORY_KEYS, *CASE_COLUMNS[self.case])
         n = cfg.numerics
         self.num = Numerics(n.cfl, n.cfl_diffusion, n.cfl_source, n.limiter, n.riemann, scheme="ssprk3",
                             implicit_tol=n.implicit_tol, implicit_maxiter=n.implicit_maxiter, sweeps=n.sweeps)
@@ -184,7 +194,9 @@ class Simulation:
                 self.output_times = np.asarray(t_of_tau(np.linspace(0.0, end, n_out + 1), self.phys, self.phi0,
                                                         self.theta0))
         else:
-            t_end = end if cfg.time.unit == "s" else end * self.t_haff
+            t_end = {"s": end, "haff": end * self.t_haff}.get(cfg.time.unit)
+            if cfg.time.unit == "strain":
+                t_end = end / shear_rate(self.grid)
             self.output_times = np.linspace(0.0, t_end, n_out + 1)
         self.output_times[0] = 0.0
         t = self.output_times
@@ -232,7 +244,7 @@ class Simulation:
             )
         else:
             U = conservative(*(jnp.asarray(f) for f in uniform_fields(self.grid, self.phys, self.phi0, self.theta0)))
-        return self.place(U)
+        return self.place(add_base_flow(U, self.grid, ini.shear_rate))
 
     @_in_precision
     def place(self, U: Any) -> Any:
@@ -295,10 +307,11 @@ class Simulation:
                     f"initial state: {STATUS_MESSAGES[status]} (phi_stop = {self.phys.phi_stop:g}); "
                     "reduce initial.amplitude or raise numerics.phi_stop"
                 )
-            history = {name: [] for name in HISTORY_KEYS}
+            history = {name: [] for name in self.history_keys}
         self.history = history
         ckpt = self.directory / CHECKPOINT
-        bar = _Progress(progress, self.output_times[-1], self.t_haff, self.phys, self.phi0, self.theta0)
+        bar = _Progress(progress, self.output_times[-1], self.t_haff, self.phys, self.phi0, self.theta0,
+                        cooling=self.case == "cooling")
         chunks = 0
         first_chunk = True
         try:
@@ -352,9 +365,15 @@ class Simulation:
             ) from (None if isinstance(exc, Interrupted) else exc)
         self.state, self.time, self.steps = U, t, steps
         ds = self.dataset(history)
+        self.verification = verification(self.case, history, self.phys, self.grid, self.phi0)
         if write_files:
             ds.attrs["run_complete"] = 1
             write_netcdf(ds, self.directory / TIMESERIES)
+            if self.verification is not None:
+                from ..io import atomic_path
+
+                with atomic_path(self.directory / VERIFICATION_FILE) as tmp:
+                    tmp.write_text(json.dumps(self.verification, indent=2) + "\n")
         return ds
 
     @staticmethod
@@ -431,13 +450,14 @@ class Simulation:
         n_out = len(self.output_times)
         if not 0 <= k <= n_out:
             raise InputError(f"{name}: field output_index = {k} is out of range: valid 0 <= output_index <= {n_out}")
-        if sorted(history) != sorted(HISTORY_KEYS):
-            raise InputError(f"{name}: field history has the columns {sorted(history)}; expected {sorted(HISTORY_KEYS)}")
-        bad = [c for c in HISTORY_KEYS if len(history[c]) != k]
+        keys = self.history_keys
+        if sorted(history) != sorted(keys):
+            raise InputError(f"{name}: field history has the columns {sorted(history)}; expected {sorted(keys)}")
+        bad = [c for c in keys if len(history[c]) != k]
         if bad:
             raise InputError(f"{name}: field history.{bad[0]} has {len(history[bad[0]])} rows; output_index = {k}")
         try:
-            rows = {c: np.asarray(history[c], dtype=float) for c in HISTORY_KEYS}
+            rows = {c: np.asarray(history[c], dtype=float) for c in keys}
         except (TypeError, ValueError):
             raise InputError(f"{name}: field history holds non-numbers") from None
         times = rows["time"]
@@ -465,6 +485,8 @@ class Simulation:
         lim = np.asarray(limits(U, self.grid, self.phys, self.num))
         for name, v in zip(LIMIT_NAMES, lim):
             history.setdefault(f"dt_{name}", []).append(float(v))
+        for name, v in case_diagnostics(self.case, U, t, self.grid, self.phys).items():
+            history[name].append(v)
 
     def _write_fields(self, U: Any, t: float, k: int) -> None:
         out = self.cfg.output
@@ -488,7 +510,7 @@ class Simulation:
         """Save the last good state, reproduce the rejected step and raise a located diagnosis."""
         if write_files:
             self._save(ckpt, U, t, steps, k, history)
-        bad, residual = step(U, dt, self.grid, self.phys, self.num) if dt > 0 else (U, 0.0)
+        bad, residual = step(U, dt, self.grid, self.phys, self.num, t) if dt > 0 else (U, 0.0)
         W = np.asarray(primitive(jnp.asarray(bad)))
         phi = W[0] / self.phys.material_density
         if status == 1:
@@ -511,7 +533,7 @@ class Simulation:
             field, idx, value = "time_step", (), dt
         where = tuple(int(i) for i in idx)
         pos = ", ".join(f"{(i + 0.5) * h:.4g}" for i, h in zip(where, self.grid.spacing))
-        tau = float(tau_of_t(t, self.phys, self.phi0, self.theta0))
+        tau = float(tau_of_t(t, self.phys, self.phi0, self.theta0)) if self.case == "cooling" else float("nan")
         saved = f"; last good state saved to {ckpt}" if write_files else ""
         err = DivergenceError(
             f"run stopped at t = {t:.6g} s (tau = {tau:.4g}, step {steps + 1}): {STATUS_MESSAGES[status]}: "
@@ -531,23 +553,41 @@ class Simulation:
         data = {name: ("time", np.asarray(history[name], dtype=float)) for name in SCALARS}
         data.update({name: (("time", "axis"), np.asarray(history[name], dtype=float).reshape(len(t), -1))
                      for name in PER_AXIS})
-        data["theta_haff"] = ("time", theta_haff)
+        cooling = self.case == "cooling"
+        if cooling:
+            data["theta_haff"] = ("time", theta_haff)
+        coords = {"time": t, "axis": list("xyz"[: self.grid.ndim])}
+        for name in CASE_COLUMNS[self.case]:
+            values = np.asarray(history[name], dtype=float)
+            if name in PROFILES:  # profiles across the gap, one row per output
+                a = gradient_axis(self.grid)
+                data[name] = (("time", "normal"), values.reshape(len(t), self.grid.cells[a]))
+                coords["normal"] = ("normal", self.grid.centres(a), {"units": "m", "long_name":
+                                    f"cell centres along the wall-normal axis {'xyz'[a]}"})
+            else:
+                data[name] = ("time", values)
         limit_names = [n for n in LIMIT_NAMES if len(history.get(f"dt_{n}", [])) == len(t)]
         for name in limit_names:
             data[f"dt_{name}"] = ("time", np.asarray(history[f"dt_{name}"], dtype=float))
-        data["tau"] = ("time", np.asarray(tau_of_t(t, self.phys, self.phi0, self.theta0), dtype=float))
-        ds = xr.Dataset(data, coords={"time": t, "axis": list("xyz"[: self.grid.ndim])})
+        if cooling:
+            data["tau"] = ("time", np.asarray(tau_of_t(t, self.phys, self.phi0, self.theta0), dtype=float))
+        ds = xr.Dataset(data, coords=coords)
         units = {"time": "s", "theta_mean": "m2 s-2", "theta_haff": "m2 s-2", "theta_min": "m2 s-2",
                  "kinetic_energy": "m2 s-2", "ke_transverse": "m2 s-2", "ke_longitudinal": "m2 s-2",
                  "tau": "1", "density_variance": "1", "phi_max": "1", "mode_density": "1", "mode_velocity": "1"}
         units.update({f"dt_{name}": "s" for name in limit_names})
+        units.update({name: CASE_UNITS[name] for name in CASE_COLUMNS[self.case]})
         for name, unit in units.items():
-            ds[name].attrs["units"] = unit
+            if name in ds:
+                ds[name].attrs["units"] = unit
         ds.attrs.update(run_metadata(
             self.model, config=self.cfg.model_dump(mode="json"), box_lengths_m=list(self.grid.lengths),
             haff_time_s=self.t_haff, mean_free_path_m=float(mean_free_path(self.phi0, self.phys.diameter)),
             steps=steps if steps is not None else getattr(self, "steps", None),
         ))
+        if not cooling:
+            ds.attrs.update({"case": self.case, "boundaries": describe_boundaries(self.grid),
+                             "shear_rate_per_s": shear_rate(self.grid)})
         ds.attrs.update(self.run_summary(history))
         return ds
 
@@ -572,11 +612,13 @@ class _Progress:
     """
 
     def __init__(self, enabled: bool, t_end: float, t_haff: float, phys: Physics, phi0: float, theta0: float,
-                 clock: Callable[[], float] = _time.perf_counter) -> None:
+                 clock: Callable[[], float] = _time.perf_counter, cooling: bool = True) -> None:
         self.enabled, self.t_end = enabled, t_end
         self.args = (phys, phi0, theta0)
         self.clock = clock
-        self.tau_end = float(tau_of_t(t_end, *self.args))
+        # A sheared case has no Haff clock; its steps are about equally long in t.
+        self._tau = (lambda t: float(tau_of_t(t, *self.args))) if cooling else float
+        self.tau_end = self._tau(t_end)
         self._steps, self._wall, self._first = 0, 0.0, True
         self._start: tuple[float, float] | None = None  # (τ, clock) at the end of the first chunk
         self.remaining: float | None = None  # seconds, once two chunks have run
@@ -594,7 +636,7 @@ class _Progress:
         return self
 
     def update(self, t: float, steps: int, wall: float) -> None:
-        tau = float(tau_of_t(t, *self.args))
+        tau = self._tau(t)
         now = self.clock()
         if self._first:  # the first chunk includes compilation: keep it out of the step rate and the ETA
             self._first = False

@@ -1,4 +1,4 @@
-"""Collisional energy sink −(3/2)ρθζ, ζ = ζ0 + ζ_U∇·u (model.md §1).
+"""Sources: the collisional energy sink −(3/2)ρθζ, ζ = ζ0 + ζ_U∇·u (model.md §1), and a body force.
 
 The sink is integrated explicitly, together with the convective fluxes.  Each SSP-RK3 stage is
 a convex combination of forward-Euler steps, and a forward-Euler step of dθ/dt = −ζθ keeps θ
@@ -20,3 +20,14 @@ def cooling_source(W: Any, divu: Any, phys: Physics, r: Reduced) -> tuple[Any, A
     rho, theta = W[0], W[4]
     zeta = phys.cooling_rate(rho, theta, divu, r)
     return -1.5 * rho * theta * zeta, zeta
+
+
+def body_force(W: Any, phys: Physics) -> tuple[tuple[Any, Any, Any], Any]:
+    """Momentum source ρg [N/m³] per component and its power ρg·u [W/m³] (gravity at any angle).
+
+    ``phys.gravity`` = (g_x, g_y, g_z) per unit mass; explicit, like the convective terms.
+    """
+    rho, u = W[0], W[1:4]
+    g = phys.gravity
+    force = tuple(rho * g[j] for j in range(3))
+    return force, sum(f * v for f, v in zip(force, u))

@@ -35,11 +35,11 @@ from typing import Any
 import jax
 import jax.numpy as jnp
 
-from .fluxes import LIMITERS, RIEMANN_SOLVERS, flux_divergence, materialise
+from .fluxes import LIMITERS, RIEMANN_SOLVERS, cell_divergence, flux_divergence, materialise, pad_fields
 from .grid import Grid
 from .imex import EXPLICIT_WEIGHTS, GAMMA, IMPLICIT_WEIGHTS, implicit_stage
 from .physics import Physics
-from .sources import cooling_source
+from .sources import body_force, cooling_source
 from .state import primitive_fields
 
 STATUS_MESSAGES = {
@@ -122,25 +122,30 @@ class Numerics:
             raise InputError(f"time scheme {self.scheme!r} is not valid: choose one of {SCHEMES}")
 
 
-def explicit_rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, viscous: bool, r: Any = None) -> list[Any]:
-    """−∇·F + S: the convective flux and sink (+ viscous and heat flux if ``viscous``).
+def explicit_rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, viscous: bool, r: Any = None,
+                 t: Any = 0.0) -> list[Any]:
+    """−∇·F + S: the convective flux, sink and body force (+ viscous and heat flux if ``viscous``).
 
-    ``r``: cell coefficients of ρ already evaluated (the closures run once per cell and stage).
+    ``r``: cell coefficients of ρ already evaluated (the closures run once per cell and stage);
+    ``t``: the time (of the moving boundaries).
     """
     W = materialise(primitive_fields(U))
     if r is None:
         r = phys.reduced(W[0])
     eos = (r.p, phys.sound_factor(r))
     transport = phys.transport(W[0], W[4], r) if viscous else ()
-    dU, divu = flux_divergence(W, (eos, transport), grid, phys, num.limiter, num.riemann, viscous=viscous)
+    dU, divu = flux_divergence(W, (eos, transport), grid, phys, num.limiter, num.riemann, viscous=viscous, t=t)
     source, _ = cooling_source(W, divu, phys, r)
     dU[4] = dU[4] + source
+    if phys.gravity is not None:
+        force, power = body_force(W, phys)
+        dU = [dU[0], *(d + f for d, f in zip(dU[1:4], force)), dU[4] + power]
     return dU
 
 
-def rhs(U: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
+def rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> Any:
     """dU/dt = −∇·F(U) + S(U) (all terms)."""
-    return tuple(explicit_rhs(U, grid, phys, num, viscous=True))
+    return tuple(explicit_rhs(U, grid, phys, num, viscous=True, t=t))
 
 
 def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None) -> Any:
@@ -158,7 +163,10 @@ def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None)
     # max|ζ| ≤ max ζ0 + max|ζ_U| max|∇·u|, and the central ∇·u obeys
     # |∇·u| ≤ Σ_a (max u_a − min u_a)/(2Δx_a): plain reductions only, since a stencil inside
     # XLA's CPU reduction loop makes it an order of magnitude slower.
-    divu_bound = sum((jnp.max(u[a]) - jnp.min(u[a])) * (0.5 / grid.spacing[a]) for a in range(grid.ndim))
+    if grid.boundaries is None or grid.boundaries.all_periodic:
+        divu_bound = sum((jnp.max(u[a]) - jnp.min(u[a])) * (0.5 / grid.spacing[a]) for a in range(grid.ndim))
+    else:  # a mean shear makes max u − min u large; the central ∇·u itself (any time: only its size matters)
+        divu_bound = jnp.max(jnp.abs(cell_divergence(pad_fields(u, grid, velocity=0), grid)))
     zeta = jnp.max(phys.cooling_rate(rho, theta, 0.0, r)) + jnp.max(jnp.abs(r.zeta_u)) * divu_bound
     return jnp.stack([num.cfl / jnp.max(wave), viscous, conductive, num.cfl_source / zeta])
 
@@ -172,23 +180,24 @@ def stable_dt(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None) -
     return jnp.minimum(dt, num.dt_max)
 
 
-def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> Any:
+def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> Any:
     """One SSP-RK3 step of size dt.
 
     Written as three stages U_{k+1} = a_k U + (1 − a_k)(U_k + Δt L(U_k)), a = (0, 3/4, 1/3),
     in a ``fori_loop`` so the right-hand side is traced (and compiled) once, not three times.
     """
     coef = jnp.asarray([0.0, 0.75, 1.0 / 3.0], dtype=U[0].dtype)
+    when = jnp.asarray([0.0, 1.0, 0.5], dtype=jnp.result_type(t, float))  # stage times / Δt
 
     def stage(k: Any, Uk: tuple) -> tuple:
         a = coef[k]
-        L = rhs(Uk, grid, phys, num)
+        L = rhs(Uk, grid, phys, num, t + when[k] * dt)
         return tuple(a * u + (1.0 - a) * (uk + dt * l) for u, uk, l in zip(U, Uk, L))
 
     return jax.lax.fori_loop(0, 3, stage, tuple(U))
 
 
-def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> tuple[Any, Any]:
+def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> tuple[Any, Any]:
     """One ARS(2,2,2) step (:mod:`.imex`); returns the state and the worst solve residual / tolerance.
 
     The two implicit stages run in a ``fori_loop`` (traced once); the closures are evaluated
@@ -199,10 +208,14 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> tupl
     wE = jnp.asarray(EXPLICIT_WEIGHTS, dtype)
     wI = jnp.asarray(IMPLICIT_WEIGHTS, dtype)
     Un = tuple(U)
+    t = jnp.asarray(t, jnp.result_type(t, float))
+    # Times of the explicit evaluation (Uⁿ, U₂) and of the implicit solve (U₂, U₃) of each stage.
+    t_explicit = t + jnp.asarray([0.0, GAMMA], t.dtype) * dt
+    t_implicit = t + jnp.asarray([GAMMA, 1.0], t.dtype) * dt
 
     def stage(k: Any, carry: tuple) -> tuple:
         Uk, rk, KE1, KI2, worst = carry
-        KE = explicit_rhs(Uk, grid, phys, num, viscous=False, r=rk)
+        KE = explicit_rhs(Uk, grid, phys, num, viscous=False, r=rk, t=t_explicit[k])
         KE1 = tuple(jnp.where(k == 0, a, b) for a, b in zip(KE, KE1))
         Uhat = tuple(u + dt * (wE[k, 0] * e1 + wE[k, 1] * e + wI[k] * i2)
                      for u, e1, e, i2 in zip(Un, KE1, KE, KI2))
@@ -211,7 +224,8 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> tupl
         Uhat64 = tuple(u.astype(jnp.float64) for u in Uhat)
         r = phys.reduced(Uhat64[0])
         Ui, fI, res = implicit_stage(Uhat64, GAMMA * jnp.asarray(dt, jnp.float64), grid, phys, r,
-                                     jnp.asarray(num.implicit_tol, jnp.float64), num.implicit_maxiter, num.sweeps)
+                                     jnp.asarray(num.implicit_tol, jnp.float64), num.implicit_maxiter, num.sweeps,
+                                     t_implicit[k])
         r = jax.tree_util.tree_map(lambda x: jnp.asarray(x).astype(dtype), r)
         return tuple(u.astype(dtype) for u in Ui), r, KE1, \
             tuple(jnp.broadcast_to(f, Un[0].shape).astype(dtype) for f in fI), jnp.maximum(worst, res.astype(dtype))
@@ -223,11 +237,11 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> tupl
     return Ui, worst
 
 
-def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> tuple[Any, Any]:
-    """One step of the configured scheme: (state, implicit residual / tolerance — 0 for SSP-RK3)."""
+def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> tuple[Any, Any]:
+    """One step of the configured scheme from time t: (state, implicit residual / tolerance — 0 for SSP-RK3)."""
     if num.scheme == "imex":
-        return imex_step(U, dt, grid, phys, num)
-    return ssprk3_step(U, dt, grid, phys, num), jnp.zeros((), U[0].dtype)
+        return imex_step(U, dt, grid, phys, num, t)
+    return ssprk3_step(U, dt, grid, phys, num, t), jnp.zeros((), U[0].dtype)
 
 
 #: CPU time of one IMEX step over one SSP-RK3 step, measured (RET at φ = 0.5 with Δx = ℓ, 32³:
@@ -287,7 +301,7 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         dt_stable = stable_dt(U, grid, phys, num).astype(t.dtype)
         last = dt_stable >= t_end - t
         dt = jnp.where(last, t_end - t, dt_stable)
-        U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num)
+        U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t)
         bad_state = state_status(U_new, phys)
         status = jnp.where(bad_state != 0, bad_state, jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5))
         status = jnp.where((status == 0) & ~(residual <= RESIDUAL_FAIL), 6, status)
@@ -305,9 +319,9 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
 
 
 @jax.jit
-def step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics) -> tuple[Any, Any]:
+def step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> tuple[Any, Any]:
     """One step (compiled) and its implicit residual / tolerance, to reproduce a failed step for its diagnosis."""
-    U_new, residual = scheme_step(tuple(U), dt, grid, phys, num)
+    U_new, residual = scheme_step(tuple(U), dt, grid, phys, num, t)
     return jnp.stack(U_new), residual
 
 

@@ -1,0 +1,338 @@
+"""Boundary conditions of the finite-volume solver as data: one kind per grid axis.
+
+Every stencil of :mod:`.fluxes` and :mod:`.imex` reads fields padded with :data:`~.fluxes.GHOST`
+ghost cells per side; the boundaries only decide what the ghost cells hold (:func:`pad`).
+
+``periodic``
+    The ghost cells are the cells at the other end of the axis (the cooling box; the code path
+    is the one of :func:`~.fluxes.pad_periodic`, so periodic runs are unchanged bit for bit).
+``lees-edwards``
+    Shearing-periodic images (Lees & Edwards 1972, *J. Phys. C* 5, 1921): along the gradient
+    axis a (length L_a) the image boxes above and below move with velocity ±γ̇L_a along the
+    flow direction f and are displaced by ±Δ(t), Δ = γ̇L_a t mod L_f.  A ghost cell above the
+    box at position x_f holds the state of the cell it images,
+
+        W(x_f, L_a + s) = W(x_f − Δ, s) + γ̇L_a e_f      (below: W(x_f + Δ, L_a − s) − γ̇L_a e_f)
+
+    with the velocity jump on the flow component only (ρ, θ and the closures are unchanged).
+    Δ is not a whole number of cells: the image is interpolated linearly between the two
+    cells it straddles (second order, like the reconstruction).  If the flow direction is not
+    a grid axis (a 1D grid along the gradient, or a 2D grid x–y with flow along z) there is no
+    displacement to make and only the jump remains.  Uniform shear u_f = γ̇(x_a − L_a/2) is then
+    an exact steady solution of the discrete momentum balance (a linear profile continues
+    across the boundary).
+
+``wall``
+    Both ends of the axis are walls (:class:`WallSide`: a :class:`ktgf.couette.walls.Wall` and
+    its velocity), the Johnson & Jackson (1987, *J. Fluid Mech.* 176, 67) conditions of the 1D
+    Couette solver, evaluated by the same functions (:mod:`ktgf.couette.walls`).  With n the
+    normal into the medium, u_sl = u − U_w the slip at the wall and c = ρ_s (π√3/6) φ'(φ/φ_pk)χ√θ:
+
+        η ∂u_t/∂n = c u_sl,t        (tangential momentum: shear stress of the wall)
+        u_n = 0                     (no flux through the wall)
+        −q·n = D − G,  D = ρ_s (π√3/(4φ_pk))(1 − e_w²) φχθ^{3/2},  G = c|u_sl|²
+
+    The convective flux through the wall face is the HLL flux between the medium's face state
+    (reconstructed with a one-sided slope in the wall cell) and its mirror image (u_n odd): no
+    mass, tangential momentum or energy crosses the wall, the normal momentum flux is
+    ρu_n² + p − sρu_n (s = |u_n| + c: the wall pressure, p at rest) (:func:`~.fluxes.wall_flux`).
+    The viscous and heat fluxes see ghost cells that make the central face fluxes equal to the
+    conditions: the face velocity u_f solves η_f(u_c − u_f)/(Δ/2) = c(u_f − U_w) (u_c the wall
+    cell), u_ghost = 2u_f − u_c, and θ_ghost = θ_c − Δ(D − G)/κ_f, so the discrete wall stress is
+    exactly c(u_f − U_w) and the heat flux exactly D − G (η_f, κ_f: the face coefficients of the
+    fluxes, the mean of the wall cell and a limited linear extrapolation).  φ and θ in c, D and G are the values
+    at the wall extrapolated from the two nearest cells (second order), the slip the face u_f.
+    ``momentum = "prescribed"`` (no slip, c → ∞) and ``"free-slip"`` (c = 0), ``energy =
+    "adiabatic"`` (q·n = 0) and ``"prescribed"`` (θ_ghost = 2θ_w − θ_c) are the limits.
+
+Affine parts.  The Lees–Edwards velocity jump, the wall velocity and the wall heat flux G are the
+affine part of the boundary: an operator linear in the velocity or θ (the implicit operators of
+the IMEX stage solves) is applied with ``affine=False`` and the rest goes into its right-hand
+side (:func:`~.imex.implicit_stage`).  In those solves the coefficients c and D/θ of the walls
+are frozen with the transport coefficients (at the sweep's θ), so D is linear in θ there.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import jax
+import jax.numpy as jnp
+
+PERIODIC = "periodic"
+LEES_EDWARDS = "lees-edwards"
+WALL = "wall"
+KINDS = (PERIODIC, LEES_EDWARDS, WALL)
+AXES = "xyz"
+#: Wall conditions the 3D solver applies (of :mod:`ktgf.couette.walls`).
+WALL_MOMENTUM = ("johnson-jackson", "prescribed", "free-slip")
+WALL_ENERGY = ("johnson-jackson", "adiabatic", "prescribed")
+
+
+@dataclass(frozen=True)
+class WallSide:
+    """One wall of the solver: its conditions (:class:`ktgf.couette.walls.Wall`) and velocity [m/s]."""
+
+    wall: Any
+    velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@jax.tree_util.register_pytree_node_class
+@dataclass(frozen=True)
+class Boundaries:
+    """Boundary kind of every grid axis, and the Lees–Edwards shear if there is one.
+
+    A JAX pytree: the kinds and the flow component are static, the shear rate a traced leaf.
+
+    Parameters
+    ----------
+    kinds : tuple of str
+        One of :data:`KINDS` per grid axis.
+    shear_rate : float
+        Lees–Edwards shear rate γ̇ [1/s] (du_f/dx_a of the images).
+    flow : int
+        Velocity component of the Lees–Edwards flow direction (0, 1, 2 = x, y, z; not the gradient axis).
+    walls : tuple
+        Per axis: None, or (lower, upper) :class:`WallSide` of a ``wall`` axis.
+    """
+
+    kinds: tuple[str, ...]
+    shear_rate: float = 0.0
+    flow: int = 0
+    walls: tuple = ()
+
+    def __post_init__(self) -> None:
+        from ..errors import InputError
+
+        kinds = tuple(self.kinds)
+        object.__setattr__(self, "kinds", kinds)
+        for a, k in enumerate(kinds):
+            if k not in KINDS:
+                raise InputError(f"boundary kind {k!r} on axis {AXES[a]} is unknown; valid: {', '.join(KINDS)}")
+        if kinds.count(LEES_EDWARDS) > 1:
+            raise InputError("at most one axis can be Lees-Edwards (one shear-gradient direction)")
+        if LEES_EDWARDS in kinds:
+            a = kinds.index(LEES_EDWARDS)
+            if self.flow == a or not 0 <= self.flow <= 2:
+                raise InputError(f"Lees-Edwards flow direction {AXES[self.flow] if 0 <= self.flow <= 2 else self.flow} "
+                                 f"must differ from the gradient axis {AXES[a]}")
+            if self.flow < len(kinds) and kinds[self.flow] != PERIODIC:
+                raise InputError(f"Lees-Edwards flow axis {AXES[self.flow]} must be periodic")
+        walls = tuple(self.walls) or (None,) * len(kinds)
+        object.__setattr__(self, "walls", walls)
+        for a, k in enumerate(kinds):
+            if (k == WALL) != (walls[a] is not None):
+                raise InputError(f"axis {AXES[a]}: a wall axis needs its two walls (lower, upper), other axes none")
+            for side in walls[a] or ():
+                w = side.wall
+                if w.momentum not in WALL_MOMENTUM or w.energy not in WALL_ENERGY:
+                    raise InputError(f"wall conditions {w.momentum!r}/{w.energy!r} on axis {AXES[a]}: the 3D solver "
+                                     f"applies momentum {', '.join(WALL_MOMENTUM)} and energy {', '.join(WALL_ENERGY)}")
+                if w.momentum == "prescribed" and w.slip != 0.0:
+                    raise InputError(f"wall slip = {w.slip:g} on axis {AXES[a]}: the 3D solver's prescribed wall is "
+                                     "no-slip (slip = 0)")
+                if w.heat_flux != "total":
+                    raise InputError(f"wall heat_flux = {w.heat_flux!r} on axis {AXES[a]}: the 3D solver applies the "
+                                     "JJ energy condition to the whole heat flux (heat_flux = 'total')")
+                if side.velocity[a] != 0.0:
+                    raise InputError(f"wall velocity {side.velocity} on axis {AXES[a]} has a normal component: "
+                                     "walls move tangentially")
+    def tree_flatten(self) -> tuple[tuple, tuple]:
+        return (self.shear_rate,), (self.kinds, self.flow, self.walls)
+
+    @classmethod
+    def tree_unflatten(cls, aux: tuple, leaves: tuple) -> Boundaries:
+        obj = object.__new__(cls)
+        object.__setattr__(obj, "kinds", aux[0])
+        object.__setattr__(obj, "flow", aux[1])
+        object.__setattr__(obj, "walls", aux[2])
+        object.__setattr__(obj, "shear_rate", leaves[0])
+        return obj
+
+    @property
+    def all_periodic(self) -> bool:
+        return all(k == PERIODIC for k in self.kinds)
+
+    @property
+    def shear_axis(self) -> int | None:
+        """The Lees–Edwards gradient axis, or None."""
+        return self.kinds.index(LEES_EDWARDS) if LEES_EDWARDS in self.kinds else None
+
+    @property
+    def wall_axes(self) -> tuple[int, ...]:
+        return tuple(a for a, k in enumerate(self.kinds) if k == WALL)
+
+
+def _shifted(f: Any, s: Any, axis: int) -> Any:
+    """f(i − s) along ``axis`` (periodic), linear interpolation for a fractional s ≥ 0."""
+    k = jnp.floor(s)
+    w = (s - k).astype(f.dtype)
+    k = k.astype(jnp.int32)
+    return (1.0 - w) * jnp.roll(f, k, axis=axis) + w * jnp.roll(f, k + 1, axis=axis)
+
+
+def _lees_edwards(f: Any, grid: Any, t: Any, jump: Any, G: int) -> Any:
+    """f with G Lees–Edwards ghost layers on each side of the gradient axis (others not yet padded)."""
+    bc = grid.boundaries
+    a = bc.shear_axis
+    n = grid.cells[a]
+    U = bc.shear_rate * grid.lengths[a]
+    low = jax.lax.slice_in_dim(f, n - G, n, axis=a)  # images of the top cells below the box
+    high = jax.lax.slice_in_dim(f, 0, G, axis=a)     # images of the bottom cells above the box
+    fl = bc.flow
+    if fl < grid.ndim:
+        # Δ/Δx_f in cells, reduced modulo the period in float64 (t can be large).
+        s = jnp.mod(jnp.asarray(U, jnp.float64) * jnp.asarray(t, jnp.float64) / grid.lengths[fl], 1.0) * grid.cells[fl]
+        high = _shifted(high, s, fl)
+        low = _shifted(low, -s + grid.cells[fl], fl)
+    if jump is not None:
+        high = high + jnp.asarray(jump * U, f.dtype)
+        low = low - jnp.asarray(jump * U, f.dtype)
+    return jnp.concatenate([low, f, high], axis=a)
+
+
+def _side(f: Any, axis: int, n: int, side: int, layer: int) -> Any:
+    """The cell ``layer`` away from wall ``side`` (0 lower, 1 upper), kept as a slab of width 1."""
+    i = layer if side == 0 else n - 1 - layer
+    return jax.lax.slice_in_dim(f, i, i + 1, axis=axis)
+
+
+def _extrapolated(layers: Sequence[Any], G: int, positive: bool) -> list[Any]:
+    """Ghost layers continuing the two wall cells linearly; for a positive field (ρ, θ, closures)
+    the first is kept within [f_0/2, 3f_0/2], so face means stay positive."""
+    f0, f1 = layers[0], layers[1]
+    g0 = 2.0 * f0 - f1
+    if positive:
+        g0 = jnp.clip(g0, 0.5 * f0, 1.5 * f0)
+    return [f0 + (g + 1) * (g0 - f0) for g in range(G)]
+
+
+def wall_face(f: Any, axis: int, n: int, side: int) -> Any:
+    """The face value at wall ``side`` of a positive cell field as the fluxes see it: the mean of the
+    wall cell and its :func:`_extrapolated` ghost (the coefficients η, κ at the wall)."""
+    layers = [_side(f, axis, n, side, g) for g in range(2)]
+    return 0.5 * (layers[0] + _extrapolated(layers, 1, positive=True)[0])
+
+
+def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any], grid: Any, phys: Any) -> dict:
+    """Ghost-cell coefficients of every wall, from the state (θ: the temperature of the coefficients).
+
+    Per (axis, side): ``ratio``, ``offset`` (3 components) with u_ghost = ratio_j u_c + offset_j;
+    ``heat`` = (a, g) with θ_ghost = θ_c − Δ(a θ_w − g)/κ_f, θ_w = (3θ_0 − θ_1)/2, a = D/θ_w and
+    g = G (κ_f, and η_f in the velocity ghosts, are the wall-face coefficients the fluxes use);
+    ``stress`` = η∂u/∂n = c(u_f − U_w) and ``slip`` = u_f − U_w per component (diagnostics).
+    The coefficients depend on ``theta`` and on u; :func:`pad` applies them.
+    """
+    from ..couette.walls import jj_dissipation, jj_friction
+
+    bc = grid.boundaries
+    rho_s = phys.material_density
+    eta, kappa = transport[0], transport[2]
+    out = {}
+    for a in bc.wall_axes:
+        n, h = grid.cells[a], grid.spacing[a]
+        for side, ws in enumerate(bc.walls[a]):
+            wall = ws.wall
+            c0, c1 = (_side(x, a, n, side, 0) for x in (rho, theta)), (_side(x, a, n, side, 1) for x in (rho, theta))
+            (r0, t0), (r1, t1) = c0, c1
+            phi_w = jnp.clip((1.5 * r0 - 0.5 * r1) / rho_s, 0.5 * r0 / rho_s, 2.0 * r0 / rho_s)
+            theta_w = jnp.clip(1.5 * t0 - 0.5 * t1, 0.5 * t0, 2.0 * t0)
+            chi = phys.model.chi(phi_w)
+            beta = 2.0 * wall_face(eta, a, n, side) / h  # the face η of the viscous flux
+            if wall.momentum == "johnson-jackson":
+                c = rho_s * jj_friction(wall, phi_w, chi, theta_w)
+                ratio_t, weight = (beta - c) / (beta + c), 2.0 * c / (beta + c)
+            elif wall.momentum == "prescribed":
+                ratio_t, weight = -jnp.ones_like(beta), 2.0 * jnp.ones_like(beta)
+                c = None
+            else:
+                ratio_t, weight = jnp.ones_like(beta), jnp.zeros_like(beta)
+                c = jnp.zeros_like(beta)
+            ratio = tuple(-jnp.ones_like(beta) if j == a else ratio_t for j in range(3))
+            offset = tuple(jnp.zeros_like(beta) if j == a else weight * ws.velocity[j] for j in range(3))
+            uc = [_side(x, a, n, side, 0) for x in u]
+            u_face = [0.5 * (uc[j] * (1.0 + ratio[j]) + offset[j]) for j in range(3)]
+            slip = tuple(jnp.zeros_like(beta) if j == a else u_face[j] - ws.velocity[j] for j in range(3))
+            if c is None:  # no slip: the stress is the viscous one, η(u_c − u_f)/(Δ/2) toward the medium
+                stress = tuple(beta * (uc[j] - u_face[j]) if j != a else jnp.zeros_like(beta) for j in range(3))
+            else:
+                stress = tuple(c * s_ for s_ in slip)
+            if wall.energy == "johnson-jackson":
+                d_over_theta = rho_s * jj_dissipation(wall, phi_w, chi, theta_w) / theta_w
+                work = sum(st * sl for st, sl in zip(stress, slip)) if c is not None else jnp.zeros_like(beta)
+                heat = ("jj", d_over_theta, work)
+            elif wall.energy == "prescribed":
+                heat = ("fixed", jnp.full_like(beta, wall.temperature), jnp.zeros_like(beta))
+            else:
+                heat = ("adiabatic", jnp.zeros_like(beta), jnp.zeros_like(beta))
+            out[a, side] = {"ratio": ratio, "offset": offset, "heat": heat[1:], "stress": stress, "slip": slip,
+                            "kappa": wall_face(kappa, a, n, side)}
+    return out
+
+
+def _wall_ghosts(f: Any, grid: Any, a: int, G: int, role: Any, terms: dict | None, affine: bool) -> Any:
+    """f with G ghost layers on each side of wall axis a.
+
+    ``role``: "even" (ρ, closures), ("u", j) a velocity component, "theta"; ``terms`` None: the
+    ghosts of the convective fluxes (a linear extrapolation: the wall cell's slope is one-sided;
+    the wall face flux itself is :func:`~.fluxes.wall_flux`), else the viscous ghosts.
+    """
+    n, h = grid.cells[a], grid.spacing[a]
+    bc = grid.boundaries
+    slabs = []
+    for side in (0, 1):
+        layers = [_side(f, a, n, side, g) for g in range(G)]
+        if terms is None:  # convective and coefficients: extrapolation (one-sided slope in the wall cell)
+            ghost = _extrapolated(layers, G, positive=not isinstance(role, tuple))
+        elif role == "even":
+            ghost = layers
+        elif role == "theta":
+            T = terms[a, side]
+            kind = bc.walls[a][side].wall.energy
+            t0, t1 = layers[0], layers[1]
+            if kind == "johnson-jackson":
+                d_over_theta, work = T["heat"]
+                theta_w = 1.5 * t0 - 0.5 * t1
+                g0 = t0 - h * (d_over_theta * theta_w - (work if affine else 0.0)) / T["kappa"]
+            elif kind == "prescribed":
+                g0 = -t0 + (2.0 * T["heat"][0] if affine else 0.0)
+            else:
+                g0 = t0
+            ghost = [g0] + [t0 + g0 - layers[g] for g in range(1, G)]
+        else:
+            T = terms[a, side]
+            j = role[1]
+            g0 = T["ratio"][j] * layers[0] + (T["offset"][j] if affine else 0.0)
+            ghost = [g0] + [layers[0] + g0 - layers[g] for g in range(1, G)]
+        ghost = ghost[::-1]  # outermost first
+        slabs.append(ghost if side == 0 else ghost[::-1])
+    return jnp.concatenate([*slabs[0], f, *slabs[1]], axis=a)
+
+
+def pad(fields: Sequence[Any], grid: Any, G: int, t: Any = 0.0, velocity: int | None = None,
+        affine: bool = True, theta: int | None = None, walls: dict | None = None) -> tuple[Any, ...]:
+    """Fields with G ghost cells per side of every grid axis, filled as the boundaries say.
+
+    ``velocity``: index in ``fields`` of the x velocity component (the three components follow
+    it), so that the Lees–Edwards jump and the wall conditions reach them; None if the fields
+    hold no velocity.  ``theta``: index of θ (wall heat conditions).  ``walls``: the
+    :func:`wall_terms` of the viscous and heat fluxes, or None for the extrapolated ghosts of the
+    convective fluxes and of the cell coefficients.  ``affine=False`` leaves out the affine parts (the linear part of the operator).
+    """
+    bc = grid.boundaries
+    ndim = grid.ndim
+    if bc is None or bc.all_periodic:
+        return tuple(jnp.pad(f, [(G, G)] * ndim, mode="wrap") for f in fields)
+    out = []
+    for i, f in enumerate(fields):
+        is_velocity = velocity is not None and 0 <= i - velocity < 3
+        role = ("u", i - velocity) if is_velocity else ("theta" if i == theta else "even")
+        for a in bc.wall_axes:
+            f = _wall_ghosts(f, grid, a, G, role, walls, affine)
+        if bc.shear_axis is not None:
+            f = _lees_edwards(f, grid, t, 1.0 if (is_velocity and affine and i == velocity + bc.flow) else None, G)
+        widths = [(0, 0) if b == bc.shear_axis or bc.kinds[b] == WALL else (G, G) for b in range(ndim)]
+        out.append(jnp.pad(f, widths, mode="wrap"))
+    return tuple(out)
