@@ -123,7 +123,7 @@ def stability(
     check_range("solid fraction phi", phis, low=PHI_MIN, why="L/d grows like 1/phi: it overflows in the dilute limit")
     rows = []
     for m in _models(model, model_file):
-        r = m.reduced(phis, es)
+        r = m.reduced(phis, es, hcs=True)
         if method == "closed":
             k_perp, k_par = critical_wavenumbers(r)
         else:

@@ -127,7 +127,7 @@ class Model:
         check_state(phi, e, theta, phi_max=self.phi_max, rdf_name=self.rdf.describe())
         self.friction.check_state(e)
 
-    def reduced(self, phi: Any, e: Any, *, check: bool = True, shear: Any = None) -> Reduced:
+    def reduced(self, phi: Any, e: Any, *, check: bool = True, shear: Any = None, hcs: bool = False) -> Reduced:
         """Reduced coefficients at solid fraction φ and restitution e (broadcast together).
 
         Works on NumPy arrays and on JAX arrays (also under ``jit``/``grad``, where the range
@@ -136,31 +136,39 @@ class Model:
         used only by a dissipation correction (extended kinetic theory); without it ζ0 is the
         theory's own.  g and C always refer to the theory's own ζ0 and p* (they serve the HCS,
         where there is no shear).
+
+        ``hcs=True`` gives the homogeneous cooling state's coefficients (``docs/friction.md`` §7): the
+        friction part's HCS dissipation (rotation at its HCS ratio, :meth:`Friction.hcs_zeta0_factor`)
+        instead of the steady-shear one, and no shear (``shear`` must be ``None``: the dissipation
+        correction's correlation length is d there).  Frictionless models: identical to ``hcs=False``.
         """
         if check:
             self.check(phi, e)
+        if hcs and shear is not None:
+            raise InputError("the homogeneous cooling state has no shear: give shear = None with hcs = True")
         phi, e = asarray(phi), asarray(e)
         chi, dchi = self.rdf.chi(phi), self.rdf.dchi(phi)
         r = self.theory.reduced(phi, e, chi, dchi)
         zeta0 = r.zeta0 * self.dissipation.factor(phi, e, chi, shear)
         if self.friction.mu > 0.0:  # frictionless (μ = 0): ζ0 untouched, bit for bit
-            zeta0 = zeta0 * self.friction.zeta0_factor(e)
+            zeta0 = zeta0 * (self.friction.hcs_zeta0_factor(e) if hcs else self.friction.zeta0_factor(e))
         return r._replace(eta=r.eta * self.viscosity.factor(phi), zeta0=zeta0)
 
     def coefficients(
-        self, phi: Any, e: Any, theta: Any, *, d: Any, rho_s: Any, check: bool = True, shear: Any = None
+        self, phi: Any, e: Any, theta: Any, *, d: Any, rho_s: Any, check: bool = True, shear: Any = None,
+        hcs: bool = False,
     ) -> Dimensional:
         """SI coefficients (p [Pa], η, λ_b [Pa s], κ, ω, ζ0 [1/s], ζ_U) at (φ, e, θ [m²/s²]).
 
         ``d`` is the particle diameter [m] and ``rho_s`` the material density [kg/m³]; ``shear``
-        the local dγ̇/√θ for a dissipation correction (see :meth:`reduced`).
+        the local dγ̇/√θ for a dissipation correction; ``hcs`` the homogeneous cooling state (see :meth:`reduced`).
         """
         theta = asarray(theta)
         if check:
             self.check(phi, e, theta)
             check_positive("particle diameter d", d, "m")
             check_positive("material density rho_s", rho_s, "kg/m^3")
-        return to_dimensional(self.reduced(phi, e, check=False, shear=shear), asarray(phi), theta, d, rho_s)
+        return to_dimensional(self.reduced(phi, e, check=False, shear=shear, hcs=hcs), asarray(phi), theta, d, rho_s)
 
     def chi(self, phi: Any) -> Any:
         """The model's radial distribution function χ(φ)."""

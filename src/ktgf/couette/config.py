@@ -82,6 +82,8 @@ class WallConfig(_Strict):
     slip: float | None = None
     temperature: float | None = Field(None, gt=0)
     heat_flux: Literal["total", "conductive"] | None = None
+    friction_angle: float | None = Field(None, ge=0, lt=90, description="wall friction angle delta_w [degrees]")
+    slip_regularisation: float | None = Field(None, gt=0, le=1)
 
     @field_validator("type")
     @classmethod

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from .frictional_stress import frictional_terms
-from .walls import Wall, jj_friction, jj_heat_loss
+from .walls import Wall, jj_friction, jj_frictional_wall_stress, jj_heat_loss
 
 N_VARS = 3  # u, ln θ, ψ per node
 
@@ -100,6 +100,13 @@ class Problem:
             from ..errors import InputError
 
             raise InputError("a model with a frictional stress needs the Couette stress scale rho_s V^2 > 0 (Pa)")
+        for side, wall in zip(("bottom", "top"), self.walls):
+            if wall.friction_angle > 0.0 and not (wall.momentum == "johnson-jackson" and self.model.friction.has_stress):
+                from ..errors import InputError
+
+                raise InputError(f"{side} wall friction_angle = {wall.friction_angle:g} acts on the frictional normal "
+                                 "stress: valid only for a johnson-jackson momentum wall and a model with a frictional "
+                                 "stress (friction option stress)")
 
     # --- fields --------------------------------------------------------------------------
     def unpack(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -161,6 +168,9 @@ class Problem:
             cf = jj_friction(wall, phi[i], chi_w[k], theta[i])
             if wall.momentum == "johnson-jackson":
                 F_wall[k] = sign * self.S_wall[k] * cf * slip[k]
+                if wall.friction_angle > 0.0:  # its work is dissipated at the wall contacts, not fed to θ
+                    scale = wall.slip_regularisation * abs(self.u_wall[1] - self.u_wall[0])
+                    F_wall[k] += sign * self.S_wall[k] * jj_frictional_wall_stress(wall, p_fric[i], slip[k], scale)
             if wall.energy == "johnson-jackson":
                 E_wall[k] = sign * self.B_wall[k] * jj_heat_loss(wall, phi[i], chi_w[k], theta[i], slip[k])
                 if wall.heat_flux == "conductive":  # JJ set κ∂θ/∂n only: add the ω∂φ/∂x part

@@ -7,6 +7,8 @@ momentum
                          (Johnson & Jackson 1987, JFM 176, 67);
     ``prescribed``       the medium moves at the wall speed minus a prescribed lag (``slip``; 0 = no slip);
     ``free-slip``        zero shear stress.
+    A Johnson–Jackson wall with a wall friction angle δ_w > 0 (``friction_angle``) adds the frictional
+    wall traction p_f tan δ_w in the direction of the slip (Johnson & Jackson 1987; :func:`jj_frictional_wall_stress`).
 energy
     ``johnson-jackson``  q·n = G − D into the medium, with
                          D = (π√3/(4φ_pk)) (1 − e_w²) ρ_s φ χ θ^{3/2} (dissipation at the wall) and
@@ -75,6 +77,14 @@ class Wall:
         Prescribed granular temperature at the wall [m²/s²] (``energy="prescribed"``).
     heat_flux : {"total", "conductive"}
         Which flux the JJ energy condition sets (see the module notes).
+    friction_angle : float
+        Wall friction angle δ_w in degrees, 0 ≤ δ_w < 90 (default 0: the collisional JJ wall only).
+        tan δ_w is the particle–wall friction coefficient (MFiX keyword ``PHI_W``: "phi_w = 11.31 means
+        tan_phi_w = mu = 0.2").  It acts on the frictional normal stress p_f, so it needs a model with a
+        frictional stress (friction option ``stress``).
+    slip_regularisation : float
+        ε_w of the frictional traction's direction u_sl/√(u_sl² + (ε_w U)²), U the cell's velocity
+        difference (default 10⁻³, as the frictional viscosity's ``regularisation``).
     """
 
     momentum: Literal["johnson-jackson", "prescribed", "free-slip"] = "johnson-jackson"
@@ -85,6 +95,8 @@ class Wall:
     slip: float = 0.0
     temperature: float | None = None
     heat_flux: Literal["total", "conductive"] = "total"
+    friction_angle: float = 0.0
+    slip_regularisation: float = 1e-3
 
     def __post_init__(self) -> None:
         if self.heat_flux not in HEAT_FLUX_FORMS:
@@ -97,6 +109,10 @@ class Wall:
         check_range("wall restitution coefficient restitution", self.restitution, low=0.0, high=1.0, low_open=True)
         check_range("JJ packing limit packing_limit", self.packing_limit, low=0.0, high=1.0, low_open=True)
         check_range("prescribed wall slip slip", self.slip, why="m/s")
+        check_range("wall friction angle friction_angle", self.friction_angle, low=0.0, high=90.0, high_open=True,
+                    why="degrees")
+        check_range("wall slip regularisation slip_regularisation", self.slip_regularisation, low=0.0, high=1.0,
+                    low_open=True, why="fraction of the cell's velocity difference")
         if self.energy == "prescribed":
             if self.temperature is None:
                 raise InputError("wall temperature is required when the wall energy condition is 'prescribed'")
@@ -138,3 +154,17 @@ def jj_heat_loss(wall: Wall, phi, chi, theta, slip):
     is used, so any tangential sign convention).
     """
     return jj_dissipation(wall, phi, chi, theta) - jj_friction(wall, phi, chi, theta) * slip * slip
+
+
+def jj_frictional_wall_stress(wall: Wall, p_f, slip, slip_scale):
+    """Frictional wall traction τ_w,f = p_f tan δ_w u_sl/√(u_sl² + s²), in the units of ``p_f``.
+
+    Johnson & Jackson (1987), JFM 176, 67, wall condition for the tangential momentum: the frictional
+    (enduring-contact) part of the wall shear stress is the frictional normal stress times the
+    coefficient of wall friction tan δ_w, directed along the slip; the collisional part is
+    :func:`jj_friction`.  (The equation is quoted as MFiX and OpenFOAM users know it, τ_w,f = p_f tan δ_w;
+    the printed paper was not at hand to give its number.)  The slip direction u_sl/|u_sl| is
+    regularised with s = ε_w U (``slip_scale``), as the rate-independent frictional viscosity is
+    (``docs/friction.md`` §8).  Exactly 0 for δ_w = 0.
+    """
+    return p_f * math.tan(math.radians(wall.friction_angle)) * slip / (slip * slip + slip_scale * slip_scale) ** 0.5

@@ -5,6 +5,10 @@ A uniform gas at rest cools as dθ/dt = −ζ0(θ)θ.  Every closure here has ζ
     θ(t) = θ0/(1 + t/t0)²,     t0 = 2/ζ0(θ0)
 
 (Haff, J. Fluid Mech. 134, 401 (1983)).
+
+Frictional models cool with the homogeneous-cooling dissipation of their friction part (``Model.reduced(...,
+hcs=True)``): rotation at its HCS ratio T_rot/T, which the translational temperature θ here drags along
+(Luding, Huthmann, McNamara & Zippelius, Phys. Rev. E 58, 3416 (1998); ``docs/friction.md`` §7).
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ def cooling_rate(model: Model | str, phi: Any, e: Any, theta0: Any, *, d: float)
     model.check(phi, e, theta0)  # on the values as given, so that the error names them
     check_positive("particle diameter d", d, "m")
     phi, e, theta0 = asarray(phi), asarray(e), asarray(theta0)
-    return nu0(phi, theta0, d) * model.reduced(phi, e, check=False).zeta0
+    return nu0(phi, theta0, d) * model.reduced(phi, e, check=False, hcs=True).zeta0
 
 
 def cooling_time(model: Model | str, phi: Any, e: Any, theta0: Any, *, d: float) -> Any:
@@ -86,7 +90,7 @@ def integrate_cooling(
 
     def rhs(_: float, y: np.ndarray) -> np.ndarray:
         theta = np.exp(y[0])
-        return np.array([-float(model.coefficients(phi, e, theta, d=d, rho_s=rho_s, check=False).zeta0)])
+        return np.array([-float(model.coefficients(phi, e, theta, d=d, rho_s=rho_s, check=False, hcs=True).zeta0)])
 
     t_end = float(t.max()) if t.size else 0.0
     if t_end == 0.0:

@@ -37,7 +37,7 @@ def map_block(task: tuple[Model, np.ndarray, np.ndarray]) -> dict[str, np.ndarra
     phi2, e2 = np.meshgrid(np.asarray(phi, dtype=float), np.asarray(e, dtype=float), indexing="ij")
     valid = phi2 < model.phi_max
     # Evaluate beyond the packing limit at a harmless stand-in state, then blank it out.
-    r = model.reduced(np.where(valid, phi2, 0.5 * model.phi_max), e2, check=False)
+    r = model.reduced(np.where(valid, phi2, 0.5 * model.phi_max), e2, check=False, hcs=True)
     k_perp, k_par = (np.broadcast_to(k, phi2.shape) for k in critical_wavenumbers(r))
     out = {
         "k_perp": k_perp,

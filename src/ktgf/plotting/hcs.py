@@ -103,7 +103,7 @@ def plot_dispersion(
     from ..hcs.dispersion import dispersion_relation
     from ..hcs.stability import box_wavenumber, critical_wavenumbers
 
-    r = model.reduced(phi, e)
+    r = model.reduced(phi, e, hcs=True)
     kc = [float(k) for k in critical_wavenumbers(r) if np.isfinite(k) and k > 0]
     if k_max is None:
         k_max = 2.0 * max(kc) if kc else 1.0

@@ -173,6 +173,17 @@ class RoughSphereRestitution(FrictionPart):
         safe = xp.where(coupled, B, 1.0)
         return xp.where(coupled, (A - C + xp.sqrt((A - C) ** 2 + 4.0 * B**2)) / (2.0 * safe), 0.0)
 
+    def hcs_inelasticity(self, e: Any, mu: Any) -> Any:
+        """4(A − B r_HCS): the translational cooling of the HCS in units of the smooth (1 − e²).
+
+        At T_rot = r T the translational balance dT/dτ ∝ −4(A T − B T_rot) (the smooth gas: −(1 − e²) T)
+        makes Haff's law of rough spheres dT/dt = −[4(A − B r)/(1 − e²)] × (smooth cooling rate)
+        (Luding, Huthmann, McNamara & Zippelius 1998; both temperatures decay at this rate).  It equals
+        1 − e² for smooth spheres (B = 0, r = 0).
+        """
+        A, B, _ = self.collision_coefficients(e, mu)
+        return 4.0 * (A - B * self.hcs_rotational_ratio(e, mu))
+
     def check(self, e: Any, mu: Any) -> None:
         """Raise :class:`~ktgf.errors.InputError` for μ < 0."""
         check_friction_coefficient(mu)
@@ -313,6 +324,20 @@ class WaltonRestitution(FrictionPart):
             return 1.0 - float(e) ** 2
         r = self.hcs_rotational_ratio(e, mu)
         return math.nan if math.isinf(r) else -self._energy_changes(e, mu, r)[0]
+
+    def hcs_friction_threshold(self, e: Any, *, mu_high: float = 100.0) -> float:
+        """Smallest μ with a finite HCS ratio at this e (bisection on :meth:`hcs_rotational_ratio`, to 10⁻³).
+
+        Below it :meth:`hcs_rotational_ratio` returns ``inf`` (the drift stays positive to r = 10³); used to
+        state the valid range in error messages.  ``mu_high`` if even that has no finite ratio.
+        """
+        low, high = 0.0, float(mu_high)
+        if math.isinf(self.hcs_rotational_ratio(e, high)):
+            return high
+        while high - low > 1e-3:
+            mid = 0.5 * (low + high)
+            low, high = (mid, high) if math.isinf(self.hcs_rotational_ratio(e, mid)) else (low, mid)
+        return high
 
     def check(self, e: Any, mu: Any) -> None:
         """Raise :class:`~ktgf.errors.InputError` for μ < 0."""

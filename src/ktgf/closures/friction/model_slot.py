@@ -59,6 +59,10 @@ class NoFriction:
         """Multiplier of ζ0*: 1."""
         return 1.0
 
+    def hcs_zeta0_factor(self, e: Any, *, missing: str = "raise") -> Any:
+        """Multiplier of ζ0* in the homogeneous cooling state: 1."""
+        return 1.0
+
     def rotational_ratio(self, e: Any) -> None:
         """T_rot/T is not modelled (no rotation): ``None``."""
         return None
@@ -217,6 +221,34 @@ class Friction:
         factors = np.array([self.law.inelasticity(float(v), self.mu) / (1.0 - float(v) ** 2) for v in uniq])
         out = factors[inverse].reshape(values.shape)
         return float(out) if out.ndim == 0 and not isinstance(e, np.ndarray) else out.astype(values.dtype)
+
+    def hcs_zeta0_factor(self, e: Any, *, missing: str = "raise") -> Any:
+        """(1 − e_HCS²)/(1 − e²): the multiplier of ζ0* in the homogeneous cooling state (Python 1.0 at μ = 0).
+
+        In the HCS translation and rotation cool together at T_rot/T = r_HCS (the law's
+        ``hcs_rotational_ratio``), so the translational cooling is the law's ``hcs_inelasticity`` at that
+        ratio — not the steady-shear e_eff of :meth:`zeta0_factor`, where only translation is heated
+        (``docs/friction.md`` §1, §7).  Walton's rule has no finite HCS ratio at weak friction (e.g. μ ≤ 0.3
+        at e = 0.7): ``missing="raise"`` gives a one-line :class:`~ktgf.errors.InputError`, ``"nan"`` NaN
+        there (maps).  The Chialvo–Sundaresan e_eff is a fit to sheared DEM without rotation: refused.
+        """
+        if self.mu == 0.0:
+            return 1.0
+        if self.restitution == "chialvo-sundaresan-2013":
+            raise InputError("option restitution = 'chialvo-sundaresan-2013' of friction has no homogeneous cooling "
+                             "state (a fit to sheared DEM, no rotation): valid for the HCS: walton, rough-sphere")
+        if isinstance(self.law, RoughSphereRestitution):
+            return self.law.hcs_inelasticity(e, self.mu) / (1.0 - e**2)
+        values = np.asarray(e, dtype=float)
+        uniq, inverse = np.unique(values, return_inverse=True)
+        factors = np.array([self.law.hcs_inelasticity(float(v), self.mu) / (1.0 - float(v) ** 2) for v in uniq])
+        if missing == "raise" and np.isnan(factors).any():
+            bad = float(uniq[np.isnan(factors)][0])
+            raise InputError(f"friction mu = {self.mu:g} has no homogeneous cooling state at e = {bad:g} "
+                             f"(Walton's rule, beta0 = {self.beta0:g}: T_rot/T grows without bound): valid mu >= "
+                             f"{self.law.hcs_friction_threshold(bad):.3g} at this e (docs/friction.md §1)")
+        out = factors[inverse].reshape(values.shape)
+        return float(out) if out.ndim == 0 and not isinstance(e, np.ndarray) else out
 
     def rotational_ratio(self, e: Any) -> Any:
         """T_rot/T of steady homogeneous shear (``None`` if the law does not model rotation; 0 at μ = 0)."""
