@@ -268,6 +268,11 @@ def check_physics(cfg: Config, source: str = "config") -> None:
         model = get_model(cfg.model.name, **cfg.model.options)
     except KtgfError as exc:
         raise InputError(f"{source}: field model.name/options: {exc}") from None
+    if model.friction.key != "none":
+        # The 3D solver has no frictional stress and uses the shear-flow dissipation, which for a
+        # frictional cooling gas is 1.5x the homogeneous-cooling one (docs/friction.md): refuse.
+        raise InputError(f"{source}: field model.name = {cfg.model.name!r}: the 3D solver does not support "
+                         f"friction part {model.friction.key!r} yet (valid: models with friction 'none')")
     phi0 = cfg.initial.solid_fraction
     stop = cfg.numerics.phi_stop if cfg.numerics.phi_stop is not None else 0.99 * model.phi_max
     if phi0 >= model.phi_max:
