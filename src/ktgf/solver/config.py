@@ -117,7 +117,7 @@ class NumericsSection(_Section):
     cfl_source: float = Field(0.5, gt=0.0, lt=1.0)
     limiter: str = "vanleer"
     riemann: str = "hll"
-    precision: Literal["float64", "float32"] = "float64"
+    precision: Literal["float64", "float32", "mixed"] = "float64"
     phi_stop: float | None = Field(None, gt=0.0, lt=1.0, description="stop when max phi reaches this (default 0.99 phi_max)")
     implicit_tol: float = Field(1e-6, gt=0.0, lt=1.0, description="IMEX: relative residual of the stage solves")
     implicit_maxiter: int = Field(5, ge=1, le=100, description="IMEX: Krylov iterations of the stage solves, in tens")

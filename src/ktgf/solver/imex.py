@@ -150,19 +150,98 @@ def _scaled(apply: Any, scale: Any) -> Any:
     return lambda r: apply(r / scale) / scale
 
 
-def _norm(x: Any) -> Any:
-    return jnp.sqrt(sum(jnp.sum(f * f) for f in (x if isinstance(x, tuple) else (x,))))
+def _leaves(x: Any) -> tuple:
+    return x if isinstance(x, tuple) else (x,)
 
 
-def _unit(x: Any) -> Any:
+def _dot(x: Any, y: Any, acc: Any = None) -> Any:
+    """Σ x·y over all cells and components, accumulated in ``acc`` (default: the dtype of x)."""
+    acc = acc or _leaves(x)[0].dtype
+    return sum(jnp.sum(a.astype(acc) * b.astype(acc)) for a, b in zip(_leaves(x), _leaves(y)))
+
+
+def _norm(x: Any, acc: Any = None) -> Any:
+    return jnp.sqrt(_dot(x, x, acc))
+
+
+def _axpy(x: Any, a: Any, y: Any) -> Any:
+    """x + a·y with a (a float64 scalar of the mixed solvers) cast to the dtype of the vectors."""
+    return jax.tree_util.tree_map(lambda u, v: u + a.astype(u.dtype) * v, x, y)
+
+
+def _bicgstab64(A: Any, b: Any, tol: Any, atol: Any, maxiter: int, M: Any) -> Any:
+    """Right-preconditioned BiCGSTAB (van der Vorst 1992) with float32 vectors and float64 inner products.
+
+    The same iteration as ``jax.scipy.sparse.linalg.bicgstab`` (x0 = 0, stop at
+    ‖r‖ ≤ max(tol‖b‖, atol)); only the scalars (inner products, norms, α, ω) are float64.
+    """
+    f8 = jnp.float64
+    stop2 = jnp.maximum(tol * _norm(b, f8), atol) ** 2
+    zero = jax.tree_util.tree_map(jnp.zeros_like, b)
+    one = jnp.ones((), f8)
+
+    def cond(c: tuple) -> Any:
+        _, r, *_, k = c
+        return (_dot(r, r, f8) > stop2) & (k < maxiter)
+
+    def body(c: tuple) -> tuple:
+        x, r, rhat, p, v, rho_old, alpha, omega, k = c
+        rho = _dot(rhat, r, f8)
+        beta = (rho / rho_old) * (alpha / omega)
+        p = _axpy(r, beta, _axpy(p, -omega, v))
+        ph = M(p)
+        v = A(ph)
+        alpha = rho / _dot(rhat, v, f8)
+        s = _axpy(r, -alpha, v)
+        sh = M(s)
+        tv = A(sh)
+        done = _dot(s, s, f8) <= stop2  # converged at the half step: no ω update (ω = 0 would break it)
+        omega = jnp.where(done, one, _dot(tv, s, f8) / _dot(tv, tv, f8))
+        x = _axpy(_axpy(x, alpha, ph), jnp.where(done, 0.0, omega), sh)
+        r = jax.tree_util.tree_map(lambda a, b_: jnp.where(done, a, b_), s, _axpy(s, -omega, tv))
+        return x, r, rhat, p, v, rho, alpha, omega, k + 1
+
+    x, *_ = jax.lax.while_loop(cond, body, (zero, b, b, zero, zero, one, one, one, 0))
+    return x
+
+
+def _cg64(A: Any, b: Any, tol: Any, atol: Any, maxiter: int, M: Any) -> Any:
+    """Preconditioned CG with float32 vectors and float64 inner products (else as ``jax.scipy``'s ``cg``)."""
+    f8 = jnp.float64
+    stop2 = jnp.maximum(tol * _norm(b, f8), atol) ** 2
+    z = M(b)
+
+    def cond(c: tuple) -> Any:
+        _, r, *_, k = c
+        return (_dot(r, r, f8) > stop2) & (k < maxiter)
+
+    def body(c: tuple) -> tuple:
+        x, r, p, gamma, k = c
+        Ap = A(p)
+        alpha = gamma / _dot(p, Ap, f8)
+        x = _axpy(x, alpha, p)
+        r = _axpy(r, -alpha, Ap)
+        z = M(r)
+        gamma_new = _dot(r, z, f8)
+        p = _axpy(z, gamma_new / gamma, p)
+        return x, r, p, gamma_new, k + 1
+
+    x, *_ = jax.lax.while_loop(cond, body, (jnp.zeros_like(b), b, z, _dot(b, z, f8), 0))
+    return x
+
+
+def _unit(x: Any, acc: Any = None) -> Any:
     """The norm of x, or 1 where it is 0 (to solve on a unit right-hand side)."""
-    n = _norm(x)
-    return jnp.where(n > 0, n, 1.0)
+    n = _norm(x, acc)
+    return jnp.where(n > 0, n, 1.0).astype(_leaves(x)[0].dtype)
 
 
 def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced, tol: Any, maxiter: int,
-                   sweeps: int, t: Any = 0.0) -> tuple[tuple, list[Any], Any]:
+                   sweeps: int, t: Any = 0.0, mixed: bool = False) -> tuple[tuple, list[Any], Any]:
     """Solve U = Û + aΔt f_I(U) (see the module docstring) at the stage time ``t``.
+
+    ``mixed``: a float32 stage solved with float32 vectors and float64 inner products, norms and
+    Krylov scalars (:func:`_bicgstab64`, :func:`_cg64`); else everything in the dtype of Û.
 
     Returns the stage state, f_I at it, and the largest relative residual divided by ``tol``.
     Boundaries: the Krylov operators are the linear part of the discrete operator (ghost cells
@@ -186,6 +265,9 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     theta = jnp.clip(theta + adt * heat / (1.5 * rho), 0.5 * theta, 2.0 * theta)
 
     worst = jnp.zeros((), dtype)
+    acc = jnp.float64 if mixed else None
+    solve_m = (lambda *a, **k: (_bicgstab64(*a[:2], **k), None)) if mixed else bicgstab
+    solve_E = (lambda *a, **k: (_cg64(*a[:2], **k), None)) if mixed else cg
     for _ in range(sweeps):
         transport = phys.transport(rho, theta, r)
         Pk = pad_fields(transport, grid, t)
@@ -221,12 +303,12 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         b = tuple(m - a for m, a in zip(m_hat, A(u, True)))  # solve for the correction to the current u
         # Absolute floors from the scale of the state (thermal momentum ρ√θ, energy Ê), not of
         # the correction: in a nearly uniform gas the correction itself is round-off.
-        atol_m = floor * _norm(rho) * jnp.sqrt(jnp.mean(theta))
+        atol_m = floor * _norm(rho, acc) * jnp.sqrt(jnp.mean(theta))
         # BiCGSTAB, not GMRES: jax.scipy's GMRES returned a zero correction for a state of the
         # 0.7 L⊥ paper box late in its decay (θ ~ 5e-13 m²/s², step 1064; BiCGSTAB: residual
         # 0.006 of the limit).  Solved on a unit right-hand side.
-        sb = _unit(b)
-        du, _ = bicgstab(A, tuple(x / sb for x in b), tol=tol, atol=atol_m / sb, maxiter=RESTART * maxiter, M=M)
+        sb = _unit(b, acc)
+        du, _ = solve_m(A, tuple(x / sb for x in b), tol=tol, atol=atol_m / sb, maxiter=RESTART * maxiter, M=M)
         u = tuple(x + sb * dx for x, dx in zip(u, du))
         if walls is not None:  # the wall heat terms need the slip of the new u
             walls = wall_terms(rho, u, theta, transport, grid, phys)
@@ -246,18 +328,19 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         Mh = _scaled(heat_preconditioner(grid, rho_mean, kap_m, adt, dtype), hscale)
         th0 = primitive_fields((rho, *(rho * x for x in u), E_hat))[4]  # θ of Û with the new u
         bE = rhs_E - B(th0)
-        atol_E = floor * _norm(E_hat)
-        sE = _unit(bE)
-        dth, _ = cg(B, bE / sE, tol=tol, atol=atol_E / sE, maxiter=RESTART * maxiter, M=Mh)
+        atol_E = floor * _norm(E_hat, acc)
+        sE = _unit(bE, acc)
+        dth, _ = solve_E(B, bE / sE, tol=tol, atol=atol_E / sE, maxiter=RESTART * maxiter, M=Mh)
         theta = th0 + sE * dth
 
         # The conservative stage state and the residual of its two linear problems.
         fI = viscous_divergence((rho, *u, theta), transport, grid, phys, t, walls)
         U = (rho, *(m + adt * f for m, f in zip(m_hat, fI[1:4])), E_hat + adt * fI[4])
-        res_m = _norm(tuple(rho * x - m for x, m in zip(u, U[1:4])))
-        res_E = _norm(U[4] - rho * (0.5 * sum(x * x for x in u) + 1.5 * theta))
+        res_m = _norm(tuple(rho * x - m for x, m in zip(u, U[1:4])), acc)
+        res_E = _norm(U[4] - rho * (0.5 * sum(x * x for x in u) + 1.5 * theta), acc)
         tiny = float(jnp.finfo(dtype).tiny)  # a zero right-hand side (uniform gas) is solved exactly
-        worst = jnp.maximum(worst, jnp.maximum(res_m / jnp.maximum(jnp.maximum(tol * _norm(b), atol_m), tiny),
-                                               res_E / jnp.maximum(jnp.maximum(tol * _norm(bE), atol_E), tiny)))
+        worst = jnp.maximum(worst, jnp.maximum(res_m / jnp.maximum(jnp.maximum(tol * _norm(b, acc), atol_m), tiny),
+                                               res_E / jnp.maximum(jnp.maximum(tol * _norm(bE, acc), atol_E), tiny)
+                                               ).astype(dtype))
         theta = primitive_fields(U)[4]
     return U, fI, worst

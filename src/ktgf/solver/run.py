@@ -183,7 +183,8 @@ class Simulation:
         self.history_keys = (*HISTORY_KEYS, *CASE_COLUMNS[self.case])
         n = cfg.numerics
         self.num = Numerics(n.cfl, n.cfl_diffusion, n.cfl_source, n.limiter, n.riemann, scheme="ssprk3",
-                            implicit_tol=n.implicit_tol, implicit_maxiter=n.implicit_maxiter, sweeps=n.sweeps)
+                            implicit_tol=n.implicit_tol, implicit_maxiter=n.implicit_maxiter, sweeps=n.sweeps,
+                            mixed=n.precision == "mixed")
         self.dtype = jnp.float64 if n.precision == "float64" else jnp.float32
         self.directory = Path(directory if directory is not None else cfg.output.directory)
         self.phi0, self.theta0 = cfg.initial.solid_fraction, cfg.initial.temperature
@@ -478,7 +479,8 @@ class Simulation:
         return self.place(U), t, steps, k, history
 
     def _record(self, U: Any, t: float, history: dict[str, list]) -> None:
-        d = diagnostics(U, self.grid, self.phys.material_density)
+        # mixed precision: the diagnostic sums in float64 (the state stays float32)
+        d = diagnostics(U.astype(jnp.float64) if self.num.mixed else U, self.grid, self.phys.material_density)
         history["time"].append(t)
         for name in SCALARS:
             history[name].append(float(d[name]))

@@ -85,6 +85,10 @@ class Numerics:
         Krylov iterations of each stage solve, in units of :data:`~ktgf.solver.imex.RESTART` (10).
     sweeps : int
         Picard passes updating the frozen θ of the implicit coefficients (2 keeps second order).
+    mixed : bool
+        IMEX with a float32 state: solve the stages with float32 vectors and float64 inner
+        products and norms (:func:`~ktgf.solver.imex.implicit_stage`), instead of casting the
+        stage to float64 (``numerics.precision = "mixed"``).
     """
 
     cfl: float = 0.4
@@ -97,9 +101,10 @@ class Numerics:
     implicit_tol: float = 1e-6
     implicit_maxiter: int = 5
     sweeps: int = 1
+    mixed: bool = False
 
     _LEAVES = ("cfl", "cfl_diffusion", "cfl_source", "dt_max", "implicit_tol")
-    _STATIC = ("limiter", "riemann", "scheme", "implicit_maxiter", "sweeps")
+    _STATIC = ("limiter", "riemann", "scheme", "implicit_maxiter", "sweeps", "mixed")
 
     def tree_flatten(self) -> tuple[tuple, tuple]:
         return tuple(getattr(self, k) for k in self._LEAVES), tuple(getattr(self, k) for k in self._STATIC)
@@ -219,13 +224,14 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
         KE1 = tuple(jnp.where(k == 0, a, b) for a, b in zip(KE, KE1))
         Uhat = tuple(u + dt * (wE[k, 0] * e1 + wE[k, 1] * e + wI[k] * i2)
                      for u, e1, e, i2 in zip(Un, KE1, KE, KI2))
-        # The stage solves run in float64 also for a float32 state: float32 Krylov iterations
-        # stall above the tolerance (measured: residual 67x the limit after a few steps).
-        Uhat64 = tuple(u.astype(jnp.float64) for u in Uhat)
+        # Plain float32: the stage solves run in float64 (float32 Krylov iterations stall above
+        # the tolerance: residual 67x the limit after a few steps).  Mixed: float32 vectors,
+        # float64 inner products (docs/solver.md, Speed).
+        Uhat64 = Uhat if num.mixed else tuple(u.astype(jnp.float64) for u in Uhat)
         r = phys.reduced(Uhat64[0])
-        Ui, fI, res = implicit_stage(Uhat64, GAMMA * jnp.asarray(dt, jnp.float64), grid, phys, r,
-                                     jnp.asarray(num.implicit_tol, jnp.float64), num.implicit_maxiter, num.sweeps,
-                                     t_implicit[k])
+        Ui, fI, res = implicit_stage(Uhat64, GAMMA * jnp.asarray(dt, jnp.float64).astype(Uhat64[0].dtype), grid, phys,
+                                     r, jnp.asarray(num.implicit_tol, jnp.float64), num.implicit_maxiter, num.sweeps,
+                                     t_implicit[k], mixed=num.mixed)
         r = jax.tree_util.tree_map(lambda x: jnp.asarray(x).astype(dtype), r)
         return tuple(u.astype(dtype) for u in Ui), r, KE1, \
             tuple(jnp.broadcast_to(f, Un[0].shape).astype(dtype) for f in fI), jnp.maximum(worst, res.astype(dtype))
