@@ -76,3 +76,27 @@ def test_mixed_growth_rate_of_a_vortex_mode() -> None:
     measured, theory = measure_rate("ret", (64,), (1,), 0.2, "transverse", mixed=True, amplitude=1e-3)
     print(f"relative error {abs(measured - theory) / abs(theory):.4f}", measured, theory)
     assert abs(measured - theory) <= 0.02 * abs(theory), (measured, theory)
+
+
+def test_float64_inner_product_krylov_solvers_solve_float32_systems() -> None:
+    """_bicgstab64 and _cg64 (float32 vectors, float64 scalars) against a dense NumPy solve in float64:
+    a non-symmetric diagonally dominant system and a symmetric positive definite one, Jacobi-preconditioned."""
+    import jax.numpy as jnp
+
+    from ktgf.solver.imex import _bicgstab64, _cg64
+
+    rng = np.random.default_rng(1)
+    n = 40
+    N = np.eye(n) * 4.0 + 0.3 * rng.standard_normal((n, n))
+    S = N @ N.T / n + np.eye(n)
+    b = rng.standard_normal(n)
+    for mat, solver in ((N, _bicgstab64), (S, _cg64)):
+        A32 = jnp.asarray(mat, jnp.float32)
+        d = jnp.asarray(np.diag(mat), jnp.float32)
+        x = solver(lambda v: A32 @ v, jnp.asarray(b, jnp.float32), tol=jnp.float64(1e-6), atol=0.0,
+                   maxiter=200, M=lambda r: r / d)
+        assert x.dtype == jnp.float32
+        exact = np.linalg.solve(mat.astype(np.float32).astype(np.float64), b.astype(np.float32).astype(np.float64))
+        err = np.linalg.norm(np.asarray(x, np.float64) - exact) / np.linalg.norm(exact)
+        print(solver.__name__, "relative error", err)
+        assert err < 1e-5, err
