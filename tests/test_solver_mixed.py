@@ -100,3 +100,28 @@ def test_float64_inner_product_krylov_solvers_solve_float32_systems() -> None:
         err = np.linalg.norm(np.asarray(x, np.float64) - exact) / np.linalg.norm(exact)
         print(solver.__name__, "relative error", err)
         assert err < 1e-5, err
+
+
+@pytest.mark.slow  # 18 s under load (two compiled runs)
+def test_mixed_run_follows_the_float64_run(tmp_path) -> None:
+    """The whole run (config → Simulation → history) in mixed precision: float32 state, and the
+    diagnostics agree with the float64 run's to float32 accuracy."""
+    from _tiny_case import tiny_case
+
+    from ktgf.solver.config import parse_config
+    from ktgf.solver.run import Simulation
+
+    try:
+        import tomllib
+    except ImportError:  # pragma: no cover
+        import tomli as tomllib
+    out = {}
+    for precision in ("float64", "mixed"):
+        cfg = tomllib.loads(tiny_case(end=2.0))
+        cfg["numerics"] = {"precision": precision}
+        sim = Simulation(parse_config(cfg), tmp_path / precision)
+        out[precision] = sim.run(progress=False, write_files=False)
+        assert np.asarray(sim.state).dtype == (np.float64 if precision == "float64" else np.float32)
+    a, b = (np.asarray(out[p]["theta_mean"]) for p in ("float64", "mixed"))
+    print("theta_mean relative difference", np.max(np.abs(b / a - 1.0)))
+    assert np.allclose(b, a, rtol=1e-5), (a, b)
