@@ -76,3 +76,52 @@ def test_mixed_growth_rate_of_a_vortex_mode() -> None:
     measured, theory = measure_rate("ret", (64,), (1,), 0.2, "transverse", mixed=True, amplitude=1e-3)
     print(f"relative error {abs(measured - theory) / abs(theory):.4f}", measured, theory)
     assert abs(measured - theory) <= 0.02 * abs(theory), (measured, theory)
+
+
+def test_float64_inner_product_krylov_solvers_solve_float32_systems() -> None:
+    """_bicgstab64 and _cg64 (float32 vectors, float64 scalars) against a dense NumPy solve in float64:
+    a non-symmetric diagonally dominant system and a symmetric positive definite one, Jacobi-preconditioned."""
+    import jax.numpy as jnp
+
+    from ktgf.solver.imex import _bicgstab64, _cg64
+
+    rng = np.random.default_rng(1)
+    n = 40
+    N = np.eye(n) * 4.0 + 0.3 * rng.standard_normal((n, n))
+    S = N @ N.T / n + np.eye(n)
+    b = rng.standard_normal(n)
+    for mat, solver in ((N, _bicgstab64), (S, _cg64)):
+        A32 = jnp.asarray(mat, jnp.float32)
+        d = jnp.asarray(np.diag(mat), jnp.float32)
+        x = solver(lambda v: A32 @ v, jnp.asarray(b, jnp.float32), tol=jnp.float64(1e-6), atol=0.0,
+                   maxiter=200, M=lambda r: r / d)
+        assert x.dtype == jnp.float32
+        exact = np.linalg.solve(mat.astype(np.float32).astype(np.float64), b.astype(np.float32).astype(np.float64))
+        err = np.linalg.norm(np.asarray(x, np.float64) - exact) / np.linalg.norm(exact)
+        print(solver.__name__, "relative error", err)
+        assert err < 1e-5, err
+
+
+@pytest.mark.slow  # 18 s under load (two compiled runs)
+def test_mixed_run_follows_the_float64_run(tmp_path) -> None:
+    """The whole run (config → Simulation → history) in mixed precision: float32 state, and the
+    diagnostics agree with the float64 run's to float32 accuracy."""
+    from _tiny_case import tiny_case
+
+    from ktgf.solver.config import parse_config
+    from ktgf.solver.run import Simulation
+
+    try:
+        import tomllib
+    except ImportError:  # pragma: no cover
+        import tomli as tomllib
+    out = {}
+    for precision in ("float64", "mixed"):
+        cfg = tomllib.loads(tiny_case(end=2.0))
+        cfg["numerics"] = {"precision": precision}
+        sim = Simulation(parse_config(cfg), tmp_path / precision)
+        out[precision] = sim.run(progress=False, write_files=False)
+        assert np.asarray(sim.state).dtype == (np.float64 if precision == "float64" else np.float32)
+    a, b = (np.asarray(out[p]["theta_mean"]) for p in ("float64", "mixed"))
+    print("theta_mean relative difference", np.max(np.abs(b / a - 1.0)))
+    assert np.allclose(b, a, rtol=1e-5), (a, b)

@@ -25,7 +25,8 @@ Precision
     is part of its config: :class:`Simulation` runs inside ``jax.enable_x64(True)`` (see
     :meth:`Simulation.precision`), with the state in ``numerics.precision`` — ``"float64"`` (the
     default; needed for the verification against linear theory) or ``"float32"`` (≈1.6× faster
-    on CPU; the clock stays float64).  Calling the lower-level functions (:func:`advance`, ...) directly in
+    on CPU; the clock stays float64) or ``"mixed"`` (float32 state, IMEX stage solves with float64
+    inner products, float64 diagnostics; docs/solver.md "Mixed precision").  Calling the lower-level functions (:func:`advance`, ...) directly in
     float64 needs the same context, or ``jax.config.update("jax_enable_x64", True)`` by the caller.
 
 Several devices (one host)
