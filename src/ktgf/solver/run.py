@@ -37,7 +37,7 @@ from ..closures.coefficients import mean_free_path
 from ..errors import DivergenceError, InputError, KtgfError
 from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
 from ..io import write_netcdf
-from .config import Config
+from .config import Config, initial_temperature
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
 from .flows import (CASE_COLUMNS, CASE_UNITS, PROFILES, VERIFICATION_FILE, add_base_flow, case_diagnostics, gradient_axis,
                     shear_rate, verification)
@@ -187,7 +187,7 @@ class Simulation:
                             mixed=n.precision == "mixed")
         self.dtype = jnp.float64 if n.precision == "float64" else jnp.float32
         self.directory = Path(directory if directory is not None else cfg.output.directory)
-        self.phi0, self.theta0 = cfg.initial.solid_fraction, cfg.initial.temperature
+        self.phi0, self.theta0 = cfg.initial.solid_fraction, initial_temperature(cfg)
         self.t_haff = haff_time(self.phys, self.phi0, self.theta0)
         end, n_out = cfg.time.end, cfg.time.outputs
         if cfg.time.unit == "tau":  # equal steps in τ: the natural clock of a cooling gas
