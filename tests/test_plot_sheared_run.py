@@ -35,15 +35,16 @@ def _timeseries(example: str, tmp_path: Path) -> tuple[Path, float]:
     return path, shear_rate(sim.grid)
 
 
-@pytest.mark.parametrize(("example", "panels"), [("uniform_shear.toml", 3), ("couette_2d.toml", 5)])
+@pytest.mark.parametrize(("example", "panels"), [("uniform_shear.toml", 3), ("couette_2d.toml", 5), ("chute_2d.toml", 5)])
 def test_plot_run_draws_a_sheared_history_against_strain(example: str, panels: int, tmp_path: Path,
                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """Strain γ̇t on the x axis where a shear rate is imposed, t [s] for the chute; units on the y axes."""
     import ktgf.plotting
     from ktgf.cli import app
     from typer.testing import CliRunner
 
     path, rate = _timeseries(example, tmp_path)
-    assert rate > 0
+    assert (rate > 0) == (example != "chute_2d.toml")
     drawn = []
     real_save = ktgf.plotting.save
     monkeypatch.setattr(ktgf.plotting, "save", lambda fig, out: (drawn.append(fig), real_save(fig, out))[1])
@@ -53,10 +54,13 @@ def test_plot_run_draws_a_sheared_history_against_strain(example: str, panels: i
     assert out.stat().st_size > 1000
     axes = drawn[0].axes
     assert len(axes) == panels
-    assert axes[0].get_xlabel() == "strain γ̇t"
+    times = np.array([0.0, 0.01, 0.02])
+    assert axes[0].get_xlabel() == ("strain γ̇t" if rate else "t [s]")
+    np.testing.assert_allclose(axes[0].lines[0].get_xdata(), rate * times if rate else times)
     assert axes[0].get_ylabel() == "θ [m2 s-2]"
     assert axes[1].get_ylabel().endswith("[Pa]")
-    np.testing.assert_allclose(axes[0].lines[0].get_xdata(), rate * np.array([0.0, 0.01, 0.02]))
+    if panels == 5:  # gap profiles: u_f, φ, θ against the wall-normal position
+        assert axes[2].get_xlabel().startswith("u_f [m s-1]") and axes[2].get_ylabel().endswith("[m]")
 
 
 def test_plot_run_names_a_missing_sheared_column(tmp_path: Path) -> None:
