@@ -104,7 +104,7 @@ def test_layering_rate_converges_with_resolution() -> None:
     assert errors[1] < errors[0] / 4 and errors[2] < errors[1] / 4 and errors[2] < 0.01, errors
 
 
-def _config(mode: list[int], kind: str = "uniform-shear", branch: int = 2, flow: str = "z") -> str:
+def _config(mode: list[int], kind: str = "uniform-shear", branch: int = 2, flow: str = "z", temperature: str = "") -> str:
     return f"""
 [case]
 kind = "{kind}"
@@ -113,7 +113,7 @@ name = "{MODEL}"
 restitution = {E}
 [initial]
 solid_fraction = {PHI}
-temperature = 1e-2
+{temperature}
 perturbation = "shear-mode"
 mode = {mode}
 branch = {branch}
@@ -166,7 +166,8 @@ def test_bad_shear_mode_config_names_the_field(kind: str, branch: int, pert: str
     from ktgf.errors import InputError
     from ktgf.solver.config import parse_config
 
-    text = _config([0, 1], kind="uniform-shear" if kind == "elastic" else kind, branch=branch, flow=flow)
+    text = _config([0, 1], kind="uniform-shear" if kind == "elastic" else kind, branch=branch, flow=flow,
+                   temperature="temperature = 1e-2" if kind == "cooling" else "")
     if kind == "elastic":
         text = text.replace(f"restitution = {E}", "restitution = 1.0")
     text = text.replace('"shear-mode"', f'"{pert}"')
@@ -176,3 +177,27 @@ def test_bad_shear_mode_config_names_the_field(kind: str, branch: int, pert: str
     with pytest.raises(InputError) as exc:
         parse_config(tomllib.loads(text))
     assert "\n" not in str(exc.value) and field in str(exc.value), str(exc.value)
+
+
+def test_shear_mode_temperature_is_the_closed_form_or_refused() -> None:
+    """``initial.temperature`` is optional for a shear-mode seed (θ0 is the closed-form steady θ);
+    a value that differs is refused in one line naming the field, a missing one elsewhere too."""
+    import tomllib
+
+    from ktgf.couette.uniform_shear import uniform_shear
+    from ktgf.errors import InputError
+    from ktgf.solver.config import initial_temperature, parse_config
+
+    theta = float(uniform_shear(get_model(MODEL), PHI, E).temperature_ratio) * (RATE * D) ** 2
+    cfg = parse_config(tomllib.loads(_config([0, 1])))
+    assert cfg.initial.temperature is None
+    assert initial_temperature(cfg) == pytest.approx(theta, rel=1e-12)
+    parse_config(tomllib.loads(_config([0, 1], temperature=f"temperature = {theta!r}")))  # the same θ: accepted
+    with pytest.raises(InputError) as exc:
+        parse_config(tomllib.loads(_config([0, 1], temperature="temperature = 1e-2")))
+    msg = str(exc.value)
+    assert "\n" not in msg and "initial.temperature = 0.01" in msg and f"{theta:.6g}" in msg, msg
+    random = _config([0, 1]).replace('"shear-mode"', '"random"')
+    with pytest.raises(InputError) as exc:
+        parse_config(tomllib.loads(random))
+    assert "\n" not in str(exc.value) and "initial.temperature" in str(exc.value), str(exc.value)

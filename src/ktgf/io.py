@@ -141,9 +141,14 @@ def read_dataset(path: str | Path, needs: tuple[str, ...] = (), what: str = "net
         text = str(exc).strip()
         first = text.splitlines()[0].split(". ")[0][:160] if text else type(exc).__name__
         raise InputError(f"{what} {str(path)!r} is not a readable netCDF file ({first})") from None
+    return require(ds, path, needs, what)
+
+
+def require(ds: Any, path: str | Path, needs: tuple[str, ...], what: str = "netCDF file") -> Any:
+    """Return ``ds`` if it holds the variables ``needs``, else raise a one-line :class:`InputError`."""
     missing = [v for v in needs if v not in ds.variables]
     if missing:
-        raise InputError(f"{str(path)!r} is not a {what}: it lacks {', '.join(missing)}")
+        raise InputError(f"{str(Path(path))!r} is not a {what}: it lacks {', '.join(missing)}")
     return ds
 
 

@@ -64,14 +64,23 @@ def plot_run(
     timeseries: Path = typer.Argument(..., help="hcs.nc written by `ktgf run`."),
     out: Path = typer.Option(Path("hcs.png"), "--out", "-o", help="Figure file (png/pdf/svg)."),
 ) -> None:
-    """Plot θ/θ_Haff, transverse and longitudinal kinetic energy / θ and density variance against τ."""
+    """Plot a run's time series: for the cooling box θ/θ_Haff, transverse and longitudinal kinetic energy / θ
+    and density variance against τ; for a sheared case θ and its stresses against the strain γ̇t (and the
+    profiles across the gap at the last output for the Couette cell and the chute)."""
     import matplotlib.pyplot as plt
 
-    from ..io import read_dataset
+    from ..io import read_dataset, require
     from ..plotting import save
+    from ..plotting.sheared import needs, plot_sheared_run
 
-    ds = read_dataset(timeseries, ("tau", "theta_mean", "theta_haff", "ke_transverse", "ke_longitudinal",
-                                   "density_variance"), "time series written by `ktgf run`")
+    what = "time series written by `ktgf run`"
+    ds = read_dataset(timeseries, ("time",), what)
+    case = str(ds.attrs.get("case", "cooling"))
+    if case != "cooling":
+        typer.echo(f"wrote {plot_sheared_run(require(ds, timeseries, needs(case), what), out)}")
+        return
+    require(ds, timeseries, ("tau", "theta_mean", "theta_haff", "ke_transverse", "ke_longitudinal",
+                             "density_variance"), what)
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
     ax[0].plot(ds.tau, ds.theta_mean / ds.theta_haff)
     ax[0].set_xlabel("τ")

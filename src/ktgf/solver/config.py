@@ -70,7 +70,7 @@ class ParticlesSection(_Section):
 
 class InitialSection(_Section):
     solid_fraction: float = Field(..., gt=0.0, lt=1.0, description="phi0")
-    temperature: float = Field(..., gt=0.0, description="theta0 [m^2/s^2]")
+    temperature: float | None = Field(None, gt=0.0, description="theta0 [m^2/s^2]; shear-mode: the closed form's")
     perturbation: Literal["random", "mode", "shear-mode", "none"] = "random"
     amplitude: float = Field(1e-2, ge=0.0, le=0.5)
     seed: int = Field(0, ge=0, le=2**63 - 1, description="seed of NumPy's default_rng")
@@ -79,6 +79,14 @@ class InitialSection(_Section):
     kind: Literal["transverse", "longitudinal"] = "transverse"
     branch: int = Field(0, ge=0, le=4, description="eigenmode by decreasing growth rate: HCS 0-2, shear 0-4")
     shear_rate: float | None = Field(None, gt=0.0, description="chute: initial u = shear_rate * height above the base [1/s]")
+
+    @model_validator(mode="after")
+    def _temperature(self) -> InitialSection:
+        # A shear-mode seed sits on the steady θ of the closed form (check_shear_mode): nothing to give.
+        if self.temperature is None and self.perturbation != "shear-mode":
+            raise ValueError("temperature is missing: give initial.temperature = theta0 > 0 [m^2/s^2] (optional "
+                             "only for perturbation = 'shear-mode', which starts from the closed-form steady θ)")
+        return self
 
 
 class GridSection(_Section):
@@ -379,12 +387,28 @@ def check_shear_mode(cfg: Config, source: str = "config") -> None:
     if flow < len(ini.mode) and ini.mode[flow] != 0:
         raise InputError(f"{source}: field initial.mode = {ini.mode} varies along the flow axis {_AXES[flow]}: "
                          f"valid mode[{flow}] = 0 (a normal mode of uniform shear has k_flow = 0)")
+    try:  # the analysis refuses e = 1 and shear-dependent dissipation
+        theta = initial_temperature(cfg)
+    except KtgfError as exc:
+        raise InputError(f"{source}: field initial.perturbation = 'shear-mode': {exc}") from None
+    if ini.temperature is not None and abs(ini.temperature - theta) > SHEAR_MODE_THETA_RTOL * theta:
+        raise InputError(f"{source}: field initial.temperature = {ini.temperature:g} m^2/s^2 differs from the steady "
+                         f"θ = {theta:.6g} m^2/s^2 that perturbation = 'shear-mode' starts from: omit the field")
+
+
+#: Relative tolerance on a given initial.temperature against the closed-form θ of a shear-mode seed.
+SHEAR_MODE_THETA_RTOL = 1e-6
+
+
+def initial_temperature(cfg: Config) -> float:
+    """θ0 [m²/s²]: ``initial.temperature``, or for ``perturbation = "shear-mode"`` the steady θ of the
+    closed form at the box's γ̇ (:func:`ktgf.shear.stability.shear_base_state`), which the seed starts from."""
+    ini, b = cfg.initial, cfg.boundaries
+    if ini.perturbation != "shear-mode":
+        return float(ini.temperature)
     from ..closures import get_model
     from ..shear.stability import shear_base_state
 
     le = getattr(b, b.shear_axis())
-    try:  # the analysis refuses e = 1 and shear-dependent dissipation
-        shear_base_state(get_model(cfg.model.name, **cfg.model.options), ini.solid_fraction, cfg.model.restitution,
-                         float(le.shear_rate), d=cfg.particles.diameter, rho_s=cfg.particles.density)
-    except KtgfError as exc:
-        raise InputError(f"{source}: field initial.perturbation = 'shear-mode': {exc}") from None
+    return shear_base_state(get_model(cfg.model.name, **cfg.model.options), ini.solid_fraction, cfg.model.restitution,
+                            float(le.shear_rate), d=cfg.particles.diameter, rho_s=cfg.particles.density).theta

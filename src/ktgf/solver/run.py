@@ -37,7 +37,7 @@ from ..closures.coefficients import mean_free_path
 from ..errors import DivergenceError, InputError, KtgfError
 from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
 from ..io import write_netcdf
-from .config import Config
+from .config import Config, initial_temperature
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
 from .flows import (CASE_COLUMNS, CASE_UNITS, PROFILES, VERIFICATION_FILE, add_base_flow, case_diagnostics, gradient_axis,
                     shear_rate, verification)
@@ -187,7 +187,7 @@ class Simulation:
                             mixed=n.precision == "mixed")
         self.dtype = jnp.float64 if n.precision == "float64" else jnp.float32
         self.directory = Path(directory if directory is not None else cfg.output.directory)
-        self.phi0, self.theta0 = cfg.initial.solid_fraction, cfg.initial.temperature
+        self.phi0, self.theta0 = cfg.initial.solid_fraction, initial_temperature(cfg)
         self.t_haff = haff_time(self.phys, self.phi0, self.theta0)
         end, n_out = cfg.time.end, cfg.time.outputs
         if cfg.time.unit == "tau":  # equal steps in τ: the natural clock of a cooling gas
@@ -314,7 +314,7 @@ class Simulation:
         self.history = history
         ckpt = self.directory / CHECKPOINT
         bar = _Progress(progress, self.output_times[-1], self.t_haff, self.phys, self.phi0, self.theta0,
-                        cooling=self.case == "cooling")
+                        case=self.case, shear_rate=shear_rate(self.grid))
         chunks = 0
         first_chunk = True
         try:
@@ -608,7 +608,8 @@ class Simulation:
 
 
 class _Progress:
-    """rich progress bar over simulated time, showing t, τ, the step rate and the time left (no-op if disabled).
+    """rich progress bar over simulated time, showing the case, its clock (:func:`progress_clock`), the step
+    rate and the time left (no-op if disabled).
 
     The time left is extrapolated in τ = ∫ν dt (the collision count), not in t: a cooling gas takes
     about the same number of steps, hence wall time, per unit of τ, while its time step grows with t.
@@ -616,12 +617,14 @@ class _Progress:
     """
 
     def __init__(self, enabled: bool, t_end: float, t_haff: float, phys: Physics, phi0: float, theta0: float,
-                 clock: Callable[[], float] = _time.perf_counter, cooling: bool = True) -> None:
+                 clock: Callable[[], float] = _time.perf_counter, case: str = "cooling",
+                 shear_rate: float = 0.0) -> None:
         self.enabled, self.t_end = enabled, t_end
         self.args = (phys, phi0, theta0)
         self.clock = clock
+        self.case, self.shear_rate = case, shear_rate
         # A sheared case has no Haff clock; its steps are about equally long in t.
-        self._tau = (lambda t: float(tau_of_t(t, *self.args))) if cooling else float
+        self._tau = (lambda t: float(tau_of_t(t, *self.args))) if case == "cooling" else float
         self.tau_end = self._tau(t_end)
         self._steps, self._wall, self._first = 0, 0.0, True
         self._start: tuple[float, float] | None = None  # (τ, clock) at the end of the first chunk
@@ -632,11 +635,12 @@ class _Progress:
             from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
             self.bar = Progress(
-                TextColumn("[bold]HCS"), BarColumn(), TextColumn("t = {task.fields[t]}  τ = {task.fields[tau]}"),
-                TextColumn("{task.fields[rate]} steps/s"), TimeElapsedColumn(), TextColumn("left {task.fields[eta]}"),
+                TextColumn(f"[bold]{PROGRESS_LABELS.get(self.case, self.case)}"), BarColumn(),
+                TextColumn("{task.fields[clock]}"), TextColumn("{task.fields[rate]} steps/s"), TimeElapsedColumn(),
+                TextColumn("left {task.fields[eta]}"),
             )
             self.bar.__enter__()
-            self.task = self.bar.add_task("run", total=self.t_end, t="0", tau="0", rate="-", eta="-")
+            self.task = self.bar.add_task("run", total=self.t_end, clock=self.clock_text(0.0), rate="-", eta="-")
         return self
 
     def update(self, t: float, steps: int, wall: float) -> None:
@@ -655,11 +659,31 @@ class _Progress:
             return
         rate = f"{self._steps / self._wall:.1f}" if self._wall > 0 else "-"
         eta = "-" if self.remaining is None else _format_seconds(self.remaining)
-        self.bar.update(self.task, completed=t, t=f"{t:.4g} s", tau=f"{tau:.3g}", rate=rate, eta=eta)
+        self.bar.update(self.task, completed=t, clock=self.clock_text(t), rate=rate, eta=eta)
+
+    def clock_text(self, t: float) -> str:
+        """The simulated time as the case counts it: t and τ (cooling box), t and the strain γ̇t (sheared)."""
+        return progress_clock(self.case, t, self._tau(t) if self.case == "cooling" else None, self.shear_rate)
 
     def __exit__(self, *exc: object) -> None:
         if self.enabled:
             self.bar.__exit__(*exc)
+
+
+#: Case names as the progress bar shows them.
+PROGRESS_LABELS = {"cooling": "HCS", "uniform-shear": "uniform shear", "couette": "Couette", "chute": "chute"}
+
+
+def progress_clock(case: str, t: float, tau: float | None = None, shear_rate: float = 0.0) -> str:
+    """The progress bar's clock: ``t = … s  τ = …`` for the cooling box (τ = ∫ν dt, collisions per
+    particle), ``t = … s  γ̇t = …`` (the strain) for a case with an imposed shear rate γ̇ [1/s],
+    ``t = … s`` otherwise (a chute, whose shear rate is not imposed)."""
+    text = f"t = {t:.4g} s"
+    if case == "cooling":
+        return f"{text}  τ = {tau:.3g}"
+    if shear_rate:
+        return f"{text}  γ̇t = {shear_rate * t:.3g}"
+    return text
 
 
 def _format_seconds(s: float) -> str:
