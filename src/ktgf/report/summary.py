@@ -153,7 +153,11 @@ def _caveats(s: Summary, by: dict[str, SectionResult], hcs: SectionResult | None
         if over:
             s.caveats.append(f"Couette: the maximum φ of {_join(over)} reaches "
                              + ", ".join(f"{mp[n]:.3f}" for n in over) + ", close to random close packing (0.64).")
-    s.caveats.append("All DEM data are for frictionless spheres; real granules have friction, which these closures omit.")
+    if "friction" in by:
+        s.caveats.append("The DEM data above are for frictionless spheres, and so are the paper's four models and `dense`; "
+                         "real granules have friction: the frictional section compares the `frictional` model with frictional DEM.")
+    else:
+        s.caveats.append("All DEM data are for frictionless spheres; real granules have friction, which these closures omit.")
     if "cooling_gas" in by:
         s.caveats.append("The 3D cooling-gas section has no DEM counterpart: it checks the predicted instability thresholds, not accuracy.")
 
