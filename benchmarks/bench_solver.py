@@ -23,6 +23,7 @@ users: the load average is printed; repeat and take the best.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import re
 import time
@@ -45,12 +46,34 @@ def numpy_reference(model, U: np.ndarray, rho_s: float, e: float) -> float:
     return best
 
 
+#: Switches of :mod:`ktgf.solver.fluxes` that select main's code path (``--ab``).
+REFERENCE = {"PERIODIC_PAD": "pad"}
+
+
+@contextlib.contextmanager
+def fluxes_switches(switches: dict):
+    """The speed switches of :mod:`ktgf.solver.fluxes` set while tracing (restored after)."""
+    from ktgf.solver import fluxes
+
+    saved = {k: getattr(fluxes, k) for k in switches}
+    try:
+        for k, v in switches.items():
+            setattr(fluxes, k, v)
+        yield
+    finally:
+        for k, v in saved.items():
+            setattr(fluxes, k, v)
+
+
 def hlo_counts(fn, *args) -> dict[str, int]:
     import jax
 
-    text = jax.jit(fn).lower(*args).compile().as_text()
+    compiled = jax.jit(fn).lower(*args).compile()
+    text = compiled.as_text()
+    cost = compiled.cost_analysis()
+    cost = cost[0] if isinstance(cost, list) else cost
     return {"fusions": len(re.findall(r"^\s*\S*fusion\S* = ", text, flags=re.M)),
-            "power": len(re.findall(r" power\(", text))}
+            "power": len(re.findall(r" power\(", text)), "bytes": float((cost or {}).get("bytes accessed", 0.0))}
 
 
 def main() -> None:
@@ -62,6 +85,8 @@ def main() -> None:
     ap.add_argument("--schemes", default="ssprk3,imex")
     ap.add_argument("--models", default="ret,proposed")
     ap.add_argument("--precisions", default="float64,float32,mixed")
+    ap.add_argument("--ab", action="store_true",
+                    help="also time main's code path (REFERENCE switches) in the same process, interleaved")
     args = ap.parse_args()
 
     import jax
@@ -96,9 +121,12 @@ def main() -> None:
         print(f"[{model_name}] step limits [s]: cfl {lim[0]:.3g}, viscous {lim[1]:.3g}, conductive {lim[2]:.3g}, "
               f"cooling {lim[3]:.3g}")
         Ut = tuple(jnp.asarray(U64))
-        counts = hlo_counts(lambda U: explicit_rhs(U, grid, phys, Numerics(), viscous=True), Ut)
-        print(f"[{model_name}] optimised HLO of one full right-hand side: {counts['fusions']} fusions, "
-              f"{counts['power']} power instructions")
+        for name, switches in (("new", {}), *((("reference", REFERENCE),) if args.ab else ())):
+            with fluxes_switches(switches):
+                counts = hlo_counts(lambda U: explicit_rhs(U, grid, phys, Numerics(), viscous=True), Ut)
+            print(f"[{model_name}] optimised HLO of one full right-hand side ({name} path): {counts['fusions']} fusions, "
+                  f"{counts['power']} power instructions, {counts['bytes'] / grid.size:.0f} bytes accessed per cell "
+                  "(XLA cost analysis)")
         for scheme in args.schemes.split(","):
             for precision in args.precisions.split(","):
                 if precision == "mixed" and scheme != "imex":
@@ -106,17 +134,36 @@ def main() -> None:
                 num = Numerics(scheme=scheme, mixed=precision == "mixed")
                 dtype = jnp.float64 if precision == "float64" else jnp.float32
                 U = jnp.asarray(U64, dtype=dtype)
-                t0 = time.perf_counter()
-                jax.block_until_ready(advance(U, 0.0, far, 1, grid, phys, num))
-                t_jit = time.perf_counter() - t0
-                best, best_cpu = np.inf, np.inf
-                for _ in range(args.repeats):
-                    t0, c0 = time.perf_counter(), time.process_time()
-                    out = advance(U, 0.0, far, args.steps, grid, phys, num)
-                    jax.block_until_ready(out)
-                    best = min(best, time.perf_counter() - t0)
-                    best_cpu = min(best_cpu, time.process_time() - c0)
-                    assert int(out[2]) == args.steps and int(out[3]) == 0, (int(out[2]), int(out[3]))
+                paths = {"new": {}, **({"reference": REFERENCE} if args.ab else {})}
+                compiled, t_jit = {}, {}
+                for name, switches in paths.items():
+                    with fluxes_switches(switches):  # traced afresh (new jit) with the switches set
+                        t0 = time.perf_counter()
+                        compiled[name] = jax.jit(lambda *a: advance.__wrapped__(*a)).lower(
+                            U, 0.0, far, args.steps, grid, phys, num).compile()
+                        t_jit[name] = time.perf_counter() - t0
+                times = {name: (np.inf, np.inf) for name in paths}
+                for _ in range(args.repeats):  # interleaved, so a change of machine load hits both
+                    for name, c in compiled.items():
+                        t0, c0 = time.perf_counter(), time.process_time()
+                        out = c(U, 0.0, far, args.steps, grid, phys, num)
+                        jax.block_until_ready(out)
+                        w, cpu = time.perf_counter() - t0, time.process_time() - c0
+                        times[name] = (min(times[name][0], w), min(times[name][1], cpu))
+                        assert int(out[2]) == args.steps and int(out[3]) == 0, (int(out[2]), int(out[3]))
+                        if name == "new":
+                            out_new = out
+                if args.ab:
+                    (w0, c0), (w1, c1) = times["reference"], times["new"]
+                    a, b = np.asarray(jnp.stack(out_new[0])), np.asarray(jnp.stack(out[0]))
+                    diff = float(np.max(np.abs(a - b)) / np.max(np.abs(b)))
+                    print(f"[{model_name}] {scheme:6s} {precision}: A/B reference (main's path) {w0 / args.steps * 1e3:.1f} ms/step "
+                          f"wall, {c0 / args.steps * 1e3:.1f} CPU; new {w1 / args.steps * 1e3:.1f} wall, "
+                          f"{c1 / args.steps * 1e3:.1f} CPU; speed-up {w0 / w1:.2f} wall, {c0 / c1:.2f} CPU; "
+                          f"max |difference| / max |U| after {args.steps} steps {diff:.1e}", flush=True)
+                out = out_new
+                best, best_cpu = times["new"]
+                t_jit = t_jit["new"]
                 dt = float(out[4])
                 rate = grid.size * args.steps / best
                 rate_cpu = grid.size * args.steps / best_cpu

@@ -18,11 +18,13 @@ Flux along a of (ρ, ρu, E):  (ρu_a,  ρu u_a + P·e_a,  E u_a + (P·u)_a + q_
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from typing import Any
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from .grid import Grid
 from .physics import Physics
@@ -58,7 +60,11 @@ MATERIALISE = True  # switch for A/B timing of the barriers
 
 
 def materialise(x: Any) -> Any:
-    """``x`` behind an optimisation barrier: XLA computes it once and stores it."""
+    """``x`` behind an optimisation barrier: XLA computes it once and stores it.
+
+    Measured (docs/solver.md, Speed): the barriers keep the padded and primitive fields
+    stored, but inside the per-axis flux fusion XLA CPU fuses straight through them.
+    """
     return jax.lax.optimization_barrier(x) if MATERIALISE else x
 
 
@@ -89,13 +95,34 @@ def pad_viscous(W: Sequence[Any], transport: Sequence[Any], grid: Grid, phys: Ph
     return pad_fields(W, grid, t, velocity=1, theta=4, walls=walls)
 
 
+#: Periodic padding by one gather with a precomputed index (``"gather"``) or by ``jnp.pad``
+#: (``"pad"``: XLA emits one concatenation pass per axis).  Both copy the same values.
+PERIODIC_PAD = "gather"
+
+
+@functools.lru_cache(maxsize=16)
+def _wrap_index(shape: tuple[int, ...]) -> np.ndarray:
+    """Flat index into a field of ``shape`` of every cell of its periodically padded copy."""
+    idx = [np.arange(-GHOST, n + GHOST) % n for n in shape]
+    flat = np.ravel_multi_index(np.meshgrid(*idx, indexing="ij"), shape)
+    return flat.astype(np.int32)
+
+
 def pad_periodic(W: Sequence[Any], ndim: int) -> tuple[Any, ...]:
     """Fields with GHOST periodic ghost cells on each side of every grid axis.
 
     Padding once per stage and then reading stencils as static slices keeps the fused loops
-    free of the concatenations that ``jnp.roll`` would put in every one of them.
+    free of the concatenations that ``jnp.roll`` would put in every one of them.  The padding
+    is one gather per field (:data:`PERIODIC_PAD`): ``jnp.pad(mode="wrap")`` becomes one
+    concatenation pass per axis, 3.5× the time at 64³ (docs/solver.md, Speed).
     """
-    return materialise(tuple(jnp.pad(f, [(GHOST, GHOST)] * ndim, mode="wrap") for f in W))
+    def wrap(f: Any) -> Any:
+        if PERIODIC_PAD == "gather" and f.ndim == ndim:
+            index = jnp.asarray(_wrap_index(tuple(f.shape)))
+            return f.reshape(-1).at[index].get(mode="promise_in_bounds")
+        return jnp.pad(f, [(GHOST, GHOST)] * ndim, mode="wrap")
+
+    return materialise(tuple(wrap(f) for f in W))
 
 
 def window(P: Any, cells: tuple[int, ...], axis: int, offset: int, extra: int, shift: tuple[int, ...] = ()) -> Any:
