@@ -16,8 +16,13 @@ Also printed: the Proposed/RET, float32/float64 and mixed/float64 ratios, the st
 CFL, viscous, conductive, cooling) and so the simulated time per CPU second of each scheme, and
 for one explicit right-hand side the optimised HLO (``jit(f).lower(...).compile().as_text()``):
 number of fusions (≈ kernels) and of ``power`` instructions (closure evaluations of the Proposed
-RDF, whose β = 1.75 power XLA keeps as ``pow``).  The machine's 2 cores are shared with other
-users: the load average is printed; repeat and take the best.
+RDF, whose β = 1.75 power XLA keeps as ``pow``) and XLA's estimate of the bytes accessed per cell.
+The machine's 2 cores are shared with other users: the load average is printed; repeat and take
+the best.
+
+``--ab``: also compile main's code path (the :mod:`ktgf.solver.fluxes` switches in ``REFERENCE``)
+and time it interleaved with the new one in the same process, so a change of machine load hits
+both; prints both times, their ratio and the largest difference of the two final states.
 """
 
 from __future__ import annotations

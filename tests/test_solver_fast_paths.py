@@ -76,8 +76,23 @@ def test_gather_padding_matches_jnp_pad(kind: str, scheme: str, model: str) -> N
         U = add_base_flow(U, grid)
     U = tuple(jnp.asarray(U))
     num = Numerics(scheme=scheme)
-    L_new, U_new = _run({"PERIODIC_PAD": "gather"}, U, grid, phys, num)
+    L_new, U_new = _run({"PERIODIC_PAD": "gather"}, U, grid, phys, num)  # the default ("auto") for float64
     L_ref, U_ref = _run({"PERIODIC_PAD": "pad"}, U, grid, phys, num)
     assert np.all(np.isfinite(L_new)) and np.abs(L_new).max() > 0
     assert _close(L_new, L_ref) < RTOL
     assert _close(U_new, U_ref) < RTOL
+
+
+@pytest.mark.parametrize("mode", ["auto", "gather", "pad"])
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+@pytest.mark.parametrize("shape", [(5,), (6, 4), (4, 7, 5)])
+def test_periodic_padding_is_numpy_wrap_padding(mode: str, dtype: type, shape: tuple) -> None:
+    f = np.random.default_rng(1).random(shape).astype(dtype)
+    saved = fluxes.PERIODIC_PAD
+    try:
+        fluxes.PERIODIC_PAD = mode
+        (P,) = fluxes.pad_periodic((jnp.asarray(f),), len(shape))
+    finally:
+        fluxes.PERIODIC_PAD = saved
+    assert P.dtype == dtype
+    np.testing.assert_array_equal(np.asarray(P), np.pad(f, fluxes.GHOST, mode="wrap"))

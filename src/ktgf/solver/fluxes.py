@@ -95,9 +95,12 @@ def pad_viscous(W: Sequence[Any], transport: Sequence[Any], grid: Grid, phys: Ph
     return pad_fields(W, grid, t, velocity=1, theta=4, walls=walls)
 
 
-#: Periodic padding by one gather with a precomputed index (``"gather"``) or by ``jnp.pad``
-#: (``"pad"``: XLA emits one concatenation pass per axis).  Both copy the same values.
-PERIODIC_PAD = "gather"
+#: Periodic padding by one gather with a precomputed index (``"gather"``), by ``jnp.pad``
+#: (``"pad"``: XLA emits one concatenation pass per axis), or ``"auto"``: the gather for float64
+#: fields, ``jnp.pad`` for float32 (measured in the same process: the gather saved 3–25 % of the
+#: CPU time of a float64 step and cost 8–13 % in float32, where its int32 index is as large as
+#: the data; docs/solver.md, Speed).  All copy the same values.
+PERIODIC_PAD = "auto"
 
 
 @functools.lru_cache(maxsize=16)
@@ -113,11 +116,12 @@ def pad_periodic(W: Sequence[Any], ndim: int) -> tuple[Any, ...]:
 
     Padding once per stage and then reading stencils as static slices keeps the fused loops
     free of the concatenations that ``jnp.roll`` would put in every one of them.  The padding
-    is one gather per field (:data:`PERIODIC_PAD`): ``jnp.pad(mode="wrap")`` becomes one
-    concatenation pass per axis, 3.5× the time at 64³ (docs/solver.md, Speed).
+    is one gather per float64 field (:data:`PERIODIC_PAD`): ``jnp.pad(mode="wrap")`` becomes one
+    concatenation pass per axis, 3.5× the time of the gather for 11 fields at 64³ (docs/solver.md, Speed).
     """
     def wrap(f: Any) -> Any:
-        if PERIODIC_PAD == "gather" and f.ndim == ndim:
+        gather = PERIODIC_PAD == "gather" or (PERIODIC_PAD == "auto" and jnp.dtype(f.dtype).itemsize >= 8)
+        if gather and f.ndim == ndim:
             index = jnp.asarray(_wrap_index(tuple(f.shape)))
             return f.reshape(-1).at[index].get(mode="promise_in_bounds")
         return jnp.pad(f, [(GHOST, GHOST)] * ndim, mode="wrap")
