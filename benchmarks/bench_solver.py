@@ -20,9 +20,10 @@ RDF, whose β = 1.75 power XLA keeps as ``pow``) and XLA's estimate of the bytes
 The machine's 2 cores are shared with other users: the load average is printed; repeat and take
 the best.
 
-``--ab``: also compile main's code path (the :mod:`ktgf.solver.fluxes` switches in ``REFERENCE``)
-and time it interleaved with the new one in the same process, so a change of machine load hits
-both; prints both times, their ratio and the largest difference of the two final states.
+``--ab``: compile main's code path (the :mod:`ktgf.solver.fluxes` switches in ``REFERENCE``) and
+a candidate (``CANDIDATE``) and time them interleaved in the same process, so a change of machine
+load hits both; prints both times, their ratio and the largest difference of the two final
+states (the other lines then describe the candidate).
 """
 
 from __future__ import annotations
@@ -51,8 +52,9 @@ def numpy_reference(model, U: np.ndarray, rho_s: float, e: float) -> float:
     return best
 
 
-#: Switches of :mod:`ktgf.solver.fluxes` that select main's code path (``--ab``).
+#: ``--ab``: switches of :mod:`ktgf.solver.fluxes` of main's code path and of the candidate.
 REFERENCE = {"PERIODIC_PAD": "pad"}
+CANDIDATE = {"PERIODIC_PAD": "gather"}
 
 
 @contextlib.contextmanager
@@ -91,7 +93,7 @@ def main() -> None:
     ap.add_argument("--models", default="ret,proposed")
     ap.add_argument("--precisions", default="float64,float32,mixed")
     ap.add_argument("--ab", action="store_true",
-                    help="also time main's code path (REFERENCE switches) in the same process, interleaved")
+                    help="time main's code path (REFERENCE) and a candidate (CANDIDATE) in the same process, interleaved")
     args = ap.parse_args()
 
     import jax
@@ -126,7 +128,7 @@ def main() -> None:
         print(f"[{model_name}] step limits [s]: cfl {lim[0]:.3g}, viscous {lim[1]:.3g}, conductive {lim[2]:.3g}, "
               f"cooling {lim[3]:.3g}")
         Ut = tuple(jnp.asarray(U64))
-        for name, switches in (("new", {}), *((("reference", REFERENCE),) if args.ab else ())):
+        for name, switches in ((("new", CANDIDATE), ("reference", REFERENCE)) if args.ab else (("default", {}),)):
             with fluxes_switches(switches):
                 counts = hlo_counts(lambda U: explicit_rhs(U, grid, phys, Numerics(), viscous=True), Ut)
             print(f"[{model_name}] optimised HLO of one full right-hand side ({name} path): {counts['fusions']} fusions, "
@@ -139,7 +141,7 @@ def main() -> None:
                 num = Numerics(scheme=scheme, mixed=precision == "mixed")
                 dtype = jnp.float64 if precision == "float64" else jnp.float32
                 U = jnp.asarray(U64, dtype=dtype)
-                paths = {"new": {}, **({"reference": REFERENCE} if args.ab else {})}
+                paths = {"new": CANDIDATE, "reference": REFERENCE} if args.ab else {"new": {}}
                 compiled, t_jit = {}, {}
                 for name, switches in paths.items():
                     with fluxes_switches(switches):  # traced afresh (new jit) with the switches set

@@ -1,6 +1,6 @@
 """The faster code paths of the 3D solver reproduce the reference paths to round-off.
 
-Each speed switch of :mod:`ktgf.solver.fluxes` keeps the path it replaced behind it; here both
+Each speed switch of :mod:`ktgf.solver.fluxes` keeps main's path next to the faster one; here both
 are compiled in the same process and one right-hand side and a few steps are compared, for
 periodic, Lees–Edwards and wall boundaries, both time schemes and two closure models.  The
 oracle is the reference path (the code of main before the change), not stored numbers.
@@ -76,7 +76,7 @@ def test_gather_padding_matches_jnp_pad(kind: str, scheme: str, model: str) -> N
         U = add_base_flow(U, grid)
     U = tuple(jnp.asarray(U))
     num = Numerics(scheme=scheme)
-    L_new, U_new = _run({"PERIODIC_PAD": "gather"}, U, grid, phys, num)  # the default ("auto") for float64
+    L_new, U_new = _run({"PERIODIC_PAD": "gather"}, U, grid, phys, num)
     L_ref, U_ref = _run({"PERIODIC_PAD": "pad"}, U, grid, phys, num)
     assert np.all(np.isfinite(L_new)) and np.abs(L_new).max() > 0
     assert _close(L_new, L_ref) < RTOL

@@ -95,12 +95,13 @@ def pad_viscous(W: Sequence[Any], transport: Sequence[Any], grid: Grid, phys: Ph
     return pad_fields(W, grid, t, velocity=1, theta=4, walls=walls)
 
 
-#: Periodic padding by one gather with a precomputed index (``"gather"``), by ``jnp.pad``
-#: (``"pad"``: XLA emits one concatenation pass per axis), or ``"auto"``: the gather for float64
-#: fields, ``jnp.pad`` for float32 (measured in the same process: the gather saved 3–25 % of the
-#: CPU time of a float64 step and cost 8–13 % in float32, where its int32 index is as large as
-#: the data; docs/solver.md, Speed).  All copy the same values.
-PERIODIC_PAD = "auto"
+#: Periodic padding by ``jnp.pad`` (``"pad"``, the default: XLA emits one concatenation pass per
+#: axis and field), by one gather per field from a precomputed index (``"gather"``), or ``"auto"``
+#: (the gather for float64 fields only).  All copy the same values.  The gather halves the
+#: fusions of a right-hand side (47 → 24) and pads 3.5× faster alone, but whole steps measured in
+#: the same process against ``"pad"`` ranged from 1.25× faster to 0.88× (float32, IMEX) on the
+#: shared machine, so it is not the default (docs/solver.md, Speed).
+PERIODIC_PAD = "pad"
 
 
 @functools.lru_cache(maxsize=16)
@@ -115,9 +116,8 @@ def pad_periodic(W: Sequence[Any], ndim: int) -> tuple[Any, ...]:
     """Fields with GHOST periodic ghost cells on each side of every grid axis.
 
     Padding once per stage and then reading stencils as static slices keeps the fused loops
-    free of the concatenations that ``jnp.roll`` would put in every one of them.  The padding
-    is one gather per float64 field (:data:`PERIODIC_PAD`): ``jnp.pad(mode="wrap")`` becomes one
-    concatenation pass per axis, 3.5× the time of the gather for 11 fields at 64³ (docs/solver.md, Speed).
+    free of the concatenations that ``jnp.roll`` would put in every one of them.  How the ghost
+    cells are copied (``jnp.pad`` or one gather) is :data:`PERIODIC_PAD`.
     """
     def wrap(f: Any) -> Any:
         gather = PERIODIC_PAD == "gather" or (PERIODIC_PAD == "auto" and jnp.dtype(f.dtype).itemsize >= 8)
