@@ -17,12 +17,17 @@ from ktgf.errors import InputError
 SCALE = 2500.0
 
 
-def _problem(mu, mean_phi, stress="schaeffer", eps=1e-3, n=80, e=0.7):
+def frictional_wall_problem(mu, mean_phi, angle=0.0, stress="schaeffer", eps=1e-3, n=80, e=0.7):
+    """The map's cell: 20 d planar, JJ walls φ' = 0.2, e_w = 0.85 with wall friction angle δ_w = ``angle`` (degrees)."""
     model = get_model("frictional", mu=mu, stress=stress, regularisation=eps)
     g = PlanarCell(20.0, 1.0)
     x0, x1 = g.bounds(1.0)
-    w = Wall(specularity=0.2, restitution=0.85)
+    w = Wall(specularity=0.2, restitution=0.85, friction_angle=angle)
     return Problem(model, g, w, w, mean_phi, e, stretched_nodes(x0, x1, n, 1.5), v_scale=1.0, stress_scale=SCALE)
+
+
+def _problem(mu, mean_phi, stress="schaeffer", eps=1e-3, n=80, e=0.7):
+    return frictional_wall_problem(mu, mean_phi, 0.0, stress, eps, n, e)
 
 
 def test_frictional_terms_are_the_closures():

@@ -268,20 +268,22 @@ def homotopy_paths(problem: Problem) -> list[list[dict[str, Any]]]:
 
 def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: float, max_iter: int,
             ptc_max_iter: int, continuation: str = "natural", resume: tuple | None = None):
-    """Continuation through ``stages`` with adaptive steps; returns (X, iterations, steps, folds passed).
+    """Continuation through ``stages`` with adaptive steps; returns (X, iterations, steps, folds passed, arclength stages).
 
     ``continuation``: "natural" (raise where a stage stalls; the error's ``resume`` holds the stage,
     its fraction and the last solution there), "fallback" (from a stall on by arclength; with
     ``resume``, straight from where a natural run stalled) or "arclength" (every stage by arclength).
     """
     steps = 0
+    arclength_stages = 0
     folds: list[float] = []
 
     def by_arclength(a, b, s, X, why):
-        nonlocal total_it, steps
+        nonlocal total_it, steps, arclength_stages
         X, path = _arclength_stage(problem, a, b, s, X, history, tol, why)
         total_it += path.corrector_iterations
         steps += len(path.lam) - 1 + path.rejected_steps
+        arclength_stages += 1
         folds.extend(path.folds)
         return X
 
@@ -331,7 +333,7 @@ def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: 
             # follow the rest of this stage by pseudo-arclength continuation
             X = by_arclength(a, b, s, X, f"natural-parameter continuation stalled at {where} ({rep.message}); then ")
             break
-    return X, total_it, steps, folds
+    return X, total_it, steps, folds, arclength_stages
 
 
 def _arclength_stage(problem: Problem, a: dict[str, Any], b: dict[str, Any], s: float, X: np.ndarray,
@@ -381,12 +383,14 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
     X, rep = newton(problem, start, tol=tol, max_iter=max_iter)
     history = list(rep.history)
     if rep.converged:
-        return X, {"iterations": rep.iterations, "continuation_steps": 0, "residual": rep.residual, "history": history}
+        return X, {"iterations": rep.iterations, "continuation_steps": 0, "residual": rep.residual, "history": history,
+                   "path": "newton"}
     X, rep2 = pseudo_transient(problem, start, max_iter=ptc_max_iter)
     history += rep2.history
     if rep2.converged:
         return X, {"iterations": rep.iterations + rep2.iterations, "continuation_steps": 0,
-                   "residual": rep2.residual, "history": history, "method": "pseudo-transient"}
+                   "residual": rep2.residual, "history": history, "method": "pseudo-transient",
+                   "path": "pseudo-transient"}
 
     total_it = rep.iterations + rep2.iterations
     steps = 0
@@ -400,7 +404,7 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
         failure: CouetteConvergenceError | None = None
         for i, stages in enumerate(paths):
             try:
-                X, it, st, folds = _follow(problem, stages, history, tol, max_iter, ptc_max_iter, mode,
+                X, it, st, folds, n_arc = _follow(problem, stages, history, tol, max_iter, ptc_max_iter, mode,
                                            resumes[i] if mode == "fallback" else None)
             except CouetteConvergenceError as exc:
                 failure = failure or exc
@@ -414,4 +418,5 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
         assert failure is not None
         raise failure
     return X, {"iterations": total_it, "continuation_steps": steps, "residual": relative_residual(problem, X),
-               "history": history, "method": "continuation", "folds": folds}
+               "history": history, "method": "continuation", "folds": folds,
+               "path": "arclength" if n_arc else "natural"}
