@@ -121,6 +121,10 @@ def to_dataset(problem: Problem, X: np.ndarray, material: Material, *, phi_rcp: 
     max_phi = float(phi.max())
     verdict = validity(max_phi, phi_rcp, float(problem.model.phi_max), theta * V**2, V,
                        problem.model.label or problem.model.name)
+    if "collapsed temperature" in verdict and float(t["p_frictional"][int(np.argmin(theta))]) > 0.0:
+        # with a frictional stress a cold core is a creeping quasi-static layer, not a frozen collisional one
+        verdict += (" [the coldest node carries a frictional stress: a creeping core whose theta is set by the "
+                    "regularisation eps, docs/friction.md section 8]")
     valid = verdict == "ok"
 
     ds = xr.Dataset(
