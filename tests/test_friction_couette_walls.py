@@ -130,3 +130,69 @@ def test_the_solution_curve_approaches_the_jamming_fraction_without_a_fold():
         pressures.append(pr.terms(X)["p"][0])
     assert np.all(np.diff(pressures) > 0) and pressures[-1] > 1e3 * pressures[0]
     assert pr.phi_max - pr.unpack(X)[2].max() < 2e-4  # the densest layer is at φ_c
+
+
+CONFIG = """
+model = "frictional"
+model_options = {stress = "schaeffer"}
+mean_solid_fraction = 0.55
+restitution = 0.7
+particle_diameter = 1e-3
+particle_density = 2500.0
+
+[geometry]
+kind = "planar"
+gap = 0.02
+wall_speed = 1.0
+
+[walls]
+type = "johnson-jackson"
+specularity = 0.2
+restitution = 0.85
+
+[numerics]
+n_cells = 80
+"""
+
+
+def test_cli_sets_particle_and_wall_friction(tmp_path):
+    """``ktgf couette run --mu 0.5 --wall-friction-angle 25``: the naive start converges; the file records δ_w and μ."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from ktgf.cli import app
+    from ktgf.io import read_dataset
+
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(CONFIG)
+    out = tmp_path / "c.nc"
+    r = CliRunner().invoke(app, ["couette", "run", str(cfg), "--mu", "0.5", "--wall-friction-angle", "25", "-o", str(out),
+                                 "--format", "json"])
+    assert r.exit_code == 0, r.output
+    row = json.loads(r.stdout)[0]
+    assert row["converged"] and row["energy_budget_error"] < 1e-8
+    ds = read_dataset(out, ("u",), "Couette profile")
+    walls = json.loads(ds.attrs["parameters"])["walls"]
+    assert walls["bottom"]["friction_angle"] == walls["top"]["friction_angle"] == 25.0
+    assert json.loads(ds.attrs["model_options"])["friction"]["mu"] == 0.5
+    assert json.loads(ds.attrs["solver_state"])["path"].startswith("delta_w-continuation")
+
+
+@pytest.mark.parametrize("args,words", [
+    (["--wall-friction-angle", "90"], ["--wall-friction-angle = 90", "< 90"]),
+    (["--wall-friction-angle", "-5"], ["--wall-friction-angle = -5", "0 <="]),
+    (["--mu", "-0.1"], ["--mu = -0.1", "0 <= --mu"]),
+])
+def test_cli_bad_friction_is_a_one_line_error(tmp_path, args, words):
+    from typer.testing import CliRunner
+
+    from ktgf.cli import app
+
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(CONFIG)
+    r = CliRunner().invoke(app, ["couette", "run", str(cfg), *args, "-o", str(tmp_path / "c.nc")])
+    assert r.exit_code == 2
+    msg = r.output.strip()
+    assert all(w in msg for w in words), msg
+    assert len(msg.splitlines()) == 1, msg

@@ -211,5 +211,6 @@ def run(model, geometry, bottom: Wall, top: Wall, mean_phi: float, material: Mat
         raise err from None
     ds = to_dataset(problem, X, material, phi_rcp=phi_rcp, info=info)
     ds.attrs["solver_state"] = json.dumps({"continuation_steps": info.get("continuation_steps", 0),
-                                           "folds_passed": len(info.get("folds", []))})
+                                           "folds_passed": len(info.get("folds", [])),
+                                           "path": info.get("path", "")})
     return ds
