@@ -93,7 +93,7 @@ def test_an_inventory_above_the_jamming_fraction_is_refused_in_one_line():
 def test_frictional_wall_map_from_a_naive_start():
     """Schaeffer and Srivastava–Sundaresan × μ {0, 0.25, 0.5} × δ_w {15°, 25°, 30°} × φ̄ {0.3, 0.4, 0.5, 0.55, 0.6}:
     every case below φ_c(μ) converges from the naive start and meets its wall conditions to the solver tolerance;
-    φ̄ = 0.6 ≥ φ_c(μ) (0.576, 0.565 at μ = 0.25, 0.5) is refused as having no steady state.  2.5 min at load 6.5.
+    φ̄ = 0.6 ≥ φ_c(μ) (0.576, 0.565 at μ = 0.25, 0.5) is refused as having no steady state.  3.7 min at load 9–10.
     Residual bound 1e-8 except μ = 0, φ̄ = 0.6 with Schaeffer (measured 1e-9: near-singular Jacobian), 1e-6 there."""
     failures, refused = [], []
     for stress in ("schaeffer", "srivastava-sundaresan"):
@@ -196,3 +196,21 @@ def test_cli_bad_friction_is_a_one_line_error(tmp_path, args, words):
     msg = r.output.strip()
     assert all(w in msg for w in words), msg
     assert len(msg.splitlines()) == 1, msg
+
+
+@pytest.mark.slow
+def test_a_wall_rougher_than_the_bulk_has_a_stuck_and_a_sliding_state():
+    """Schaeffer, μ = 0.25, φ̄ = 0.55, δ_w = 30° (tan δ_w > sin φ_fr: the wall can hold more than the bulk yields):
+    Newton from the naive start reaches a stuck wall (slip ~ ε_w U, dense wall layer); continuing δ_w from the
+    sliding 25° state keeps a sliding wall.  Two steady states, both meeting the wall conditions (docs/friction.md §8).
+    ~25 s at load 7."""
+    pr = frictional_wall_problem(0.25, 0.55, 30.0)
+    Xs, info = solve(pr)
+    assert info["path"] == "newton"
+    X, _ = solve(frictional_wall_problem(0.25, 0.55, 25.0))
+    for angle in np.linspace(25.0, 30.0, 6)[1:]:
+        X, info = solve(frictional_wall_problem(0.25, 0.55, angle), X)
+    stuck, _ = check_wall_conditions(pr, Xs)
+    sliding, _ = check_wall_conditions(pr, X)
+    assert abs(stuck["slip"][0]) < 5e-3 and abs(sliding["slip"][0]) > 0.2
+    assert stuck["p_frictional"][0] > 10 * sliding["p_frictional"][0]
