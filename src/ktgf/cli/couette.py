@@ -40,27 +40,53 @@ def run_cmd(
     config: Path = typer.Argument(..., help="TOML config (see examples/couette_planar.toml)."),
     out: Path = typer.Option(None, "--out", "-o", help="Output netCDF (default: output.path of the config)."),
     model_file: Path = model_file_option(),
+    mu: float = typer.Option(None, "--mu", help="Particle friction coefficient mu >= 0 (adds Walton friction to a "
+                             "frictionless model; docs/friction.md)."),
+    wall_friction_angle: float = typer.Option(
+        None, "--wall-friction-angle", help="Wall friction angle delta_w [degrees], 0 <= delta_w < 90, on both walls "
+        "(Johnson-Jackson frictional wall traction p_f tan delta_w; needs a model with a frictional stress)."),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Solve one Couette cell described by a validated TOML config and write the profiles to netCDF.
 
     With ``--model-file`` the file's model replaces the config's ``model`` (the config's walls stay).
+    ``--mu`` and ``--wall-friction-angle`` override the model's friction coefficient and both walls'
+    ``friction_angle``.
     """
     from ..couette.config import check_output_path, load_config, run_config
     from ..io import write_netcdf
+    from ..validation import check_range
+    from .shear import with_friction
 
+    if mu is not None:
+        check_range("particle friction coefficient --mu", mu, low=0.0)
+    if wall_friction_angle is not None:
+        check_range("wall friction angle --wall-friction-angle", wall_friction_angle, low=0.0, high=90.0,
+                    high_open=True, why="degrees")
     cfg = load_config(config)
     model = None
     if model_file is not None:
         from ..calibration.model_file import load_model_file
 
         model = load_model_file(model_file).model
+    if mu is not None:
+        model = with_friction(cfg.build_model() if model is None else model, mu)
+    if wall_friction_angle is not None:
+        cfg = _with_wall_friction(cfg, wall_friction_angle)
     path = check_output_path(out, "--out") if out is not None else Path(cfg.output.path)
     ds = run_config(cfg, model, failed_path=path.with_suffix(".failed.nc"))
     write_netcdf(ds, path)
     emit([_summary(ds)], fmt, title=f"Couette ({ds.attrs['geometry']}) -> {path}")
     if not ds.attrs["physically_valid"]:
         typer.echo(f"Warning: {ds.attrs['validity']}", err=True)
+
+
+def _with_wall_friction(cfg: Any, angle: float) -> Any:
+    """The config with friction_angle = ``angle`` on both walls (per-wall entries dropped)."""
+    walls = cfg.walls
+    sides = {s: getattr(walls, s).model_copy(update={"friction_angle": None}) for s in ("bottom", "top")
+             if getattr(walls, s) is not None}
+    return cfg.model_copy(update={"walls": walls.model_copy(update={"friction_angle": float(angle), **sides})})
 
 
 @handle_errors

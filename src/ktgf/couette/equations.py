@@ -96,6 +96,13 @@ class Problem:
         self.u_wall = g.wall_velocities()
         self.walls = (self.bottom, self.top)
         self.reference_shear_rate = abs(self.u_wall[1] - self.u_wall[0]) / (x[-1] - x[0])  # U/H in V/d
+        if not 0.0 < self.mean_phi < self.phi_max:
+            from ..errors import InputError
+
+            # the inventory cannot be packed below the RDF's divergence (φ_c(μ) for a frictional RDF): no steady state
+            raise InputError(f"mean solid fraction mean_phi = {self.mean_phi:g} is out of range: valid 0 < mean_phi < "
+                             f"{self.phi_max:g} (packing limit of {self.model.label or self.model.name}): no steady "
+                             "state, the inventory does not fit below the jamming fraction")
         if self.model.friction.has_stress and not self.stress_scale > 0.0:
             from ..errors import InputError
 

@@ -121,6 +121,10 @@ def to_dataset(problem: Problem, X: np.ndarray, material: Material, *, phi_rcp: 
     max_phi = float(phi.max())
     verdict = validity(max_phi, phi_rcp, float(problem.model.phi_max), theta * V**2, V,
                        problem.model.label or problem.model.name)
+    if "collapsed temperature" in verdict and float(t["p_frictional"][int(np.argmin(theta))]) > 0.0:
+        # with a frictional stress a cold core is a creeping quasi-static layer, not a frozen collisional one
+        verdict += (" [the coldest node carries a frictional stress: a creeping core whose theta is set by the "
+                    "regularisation eps, docs/friction.md section 8]")
     valid = verdict == "ok"
 
     ds = xr.Dataset(
@@ -207,5 +211,6 @@ def run(model, geometry, bottom: Wall, top: Wall, mean_phi: float, material: Mat
         raise err from None
     ds = to_dataset(problem, X, material, phi_rcp=phi_rcp, info=info)
     ds.attrs["solver_state"] = json.dumps({"continuation_steps": info.get("continuation_steps", 0),
-                                           "folds_passed": len(info.get("folds", []))})
+                                           "folds_passed": len(info.get("folds", [])),
+                                           "path": info.get("path", "")})
     return ds

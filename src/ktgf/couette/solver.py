@@ -8,7 +8,9 @@ a single step cannot change θ or φ/(φ_max − φ) by more than a factor e^3. 
 φ < φ_max hold by construction of the unknowns.
 
 When Newton fails from the naive start (uniform φ̄, linear velocity, θ of uniform shear), the
-solver first tries pseudo-transient continuation, then follows homotopies from an easy problem
+solver first continues a frictional wall (δ_w > 0) in tan δ_w from the solution with δ_w = 0
+(itself solved by every path below; :func:`_wall_friction_continuation`), then tries
+pseudo-transient continuation, then follows homotopies from an easy problem
 (mean φ ≤ 0.3, e ≥ 0.9, specularity ≥ 0.1, no centripetal term in the annular cell) to the
 target with adaptive steps: one parameter group per stage, then all at once
 (:func:`homotopy_paths`).  Natural-parameter steps cannot pass a turning point (fold) of the
@@ -268,20 +270,22 @@ def homotopy_paths(problem: Problem) -> list[list[dict[str, Any]]]:
 
 def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: float, max_iter: int,
             ptc_max_iter: int, continuation: str = "natural", resume: tuple | None = None):
-    """Continuation through ``stages`` with adaptive steps; returns (X, iterations, steps, folds passed).
+    """Continuation through ``stages`` with adaptive steps; returns (X, iterations, steps, folds passed, arclength stages).
 
     ``continuation``: "natural" (raise where a stage stalls; the error's ``resume`` holds the stage,
     its fraction and the last solution there), "fallback" (from a stall on by arclength; with
     ``resume``, straight from where a natural run stalled) or "arclength" (every stage by arclength).
     """
     steps = 0
+    arclength_stages = 0
     folds: list[float] = []
 
     def by_arclength(a, b, s, X, why):
-        nonlocal total_it, steps
+        nonlocal total_it, steps, arclength_stages
         X, path = _arclength_stage(problem, a, b, s, X, history, tol, why)
         total_it += path.corrector_iterations
         steps += len(path.lam) - 1 + path.rejected_steps
+        arclength_stages += 1
         folds.extend(path.folds)
         return X
 
@@ -331,7 +335,7 @@ def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: 
             # follow the rest of this stage by pseudo-arclength continuation
             X = by_arclength(a, b, s, X, f"natural-parameter continuation stalled at {where} ({rep.message}); then ")
             break
-    return X, total_it, steps, folds
+    return X, total_it, steps, folds, arclength_stages
 
 
 def _arclength_stage(problem: Problem, a: dict[str, Any], b: dict[str, Any], s: float, X: np.ndarray,
@@ -359,6 +363,45 @@ def _arclength_stage(problem: Problem, a: dict[str, Any], b: dict[str, Any], s: 
     return Xn, path
 
 
+def _with_wall_friction(problem: Problem, s: float) -> Problem:
+    """``problem`` with each wall's tan δ_w scaled by s (s = 1: the problem itself)."""
+    walls = [dataclasses.replace(w, friction_angle=math.degrees(math.atan(s * math.tan(math.radians(w.friction_angle)))))
+             for w in problem.walls]
+    return dataclasses.replace(problem, bottom=walls[0], top=walls[1])
+
+
+def _wall_friction_continuation(problem: Problem, start: np.ndarray, tol: float, max_iter: int, ptc_max_iter: int,
+                                continuation: str) -> tuple[np.ndarray, dict[str, Any]]:
+    """Frictional walls: the cell with δ_w = 0 first (by every path of :func:`solve`), then tan δ_w from 0 to its value.
+
+    Natural-parameter steps in s = tan δ_w / tan δ_w,target (adaptive, as :func:`_follow`), each a Newton solve from
+    the previous solution.  Raises :class:`CouetteConvergenceError` where a step stalls (the caller then takes the
+    generic fallbacks).
+    """
+    X, info = solve(_with_wall_friction(problem, 0.0), start, tol=tol, max_iter=max_iter, ptc_max_iter=ptc_max_iter,
+                    continuation=continuation)
+    history = info["history"]
+    s, ds, steps = 0.0, 1.0, 0
+    while s < 1.0:
+        s_try = min(1.0, s + ds)
+        sub = _with_wall_friction(problem, s_try)
+        Xt, rep = newton(sub, X, tol=tol, max_iter=min(30, max_iter))
+        history += rep.history
+        info["iterations"] += rep.iterations
+        steps += 1
+        if rep.converged:
+            s, X, ds = s_try, Xt, min(1.0, 1.5 * ds)
+            continue
+        ds *= 0.5
+        if ds < 1e-3:
+            raise CouetteConvergenceError(
+                f"continuation in the wall friction angle stalled at tan(delta_w) = {s_try:.4f} of its value: "
+                f"{rep.message}", history, Xt, sub)
+    info.update(continuation_steps=info.get("continuation_steps", 0) + steps, residual=relative_residual(problem, X),
+                path=f"delta_w-continuation ({info['path']} at delta_w = 0)", method="wall-friction continuation")
+    return X, info
+
+
 def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10, max_iter: int = 60,
           ptc_max_iter: int = 400, continuation: str = "natural") -> tuple[np.ndarray, dict[str, Any]]:
     """Solve the steady problem; returns the unknowns and a dict of solver diagnostics.
@@ -381,12 +424,23 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
     X, rep = newton(problem, start, tol=tol, max_iter=max_iter)
     history = list(rep.history)
     if rep.converged:
-        return X, {"iterations": rep.iterations, "continuation_steps": 0, "residual": rep.residual, "history": history}
+        return X, {"iterations": rep.iterations, "continuation_steps": 0, "residual": rep.residual, "history": history,
+                   "path": "newton"}
+    if any(w.friction_angle > 0.0 for w in problem.walls):
+        try:
+            X, info = _wall_friction_continuation(problem, start, tol, max_iter, ptc_max_iter, continuation)
+        except CouetteConvergenceError as exc:
+            history += exc.history  # fall back on the generic paths, with the wall friction on all along
+        else:
+            info["iterations"] += rep.iterations
+            info["history"] = history + info["history"]
+            return X, info
     X, rep2 = pseudo_transient(problem, start, max_iter=ptc_max_iter)
     history += rep2.history
     if rep2.converged:
         return X, {"iterations": rep.iterations + rep2.iterations, "continuation_steps": 0,
-                   "residual": rep2.residual, "history": history, "method": "pseudo-transient"}
+                   "residual": rep2.residual, "history": history, "method": "pseudo-transient",
+                   "path": "pseudo-transient"}
 
     total_it = rep.iterations + rep2.iterations
     steps = 0
@@ -400,7 +454,7 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
         failure: CouetteConvergenceError | None = None
         for i, stages in enumerate(paths):
             try:
-                X, it, st, folds = _follow(problem, stages, history, tol, max_iter, ptc_max_iter, mode,
+                X, it, st, folds, n_arc = _follow(problem, stages, history, tol, max_iter, ptc_max_iter, mode,
                                            resumes[i] if mode == "fallback" else None)
             except CouetteConvergenceError as exc:
                 failure = failure or exc
@@ -414,4 +468,5 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
         assert failure is not None
         raise failure
     return X, {"iterations": total_it, "continuation_steps": steps, "residual": relative_residual(problem, X),
-               "history": history, "method": "continuation", "folds": folds}
+               "history": history, "method": "continuation", "folds": folds,
+               "path": "arclength" if n_arc else "natural"}

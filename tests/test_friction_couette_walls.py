@@ -1,0 +1,216 @@
+"""Frictional walls AND frictional particles in the Couette cell from the naive start (docs/friction.md §8).
+
+Wall conditions are checked against the Johnson & Jackson (1987) formulas written out here (not the code's
+functions): momentum τ_w = (π√3/6) φ' (φ/φ_pk) χ √θ u_sl + p_f tan δ_w u_sl/√(u_sl² + (ε_w U)²), energy
+q·n = G − D with the collisional slip work G only (the frictional wall work is dissipated at the contacts).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pytest
+
+from ktgf.couette.run import Material, to_dataset
+from ktgf.couette.solver import solve
+from ktgf.errors import InputError
+from test_friction_couette import SCALE, frictional_wall_problem, halving_changes
+
+SQ3PI = math.sqrt(3.0) * math.pi
+
+
+def check_wall_conditions(pr, X, tol=1e-8):
+    """Both walls satisfy the JJ momentum (collisional + frictional) and energy conditions; the budget closes."""
+    t = pr.terms(X)
+    u, theta, phi = pr.unpack(X)
+    ds = to_dataset(pr, X, Material(1.0, SCALE, pr.e))
+    U = abs(pr.u_wall[1] - pr.u_wall[0])
+    tau_scale = np.abs(t["F"]).max()
+    for k, i in ((0, 0), (1, -1)):
+        w = pr.walls[k]
+        chi = float(pr.model.chi(phi[i]))
+        slip = u[i] - pr.u_wall[k]
+        c = SQ3PI / 6 * w.specularity * phi[i] / w.packing_limit * chi * math.sqrt(theta[i])
+        pf = float(pr.model.friction.frictional_pressure(phi[i], pr.phi_max)) / SCALE
+        tau = c * slip + pf * math.tan(math.radians(w.friction_angle)) * slip / math.hypot(slip, w.slip_regularisation * U)
+        # the wall half-cell carries no momentum source: its face flux is the wall traction (sign: n into the medium)
+        face = t["F"][0] if k == 0 else -t["F"][-1]
+        assert face == pytest.approx(tau, abs=tol * tau_scale), (k, face, tau)
+        D = SQ3PI / (4 * w.packing_limit) * (1 - w.restitution**2) * phi[i] * chi * theta[i] ** 1.5
+        G = c * slip**2
+        heat_in = float(ds["wall_heat_flux"].values[k]) / SCALE  # ρ_s V³ with V = 1
+        assert heat_in == pytest.approx(G - D, abs=tol * max(abs(G), abs(D))), (k, heat_in, G - D)
+    assert ds.attrs["energy_budget_relative_error"] < tol
+    return t, ds
+
+
+def test_frictional_wall_case_converges_from_the_naive_start_and_meets_its_wall_conditions():
+    """μ = 0.5, φ̄ = 0.55, Schaeffer, δ_w = 25°: Newton fails from the naive start; the solver continues tan δ_w from
+    the δ_w = 0 solution (3 s at load 6; 24–46 s by its generic homotopies, same solution to 1e-12)."""
+    pr = frictional_wall_problem(0.5, 0.55, 25.0)
+    t0 = time.perf_counter()
+    X, info = solve(pr)
+    assert info["residual"] < 1e-8
+    assert info["path"].startswith("delta_w-continuation")
+    t, _ = check_wall_conditions(pr, X)
+    assert np.all(t["p_frictional"][[0, -1]] > 0.0)  # the wall friction acts
+    base = frictional_wall_problem(0.5, 0.55, 0.0)
+    Xb, _ = solve(base, X)  # the frictionless-wall state, from this one (Newton, < 1 s)
+    assert abs(t["slip"][0]) < abs(base.terms(Xb)["slip"][0])  # the wall friction holds the medium back
+    assert time.perf_counter() - t0 < 60.0  # generous bound for a loaded machine (measured 3 s at load 6)
+
+
+def test_a_wall_rougher_than_the_bulk_sticks_with_a_slip_set_by_the_regularisation():
+    """μ = 0, φ̄ = 0.6, Srivastava–Sundaresan, δ_w = 30°: p_f tan δ_w at the wall exceeds the traction the medium
+    transmits, so the wall sticks (Coulomb: no sliding below the friction limit); the regularised slip is then
+    O(ε_w U) and halves with ε, while profiles and wall stress change by less than the §8 tolerance."""
+    pr = frictional_wall_problem(0.0, 0.6, 30.0, "srivastava-sundaresan")
+    X, info = solve(pr)
+    t, _ = check_wall_conditions(pr, X)
+    pf = t["p_frictional"][0]
+    assert abs(t["F"][0]) < pf * math.tan(math.radians(30.0))  # below the wall's friction limit
+    assert abs(t["slip"][0]) < 3 * pr.walls[0].slip_regularisation  # stuck: slip ~ ε_w U (U = 1)
+    c = halving_changes(0.0, 0.6, 1e-3, 30.0, "srivastava-sundaresan", X)
+    assert c["du"] < 1.5e-3 and c["dphi"] < 1e-4 and c["dtau"] < 4e-3
+
+
+def test_halving_the_regularisation_with_a_sliding_frictional_wall():
+    """μ = 0.5, φ̄ = 0.55, Schaeffer, δ_w = 25° (sliding, u_sl ≈ 0.27 U, creeping core): ε and ε_w halved together
+    change the profiles by O(ε), within the §8 tolerance of the default (measured 8.7e-4, 5.6e-5, 5.1e-4)."""
+    c = halving_changes(0.5, 0.55, 1e-3, 25.0)
+    assert c["du"] < 1.5e-3 and c["dphi"] < 1e-4 and c["dtau"] < 4e-3
+
+
+def test_an_inventory_above_the_jamming_fraction_is_refused_in_one_line():
+    with pytest.raises(InputError, match=r"mean_phi = 0.6 is out of range: valid 0 < mean_phi < 0.565 .*no steady state") as e:
+        frictional_wall_problem(0.5, 0.6, 25.0)
+    assert "\n" not in str(e.value)
+
+
+@pytest.mark.slow
+def test_frictional_wall_map_from_a_naive_start():
+    """Schaeffer and Srivastava–Sundaresan × μ {0, 0.25, 0.5} × δ_w {15°, 25°, 30°} × φ̄ {0.3, 0.4, 0.5, 0.55, 0.6}:
+    every case below φ_c(μ) converges from the naive start and meets its wall conditions to the solver tolerance;
+    φ̄ = 0.6 ≥ φ_c(μ) (0.576, 0.565 at μ = 0.25, 0.5) is refused as having no steady state.  3.7 min at load 9–10.
+    Residual bound 1e-8 except μ = 0, φ̄ = 0.6 with Schaeffer (measured 1e-9: near-singular Jacobian), 1e-6 there."""
+    failures, refused = [], []
+    for stress in ("schaeffer", "srivastava-sundaresan"):
+        for mu in (0.0, 0.25, 0.5):
+            for angle in (15.0, 25.0, 30.0):
+                for mean_phi in (0.3, 0.4, 0.5, 0.55, 0.6):
+                    case = (stress, mu, angle, mean_phi)
+                    try:
+                        pr = frictional_wall_problem(mu, mean_phi, angle, stress)
+                    except InputError as exc:
+                        assert "no steady state" in str(exc) and mean_phi >= 0.565
+                        refused.append(case)
+                        continue
+                    try:
+                        X, info = solve(pr)
+                        bound = 1e-6 if (mu, mean_phi, stress) == (0.0, 0.6, "schaeffer") else 1e-8
+                        assert info["residual"] < bound, info["residual"]
+                        check_wall_conditions(pr, X, tol=max(bound, 1e-8))
+                    except Exception as exc:  # noqa: BLE001 - collect, report all at once
+                        failures.append((case, str(exc)[:120]))
+    assert not failures, failures
+    assert len(refused) == 12  # φ̄ = 0.6 at μ = 0.25 and 0.5, both stresses, three angles
+
+
+@pytest.mark.slow
+def test_the_solution_curve_approaches_the_jamming_fraction_without_a_fold():
+    """μ = 0.5, δ_w = 25°, Srivastava–Sundaresan: continuing φ̄ towards φ_c = 0.565 the wall pressure rises
+    monotonically and diverges (no turning point): there is no state at or beyond φ_c."""
+    X, pressures = None, []
+    for mean_phi in (0.55, 0.56, 0.5625, 0.564, 0.5645, 0.5649):
+        pr = frictional_wall_problem(0.5, mean_phi, 25.0, "srivastava-sundaresan")
+        X, info = solve(pr, X)
+        assert info["residual"] < 1e-8
+        pressures.append(pr.terms(X)["p"][0])
+    assert np.all(np.diff(pressures) > 0) and pressures[-1] > 1e3 * pressures[0]
+    assert pr.phi_max - pr.unpack(X)[2].max() < 2e-4  # the densest layer is at φ_c
+
+
+CONFIG = """
+model = "frictional"
+model_options = {stress = "schaeffer"}
+mean_solid_fraction = 0.55
+restitution = 0.7
+particle_diameter = 1e-3
+particle_density = 2500.0
+
+[geometry]
+kind = "planar"
+gap = 0.02
+wall_speed = 1.0
+
+[walls]
+type = "johnson-jackson"
+specularity = 0.2
+restitution = 0.85
+
+[numerics]
+n_cells = 80
+"""
+
+
+def test_cli_sets_particle_and_wall_friction(tmp_path):
+    """``ktgf couette run --mu 0.5 --wall-friction-angle 25``: the naive start converges; the file records δ_w and μ."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from ktgf.cli import app
+    from ktgf.io import read_dataset
+
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(CONFIG)
+    out = tmp_path / "c.nc"
+    r = CliRunner().invoke(app, ["couette", "run", str(cfg), "--mu", "0.5", "--wall-friction-angle", "25", "-o", str(out),
+                                 "--format", "json"])
+    assert r.exit_code == 0, r.output
+    row = json.loads(r.stdout)[0]
+    assert row["converged"] and row["energy_budget_error"] < 1e-8
+    ds = read_dataset(out, ("u",), "Couette profile")
+    walls = json.loads(ds.attrs["parameters"])["walls"]
+    assert walls["bottom"]["friction_angle"] == walls["top"]["friction_angle"] == 25.0
+    assert json.loads(ds.attrs["model_options"])["friction"]["mu"] == 0.5
+    assert json.loads(ds.attrs["solver_state"])["path"].startswith("delta_w-continuation")
+
+
+@pytest.mark.parametrize("args,words", [
+    (["--wall-friction-angle", "90"], ["--wall-friction-angle = 90", "< 90"]),
+    (["--wall-friction-angle", "-5"], ["--wall-friction-angle = -5", "0 <="]),
+    (["--mu", "-0.1"], ["--mu = -0.1", "0 <= --mu"]),
+])
+def test_cli_bad_friction_is_a_one_line_error(tmp_path, args, words):
+    from typer.testing import CliRunner
+
+    from ktgf.cli import app
+
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(CONFIG)
+    r = CliRunner().invoke(app, ["couette", "run", str(cfg), *args, "-o", str(tmp_path / "c.nc")])
+    assert r.exit_code == 2
+    msg = r.output.strip()
+    assert all(w in msg for w in words), msg
+    assert len(msg.splitlines()) == 1, msg
+
+
+@pytest.mark.slow
+def test_a_wall_rougher_than_the_bulk_has_a_stuck_and_a_sliding_state():
+    """Schaeffer, μ = 0.25, φ̄ = 0.55, δ_w = 30° (tan δ_w > sin φ_fr: the wall can hold more than the bulk yields):
+    Newton from the naive start reaches a stuck wall (slip ~ ε_w U, dense wall layer); continuing δ_w from the
+    sliding 25° state keeps a sliding wall.  Two steady states, both meeting the wall conditions (docs/friction.md §8).
+    ~25 s at load 7."""
+    pr = frictional_wall_problem(0.25, 0.55, 30.0)
+    Xs, info = solve(pr)
+    assert info["path"] == "newton"
+    X, _ = solve(frictional_wall_problem(0.25, 0.55, 25.0))
+    for angle in np.linspace(25.0, 30.0, 6)[1:]:
+        X, info = solve(frictional_wall_problem(0.25, 0.55, angle), X)
+    stuck, _ = check_wall_conditions(pr, Xs)
+    sliding, _ = check_wall_conditions(pr, X)
+    assert abs(stuck["slip"][0]) < 5e-3 and abs(sliding["slip"][0]) > 0.2
+    assert stuck["p_frictional"][0] > 10 * sliding["p_frictional"][0]
