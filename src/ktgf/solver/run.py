@@ -402,7 +402,7 @@ class Simulation:
         change = steady_change(self.case, history)
         return {"steady_tol": tol, "reached": bool(tol is not None and change is not None and change < tol),
                 "last_change": change, "time_s": history["time"][-1] if history["time"] else None,
-                "strain": history["time"][-1] * shear_rate(self.grid) if history["time"] else None}
+                "strain": history["time"][-1] * shear_rate(self.grid) if history["time"] and shear_rate(self.grid) else None}
 
     @staticmethod
     def _poll() -> None:
