@@ -39,8 +39,8 @@ from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
 from ..io import write_netcdf
 from .config import Config, initial_temperature
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
-from .flows import (CASE_COLUMNS, CASE_UNITS, PROFILES, VERIFICATION_FILE, add_base_flow, case_diagnostics, gradient_axis,
-                    shear_rate, steady_change, verification)
+from .flows import (CASE_COLUMNS, CASE_UNITS, PROFILES, VERIFICATION_FILE, add_base_flow, case_diagnostics,
+                    gradient_axis, shear_rate, steady_change, verification)
 from .flows import boundaries as case_boundaries
 from .flows import gravity as case_gravity
 from .flows import describe as describe_boundaries
@@ -402,7 +402,8 @@ class Simulation:
         change = steady_change(self.case, history)
         return {"steady_tol": tol, "reached": bool(tol is not None and change is not None and change < tol),
                 "last_change": change, "time_s": history["time"][-1] if history["time"] else None,
-                "strain": history["time"][-1] * shear_rate(self.grid) if history["time"] and shear_rate(self.grid) else None}
+                "strain": (history["time"][-1] * shear_rate(self.grid)
+                           if history["time"] and shear_rate(self.grid) else None)}
 
     @staticmethod
     def _poll() -> None:
