@@ -15,6 +15,8 @@ import tomllib
 import numpy as np
 import pytest
 
+from _chute_case import chute_case
+
 from ktgf.solver.config import parse_config
 from ktgf.solver.flows import chute_reference
 from ktgf.solver.run import Simulation
@@ -23,31 +25,10 @@ CELLS_PER_D = 3.2  # the chute example's resolution (32 cells over 10 d)
 
 
 def _config(depth_d: float) -> dict:
-    n = int(round(CELLS_PER_D * depth_d))
-    return tomllib.loads(f"""
-[case]
-kind = "chute"
-inclination_deg = 25.0
-[model]
-name = "ret"
-restitution = 0.9
-[initial]
-solid_fraction = 0.3
-temperature = 0.03
-shear_rate = 100.0
-perturbation = "none"
-[grid]
-cells = [{n}]
-length_d = {depth_d}
-[boundaries]
-x = {{ kind = "wall", flow = "y", wall_speed = 0.0, walls = {{ type = "johnson-jackson", specularity = 1.0, restitution = 0.9, top = {{ type = "zero-flux" }} }} }}
-[time]
-end = {2.5 * (depth_d / 10.0) ** 2}
-unit = "s"
-outputs = {int(round(25 * (depth_d / 10.0) ** 2))}
-scheme = "imex"
-steady_tol = 1e-4
-""")
+    """The chute of tests/test_solver_shear.py at another depth: the same resolution, time ∝ H²."""
+    scale = (depth_d / 10.0) ** 2
+    return tomllib.loads(chute_case([int(round(CELLS_PER_D * depth_d))], 2.5 * scale, length_d=depth_d,
+                                    outputs=int(round(25 * scale)), steady_tol=1e-4))
 
 
 def surface_velocities(depth_d: float) -> tuple[float, float]:

@@ -27,6 +27,8 @@ from ktgf.solver.run import Simulation, _x64
 from ktgf.solver.state import conservative
 from ktgf.solver.stepping import Numerics, rhs
 
+from _chute_case import chute_case as _chute
+
 ROOT = Path(__file__).resolve().parents[1]
 D, RHO_S, E, PHI, RATE = 1e-3, 2500.0, 0.8, 0.3, 50.0
 
@@ -348,33 +350,6 @@ def test_couette_example_parses() -> None:
 
 # --- chute: gravity-driven layer -----------------------------------------------------------------
 
-def _chute(cells: list[int], end: float) -> str:
-    return f"""
-[case]
-kind = "chute"
-inclination_deg = 25.0
-[model]
-name = "ret"
-restitution = 0.9
-[initial]
-solid_fraction = 0.3
-temperature = 0.03
-shear_rate = 100.0
-perturbation = "none"
-[grid]
-cells = {cells}
-length_d = 10.0
-[boundaries]
-x = {{ kind = "wall", flow = "y", wall_speed = 0.0, walls = {{ type = "johnson-jackson", specularity = 1.0, restitution = 0.9, top = {{ type = "zero-flux" }} }} }}
-[time]
-end = {end}
-unit = "s"
-outputs = 2
-scheme = "imex"
-[output]
-png = false
-vtk = false
-"""
 
 
 @pytest.mark.parametrize("text, field", [
