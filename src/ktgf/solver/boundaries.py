@@ -193,6 +193,37 @@ def _lees_edwards(f: Any, grid: Any, t: Any, jump: Any, G: int) -> Any:
     return jnp.concatenate([low, f, high], axis=a)
 
 
+def lees_edwards_faces(F: Sequence[Any], grid: Any, axis: int, t: Any, affine: bool = True) -> list[Any]:
+    """Face fluxes along ``axis`` (5 components, faces −1/2 … N−1/2, a component may be the scalar 0)
+    with the lower Lees–Edwards face flux replaced by the upper one, mapped back through the
+    boundary: what leaves the box through the upper face enters it through the lower one.
+
+    The upper face at x_f images the lower cells at x_f − Δ, interpolated with weights (1 − w, w)
+    (:func:`_shifted`); its flux is handed to those two lower faces with the same weights (the
+    transpose of the interpolation, which preserves sums), after the Galilean change to the frame of
+    the lower image (velocity −γ̇L_a e_f): F_ρ' = F_ρ, F_f' = F_f − U F_ρ, F_E' = F_E − U F_f + U²F_ρ/2
+    with U = γ̇L_a (``affine=False``: the linear part, without it).  So Σρ and the momentum
+    components across and normal to the flow change only by round-off; Σρu_f and ΣE change by the
+    work of the boundary, exactly as the Galilean rule says.  Other axes: F unchanged.
+    """
+    bc = grid.boundaries
+    if bc is None or bc.shear_axis != axis:
+        return list(F)
+    n, fl = grid.cells[axis], bc.flow
+    top = [f if jnp.ndim(f) == 0 else jax.lax.slice_in_dim(f, n, n + 1, axis=axis) for f in F]
+    if affine:
+        dtype = next(f.dtype for f in top if jnp.ndim(f))
+        U = jnp.asarray(bc.shear_rate * grid.lengths[axis], dtype)
+        top[4] = top[4] - U * top[1 + fl] + (0.5 * U * U) * top[0]
+        top[1 + fl] = top[1 + fl] - U * top[0]
+    if fl < grid.ndim:
+        s = jnp.mod(jnp.asarray(bc.shear_rate * grid.lengths[axis], jnp.float64) * jnp.asarray(t, jnp.float64)
+                    / grid.lengths[fl], 1.0) * grid.cells[fl]
+        top = [f if jnp.ndim(f) == 0 else _shifted(f, -s + grid.cells[fl], fl) for f in top]
+    return [f if jnp.ndim(f) == 0 else jnp.concatenate([b, jax.lax.slice_in_dim(f, 1, n + 1, axis=axis)], axis=axis)
+            for f, b in zip(F, top)]
+
+
 def _side(f: Any, axis: int, n: int, side: int, layer: int) -> Any:
     """The cell ``layer`` away from wall ``side`` (0 lower, 1 upper), kept as a slab of width 1."""
     i = layer if side == 0 else n - 1 - layer

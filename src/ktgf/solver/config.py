@@ -154,6 +154,8 @@ class TimeSection(_Section):
     max_steps_per_call: int = Field(200, ge=1, le=2**31 - 1, description="steps per compiled call (progress granularity)")
     scheme: Literal["auto", "imex", "ssprk3"] = Field(
         "auto", description="imex (implicit diffusion), ssprk3 (explicit) or auto (the cheaper for the initial state)")
+    steady_tol: float | None = Field(None, gt=0.0, lt=1.0, description="sheared cases: stop at the first output "
+                                     "whose steady monitors changed by less than this since the previous one")
 
 
 class OutputSection(_Section):
@@ -325,6 +327,9 @@ def check_case(cfg: Config, source: str = "config") -> None:
     shear, wall = b.shear_axis(), b.wall_axis()
     if kind != "chute" and cfg.case.inclination_deg is not None:
         raise InputError(f"{source}: field case.inclination_deg applies to case.kind = 'chute' only")
+    if kind == "cooling" and cfg.time.steady_tol is not None:
+        raise InputError(f"{source}: field time.steady_tol applies to the sheared cases only (a cooling box has no "
+                         "steady state)")
     if kind == "cooling" and (shear or wall):
         raise InputError(f"{source}: field boundaries.{shear or wall}.kind = {getattr(b, shear or wall).kind!r} needs "
                          "case.kind = 'uniform-shear' or 'couette' (the cooling case is a periodic box)")

@@ -19,6 +19,13 @@ Couette cell) plus the configured perturbation.
 A case adds its own columns to the time series (:func:`case_diagnostics`) and, at the end of
 a run, a comparison with its reference (:func:`verification`, written as ``verification.json``).
 
+Steady state.  With ``time.steady_tol`` a sheared run stops at the first output at which every
+steady monitor changed by less than the tolerance since the previous output (:func:`steady_change`):
+θ, η and p of uniform shear (relative change), the u, φ and θ profiles of Couette and chute
+(φ, θ pointwise relative, u relative to max|u|).  For a transient relaxing as e^{−λt} the change
+per output interval Δt is ≈ (1 − e^{−λΔt}) times the remaining deviation, so with outputs about
+1/λ apart the remaining deviation is about the tolerance (it is larger for denser outputs).
+
 Box-averaged stress tensor.  P = pI − τ with p = ρθp*(φ) and τ = η(∇u + ∇uᵀ − (2/3)∇·u I) +
 λ_b∇·u I (model.md §1), the velocity gradients by central differences across the (ghost-padded)
 cells, averaged over the box: ``stress_<ij>`` [Pa].  In uniform shear along f with gradient a the
@@ -218,6 +225,27 @@ def profiles(U: Any, grid: Grid, rho_s: float) -> dict[str, list[float]]:
     return {"u_profile": list((rho * W[1 + f]).sum(axis=others) / mass),
             "phi_profile": list(rho.mean(axis=others) / rho_s),
             "theta_profile": list((rho * W[4]).sum(axis=others) / mass)}
+
+
+#: Time-series columns whose change between outputs decides steadiness (:func:`steady_change`).
+STEADY_MONITORS = {"uniform-shear": ("theta_mean", "viscosity", "pressure"),
+                   "couette": PROFILES, "chute": PROFILES}
+
+
+def steady_change(kind: str, history: dict[str, list]) -> float | None:
+    """Max relative change of the case's steady monitors between the last two outputs (module
+    docstring; None for the cooling box or before two outputs)."""
+    names = STEADY_MONITORS.get(kind)
+    if names is None or len(history["time"]) < 2:
+        return None
+    change = 0.0
+    for name in names:
+        new, old = (np.asarray(history[name][i], dtype=float) for i in (-1, -2))
+        scale = np.max(np.abs(new)) if name == "u_profile" else np.abs(new)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rel = np.abs(new - old) / scale
+        change = max(change, float(np.max(np.where(np.isfinite(rel), rel, np.inf))))
+    return change
 
 
 def uniform_shear_reference(phys: Physics, phi: float, rate: float) -> dict[str, float]:

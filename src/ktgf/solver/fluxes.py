@@ -26,6 +26,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .boundaries import lees_edwards_faces
 from .grid import Grid
 from .physics import Physics
 from .state import conservative_fields
@@ -329,6 +330,7 @@ def flux_divergence(W: Sequence[Any], coefficients: tuple[tuple[Any, ...], tuple
         if viscous:
             Fv = viscous_flux(Pv, Pk, a, grid, phys.material_density)
             Fc = [Fc[i] + Fv[i] for i in range(5)]
+        Fc = lees_edwards_faces(Fc, grid, a, t)  # conservative across a Lees-Edwards boundary
         # One stacked array of face fluxes: XLA then computes all five components in one
         # loop and materialises them, instead of recomputing the face state in each consumer.
         dF = face_divergence(jnp.stack(Fc), grid, a)

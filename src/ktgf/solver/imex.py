@@ -51,7 +51,7 @@ from jax.scipy.sparse.linalg import bicgstab, cg
 
 from ..closures.coefficients import Reduced
 from .fluxes import face_coefficients, face_divergence, face_jump, has_walls, pad_fields, pad_viscous, stress, viscous_flux
-from .boundaries import wall_terms
+from .boundaries import lees_edwards_faces, wall_terms
 from .grid import Grid
 from .physics import Physics
 from .state import primitive_fields
@@ -130,6 +130,7 @@ def viscous_divergence(W: tuple, transport: tuple, grid: Grid, phys: Physics, t:
     out: list[Any] = [0.0] * 5
     for a in range(grid.ndim):
         F = viscous_flux(P, Pk, a, grid, phys.material_density)
+        F = lees_edwards_faces(F, grid, a, t)
         dF = face_divergence(jnp.stack([jnp.broadcast_to(f, F[1].shape) for f in F[1:]]), grid, a)
         out = [out[0]] + [o + dF[i] for i, o in enumerate(out[1:])]
     out[0] = jnp.zeros_like(W[0])
@@ -283,7 +284,9 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
             Pu = pad_fields(v, grid, t, velocity=0, affine=affine, walls=walls)
             out: list[Any] = [0.0, 0.0, 0.0]
             for a in range(grid.ndim):
-                dF = face_divergence(jnp.stack(stress(Pu, faces[a][0], faces[a][1], a, grid)), grid, a)
+                tau = lees_edwards_faces([0.0, *stress(Pu, faces[a][0], faces[a][1], a, grid), 0.0], grid, a, t,
+                                         affine=False)[1:4]
+                dF = face_divergence(jnp.stack(tau), grid, a)
                 out = [o - dF[j] for j, o in enumerate(out)]
             return out
 
@@ -315,8 +318,9 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
 
         def B(th: Any) -> Any:
             Pt = pad_fields((th,), grid, t, affine=False, theta=0, walls=walls)[0]
-            div = sum(face_divergence(-kap_f[a] * face_jump(Pt, grid.cells, a) / grid.spacing[a], grid, a)
-                      for a in range(grid.ndim))
+            div = sum(face_divergence(lees_edwards_faces(
+                [0.0, 0.0, 0.0, 0.0, -kap_f[a] * face_jump(Pt, grid.cells, a) / grid.spacing[a]], grid, a, t,
+                affine=False)[4], grid, a) for a in range(grid.ndim))
             return 1.5 * rho * th - adt * div
 
         # Right-hand side: Ê − ρ̂|u|²/2 + aΔt∇·(τ·u + ω∇φ), i.e. the stage equation with κ = 0.

@@ -39,8 +39,8 @@ from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
 from ..io import write_netcdf
 from .config import Config, initial_temperature
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
-from .flows import (CASE_COLUMNS, CASE_UNITS, PROFILES, VERIFICATION_FILE, add_base_flow, case_diagnostics, gradient_axis,
-                    shear_rate, verification)
+from .flows import (CASE_COLUMNS, CASE_UNITS, PROFILES, VERIFICATION_FILE, add_base_flow, case_diagnostics,
+                    gradient_axis, shear_rate, steady_change, verification)
 from .flows import boundaries as case_boundaries
 from .flows import gravity as case_gravity
 from .flows import describe as describe_boundaries
@@ -298,6 +298,7 @@ class Simulation:
     def _run(self, resume: str | Path | None, progress: bool, on_chunk: Callable[[dict[str, Any]], None] | None,
              write_files: bool, overwrite: bool) -> Any:
         n_out = len(self.output_times)
+        started = (_time.perf_counter(), _time.process_time())
         if resume is not None:
             U, t, steps, k, history = self._resume_from(resume)
         else:
@@ -345,6 +346,9 @@ class Simulation:
                         fault_hook("chunk", chunks)
                     self._poll()
                     self._record(U, t, history)
+                    if self._steady(history):  # the last output: its fields and checkpoint are written
+                        self.output_times = self.output_times[:k + 1]
+                        n_out = k + 1
                     if write_files:
                         fault_hook("output", k)
                         self._write_fields(U, t, k)
@@ -369,6 +373,13 @@ class Simulation:
         self.state, self.time, self.steps = U, t, steps
         ds = self.dataset(history)
         self.verification = verification(self.case, history, self.phys, self.grid, self.phi0)
+        if self.verification is not None:
+            self.verification["steady"] = self.steady_summary(history)
+            self.verification["run"] = {**self.run_summary(history), "precision": self.cfg.numerics.precision,
+                                        "cells": list(self.grid.cells),
+                                        "wall_time_s": _time.perf_counter() - started[0],
+                                        "cpu_time_s": _time.process_time() - started[1],
+                                        "load_average": list(os.getloadavg())}
         if write_files:
             ds.attrs["run_complete"] = 1
             write_netcdf(ds, self.directory / TIMESERIES)
@@ -378,6 +389,21 @@ class Simulation:
                 with atomic_path(self.directory / VERIFICATION_FILE) as tmp:
                     tmp.write_text(json.dumps(self.verification, indent=2) + "\n")
         return ds
+
+    def _steady(self, history: dict[str, list]) -> bool:
+        """True when ``time.steady_tol`` is set and the last output is steady (:func:`~.flows.steady_change`)."""
+        tol = self.cfg.time.steady_tol
+        change = steady_change(self.case, history) if tol is not None else None
+        return change is not None and change < tol
+
+    def steady_summary(self, history: dict[str, list]) -> dict[str, Any]:
+        """The steady-state stop: tolerance, whether it was met, the last change and the time [s]."""
+        tol = self.cfg.time.steady_tol
+        change = steady_change(self.case, history)
+        return {"steady_tol": tol, "reached": bool(tol is not None and change is not None and change < tol),
+                "last_change": change, "time_s": history["time"][-1] if history["time"] else None,
+                "strain": (history["time"][-1] * shear_rate(self.grid)
+                           if history["time"] and shear_rate(self.grid) else None)}
 
     @staticmethod
     def _poll() -> None:
