@@ -150,7 +150,9 @@ def stress_tensor(U: Any, t: Any, grid: Grid, phys: Physics) -> Any:
     """Box average of P = pI − τ [Pa], as (xx, yy, zz, xy, xz, yz) (module docstring)."""
     W = primitive_fields(tuple(U))
     rho, u, theta = W[0], W[1:4], W[4]
-    r = phys.reduced(rho)
+    from .friction import cell_coefficients  # (friction.py imports this module)
+
+    r = cell_coefficients(W, grid, phys, t)  # with a frictional stress: p_f and μ_f too
     p = phys.pressure(rho, theta, r)
     transport = phys.transport(rho, theta, r)
     eta, lam, _, _ = transport
@@ -198,7 +200,9 @@ def case_diagnostics(kind: str, U: Any, t: float, grid: Grid, phys: Physics) -> 
 def wall_diagnostics(U: Any, grid: Grid, phys: Physics) -> Any:
     """Mean over each wall of the shear stress η∂u_f/∂x_a [Pa] (lower, upper) and the slip u_f − U_w [m/s]."""
     W = primitive_fields(tuple(U))
-    r = phys.reduced(W[0])
+    from .friction import cell_coefficients
+
+    r = cell_coefficients(W, grid, phys)
     transport = phys.transport(W[0], W[4], r)
     terms = wall_terms(W[0], W[1:4], W[4], transport, grid, phys)
     a, f = gradient_axis(grid), grid.boundaries.flow
