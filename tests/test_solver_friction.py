@@ -139,7 +139,8 @@ def test_closed_form_frictional_uniform_shear_is_a_steady_state_with_its_stresse
         assert float(np.mean(r.p_f)) > 0.5 * p
 
 
-@pytest.mark.parametrize("options, phi, scheme", [({}, 0.5, "ssprk3"), ({"stress": "schaeffer", "jj_phi_min": 0.45}, 0.5, "ssprk3")])
+@pytest.mark.parametrize("options, phi, scheme", [({}, 0.5, "ssprk3"), ({"stress": "schaeffer", "jj_phi_min": 0.45}, 0.5, "ssprk3"),
+                                                   ({"stress": "schaeffer", "jj_phi_min": 0.45}, 0.5, "imex")])
 def test_homogeneous_frictional_shear_relaxes_to_the_closed_form(options: dict, phi: float, scheme: str) -> None:
     """From 1.3 θ the homogeneous sheared box relaxes to the closed-form θ, τ and p (to 1e-6)."""
     m = get_model("frictional", mu=0.5, **options)
@@ -156,7 +157,42 @@ def test_homogeneous_frictional_shear_relaxes_to_the_closed_form(options: dict, 
     assert abs(-P[3] / tau - 1.0) < 5e-6 and abs(P[:3].mean() / p - 1.0) < 1e-6, (P, tau, p)
 
 
-# --- 4. configs --------------------------------------------------------------------------------------
+# --- 4. planar Couette: the 1D solver with the same frictional model and walls --------------------------
+
+@pytest.mark.slow
+def test_frictional_couette_keeps_the_1d_solution_within_one_percent() -> None:
+    """``frictional`` (μ = 0.5, e = 0.7) with a Schaeffer stress at φ̄ = 0.5 (p_f is 98 % of the pressure),
+    JJ walls, 10 d gap, 128 cells, started from the 1D steady profile: after strain 10 the 3D profiles are
+    the 1D ones within 1 % in u, φ, θ (measured 0.09, 0.08, 0.6 %; 32 and 64 cells: θ 18 and 3.9 %,
+    second order), the wall stress within 1 % (0.35 %).  ~160 s wall at load 10."""
+    from test_solver_shear import RHO_S as RHO, _couette, _parse
+
+    from ktgf.solver.flows import couette_reference
+    from ktgf.solver.run import Simulation
+
+    n, phi0 = 128, 0.5
+    text = _couette([n], 10.0).replace('name = "ret"\nrestitution = 0.9', 'name = "frictional"\nrestitution = 0.7\n'
+                                        'options = { mu = 0.5, stress = "schaeffer" }')
+    sim = Simulation(_parse(text.replace("solid_fraction = 0.3", f"solid_fraction = {phi0}")))
+    ref = couette_reference(sim.phys, sim.grid, phi0)
+    assert float(ref["p_frictional"].max()) > 0.9 * float(ref["p"].max())
+    y = sim.grid.centres(0) - 0.5 * sim.grid.lengths[0]
+    yr = ref["y"].values
+    u = np.zeros((3, n))
+    u[1] = np.interp(y, yr, ref["u"].values)
+    with sim.precision():
+        U0 = conservative(jnp.asarray(RHO * np.interp(y, yr, ref["phi"].values)), jnp.asarray(u),
+                          jnp.asarray(np.interp(y, yr, ref["theta"].values)))
+        U0 = U0 * (phi0 * RHO * n / float(U0[0].sum()))
+    sim.initial_state = lambda: sim.place(U0)
+    sim.run(progress=False, write_files=False)
+    ver = sim.verification
+    assert max(ver["max_rel_error"].values()) < 0.01, ver["max_rel_error"]
+    tau_run, tau_ref = ver["wall_shear_stress_Pa"]["run"], ver["wall_shear_stress_Pa"]["reference"]
+    assert abs(tau_run[0] / tau_ref[0] - 1) < 0.01 and abs(tau_run[1] / tau_ref[1] - 1) < 0.01
+
+
+# --- 5. configs --------------------------------------------------------------------------------------
 
 def _config(case: str, options: str = "", extra: str = "") -> dict:
     if case == "cooling":
@@ -182,6 +218,18 @@ end = 1.0
 unit = "s"
 {extra}
 """)
+
+
+def test_frictional_shear_example_runs_to_the_closed_form() -> None:
+    from pathlib import Path
+
+    from ktgf.solver.config import load_config
+    from ktgf.solver.run import Simulation
+
+    sim = Simulation(load_config(Path(__file__).resolve().parents[1] / "examples" / "frictional_shear.toml"))
+    sim.run(progress=False, write_files=False)
+    err = sim.verification["max_rel_error"]
+    assert max(err.values()) < 1e-5, err
 
 
 def test_frictional_models_are_accepted_by_the_3d_solver() -> None:

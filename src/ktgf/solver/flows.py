@@ -233,6 +233,10 @@ def uniform_shear_reference(phys: Physics, phi: float, rate: float) -> dict[str,
     from ..couette.uniform_shear import uniform_shear
 
     model, e, d, rho_s = phys.model, float(phys.restitution), float(phys.diameter), float(phys.material_density)
+    if model.friction.has_stress:  # the frictional stress too: ``ktgf shear --mu`` (ktgf.solver.friction)
+        from .friction import frictional_shear_reference
+
+        return frictional_shear_reference(phys, phi, rate)
     state = uniform_shear(model, phi, e)
     theta = float(state.temperature_ratio) * (rate * d) ** 2
     r = model.reduced(phi, e)

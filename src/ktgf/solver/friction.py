@@ -23,7 +23,10 @@ the cells, once per stage (``docs/friction.md`` §7):
   stress is dissipated at the contacts and does not feed θ: the fluxes carry σ_f (momentum and the
   mechanical work in the total energy) and the energy gets the sink σ_f:∇u = 2μ_f S:S − w p_f ∇·u,
   written as the cooling rates ζ_f = 2μ_f S:S/((3/2)ρθ) and −w p_f/((3/2)ρθ) added to ζ_U (so the
-  sink scales with θ like the collisional one and the step's cooling limit covers it).
+  sink scales with θ like the collisional one and the step's cooling limit covers it).  SSP-RK3 takes
+  ζ_f explicitly; the IMEX scheme implicitly, in the energy stage solve together with the implicit
+  frictional heating (:func:`explicit_part`; explicitly, with ζ_f frozen at the stage start, a stiff
+  frictional work overshot and θ collapsed in homogeneous shear, measured).
 """
 
 from __future__ import annotations
@@ -112,3 +115,21 @@ def cell_coefficients(W: Any, grid: Grid, phys: Physics, t: Any = 0.0) -> Any:
     mu_f = friction.frictional_viscosity(p_f, ss, theta / phys.diameter**2, reg2)
     heat = 1.5 * rho * theta
     return FrictionalReduced(*r[:6], r.zeta_u - p_f / heat, r.g, r.C, p_f, dp, mu_f, 2.0 * mu_f * ss / heat)
+
+
+def explicit_part(r: Any) -> Any:
+    """The cell coefficients of the IMEX scheme's explicit part: without the frictional work ζ_f, which
+    its implicit stages take with the frictional heating (:func:`ktgf.solver.imex.implicit_stage`)."""
+    return r._replace(zeta_f=jnp.zeros_like(r.zeta_f)) if isinstance(r, FrictionalReduced) else r
+
+
+def frictional_shear_reference(phys: Physics, phi: float, rate: float) -> dict[str, float]:
+    """Steady θ [m²/s²], η = τ/γ̇ [Pa s] and p [Pa] of uniform shear with a frictional stress: the closed
+    form of ``ktgf shear --mu`` (:func:`ktgf.closures.friction_shear.model_uniform_shear`, unregularised)."""
+    from ..closures.friction_shear import model_uniform_shear
+
+    d, rho_s = float(phys.diameter), float(phys.material_density)
+    scale = rho_s * (d * rate) ** 2
+    s = model_uniform_shear(phys.model, phi, float(phys.restitution), stress_scale=scale)
+    p = float(s.p_star[0]) * scale
+    return {"theta": float(s.T[0]) * (rate * d) ** 2, "eta": float(s.tau_over_p[0]) * p / rate, "p": p}

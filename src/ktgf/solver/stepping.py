@@ -35,7 +35,7 @@ from typing import Any
 import jax
 import jax.numpy as jnp
 
-from .friction import cell_coefficients
+from .friction import cell_coefficients, explicit_part
 from .fluxes import LIMITERS, RIEMANN_SOLVERS, cell_divergence, flux_divergence, materialise, pad_fields
 from .grid import Grid
 from .imex import EXPLICIT_WEIGHTS, GAMMA, IMPLICIT_WEIGHTS, implicit_stage
@@ -221,7 +221,7 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
 
     def stage(k: Any, carry: tuple) -> tuple:
         Uk, rk, KE1, KI2, worst = carry
-        KE = explicit_rhs(Uk, grid, phys, num, viscous=False, r=rk, t=t_explicit[k])
+        KE = explicit_rhs(Uk, grid, phys, num, viscous=False, r=explicit_part(rk), t=t_explicit[k])
         KE1 = tuple(jnp.where(k == 0, a, b) for a, b in zip(KE, KE1))
         Uhat = tuple(u + dt * (wE[k, 0] * e1 + wE[k, 1] * e + wI[k] * i2)
                      for u, e1, e, i2 in zip(Un, KE1, KE, KI2))
