@@ -164,8 +164,8 @@ def test_homogeneous_frictional_shear_relaxes_to_the_closed_form(options: dict, 
 def test_frictional_couette_keeps_the_1d_solution_within_one_percent() -> None:
     """``frictional`` (μ = 0.5, e = 0.7) with a Schaeffer stress at φ̄ = 0.5 (p_f is 98 % of the pressure),
     JJ walls, 10 d gap, 128 cells, started from the 1D steady profile: after strain 10 the 3D profiles are
-    the 1D ones within 1 % in u, φ, θ (measured 0.09, 0.08, 0.6 %; 32 and 64 cells: θ 18 and 3.9 %,
-    second order), the wall stress within 1 % (0.35 %).  ~160 s wall at load 10."""
+    the 1D ones within 1 % in u, φ, θ (measured 0.08, 0.08, 0.92 %; θ converges at second order with the
+    cells, docs/friction.md §7), the wall stress within 1 % (0.35 %).  ~140 s wall at load 8."""
     from test_solver_shear import RHO_S as RHO, _couette, _parse
 
     from ktgf.solver.flows import couette_reference
