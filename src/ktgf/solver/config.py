@@ -270,6 +270,26 @@ def load_config(path: str | Path) -> Config:
     return parse_config(data, str(path))
 
 
+def _check_friction(cfg: Config, model: Any, source: str) -> None:
+    """What the 3D solver does not do with frictional particles yet (docs/friction.md §7), one line each."""
+    kind = cfg.case.kind
+    if model.friction.has_stress and kind in ("cooling", "chute"):
+        # The rate-independent viscosity is regularised with ε γ̇_ref, γ̇_ref the case's imposed shear rate.
+        raise InputError(f"{source}: field model.options.stress = {model.friction.stress!r}: a frictional stress "
+                         f"needs a case with an imposed shear rate for its regularisation (valid case.kind: "
+                         f"uniform-shear, couette; got {kind!r})")
+    if model.friction.mu > 0.0 and kind == "cooling":  # the HCS dissipation: Walton's rule has none at weak μ
+        try:
+            model.reduced(cfg.initial.solid_fraction, cfg.model.restitution, hcs=True)
+        except KtgfError as exc:
+            raise InputError(f"{source}: field model.options.mu: {exc}") from None
+    wall = cfg.boundaries.wall_axis() if kind in ("couette", "chute") else None
+    walls = getattr(cfg.boundaries, wall).walls if wall else None
+    if walls is not None and any((w.friction_angle or 0.0) > 0.0 for w in walls.build_pair()):
+        raise InputError(f"{source}: field boundaries.{wall}.walls.friction_angle: the 3D solver's walls have no "
+                         "frictional wall stress (valid: 0; it is in the 1D Couette solver, docs/friction.md §8)")
+
+
 def check_physics(cfg: Config, source: str = "config") -> None:
     """Cross-field checks that need the model: φ0 below the packing limit, a valid model name/options."""
     from ..closures import get_model
@@ -278,11 +298,6 @@ def check_physics(cfg: Config, source: str = "config") -> None:
         model = get_model(cfg.model.name, **cfg.model.options)
     except KtgfError as exc:
         raise InputError(f"{source}: field model.name/options: {exc}") from None
-    if model.friction.key != "none":
-        # The 3D solver has no frictional stress and uses the shear-flow dissipation, which for a
-        # frictional cooling gas is 1.5x the homogeneous-cooling one (docs/friction.md): refuse.
-        raise InputError(f"{source}: field model.name = {cfg.model.name!r}: the 3D solver does not support "
-                         f"friction part {model.friction.key!r} yet (valid: models with friction 'none')")
     phi0 = cfg.initial.solid_fraction
     stop = cfg.numerics.phi_stop if cfg.numerics.phi_stop is not None else 0.99 * model.phi_max
     if phi0 >= model.phi_max:
@@ -304,10 +319,11 @@ def check_physics(cfg: Config, source: str = "config") -> None:
         raise InputError(f"{source}: field initial.max_mode = {cfg.initial.max_mode} is out of range: valid "
                          f"1 <= max_mode <= {max(cells) // 2} (half the largest cell count)")
     check_case(cfg, source)
+    _check_friction(cfg, model, source)
     if cfg.grid.relative_to is not None:
         from ..hcs.stability import critical_wavenumbers
 
-        kp, kl = critical_wavenumbers(model.reduced(phi0, cfg.model.restitution))
+        kp, kl = critical_wavenumbers(model.reduced(phi0, cfg.model.restitution, hcs=True))
         k = kp if cfg.grid.relative_to == "transverse" else kl
         if not float(k) > 0:
             raise InputError(

@@ -157,7 +157,9 @@ def stress_tensor(U: Any, t: Any, grid: Grid, phys: Physics) -> Any:
     """Box average of P = pI − τ [Pa], as (xx, yy, zz, xy, xz, yz) (module docstring)."""
     W = primitive_fields(tuple(U))
     rho, u, theta = W[0], W[1:4], W[4]
-    r = phys.reduced(rho)
+    from .friction import cell_coefficients  # (friction.py imports this module)
+
+    r = cell_coefficients(W, grid, phys, t)  # with a frictional stress: p_f and μ_f too
     p = phys.pressure(rho, theta, r)
     transport = phys.transport(rho, theta, r)
     eta, lam, _, _ = transport
@@ -205,7 +207,9 @@ def case_diagnostics(kind: str, U: Any, t: float, grid: Grid, phys: Physics) -> 
 def wall_diagnostics(U: Any, grid: Grid, phys: Physics) -> Any:
     """Mean over each wall of the shear stress η∂u_f/∂x_a [Pa] (lower, upper) and the slip u_f − U_w [m/s]."""
     W = primitive_fields(tuple(U))
-    r = phys.reduced(W[0])
+    from .friction import cell_coefficients
+
+    r = cell_coefficients(W, grid, phys)
     transport = phys.transport(W[0], W[4], r)
     terms = wall_terms(W[0], W[1:4], W[4], transport, grid, phys)
     a, f = gradient_axis(grid), grid.boundaries.flow
@@ -257,6 +261,10 @@ def uniform_shear_reference(phys: Physics, phi: float, rate: float) -> dict[str,
     from ..couette.uniform_shear import uniform_shear
 
     model, e, d, rho_s = phys.model, float(phys.restitution), float(phys.diameter), float(phys.material_density)
+    if model.friction.has_stress:  # the frictional stress too: ``ktgf shear --mu`` (ktgf.solver.friction)
+        from .friction import frictional_shear_reference
+
+        return frictional_shear_reference(phys, phi, rate)
     state = uniform_shear(model, phi, e)
     theta = float(state.temperature_ratio) * (rate * d) ** 2
     r = model.reduced(phi, e)

@@ -159,14 +159,19 @@ def reconstruct(P: Sequence[Any], cells: tuple[int, ...], axis: int, limiter: st
     return left, right
 
 
-def cell_fields(W: Sequence[Any], phys: Physics) -> tuple[tuple[Any, ...], tuple[Any, ...], Any]:
+def cell_fields(W: Sequence[Any], phys: Physics, grid: Grid | None = None,
+                t: Any = 0.0) -> tuple[tuple[Any, ...], tuple[Any, ...], Any]:
     """The closures once per cell: (eos, transport, r).
 
     ``eos`` = (p*, g) for the convective flux, ``transport`` = (η, λ_b, κ, ω) in SI for the
-    viscous and heat fluxes, ``r`` the cell :class:`~ktgf.closures.Reduced` (cooling rate, Δt).
+    viscous and heat fluxes, ``r`` the cell :class:`~ktgf.closures.Reduced` (cooling rate, Δt);
+    with the ``grid`` (and time ``t``), the coefficients that need the velocity gradient too
+    (frictional stress, shear-dependent dissipation: :func:`.friction.cell_coefficients`).
     """
-    r = phys.reduced(W[0])
-    return (r.p, phys.sound_factor(r)), phys.transport(W[0], W[4], r), r
+    from .friction import cell_coefficients
+
+    r = phys.reduced(W[0]) if grid is None else cell_coefficients(W, grid, phys, t)
+    return phys.eos(W[0], W[4], r), phys.transport(W[0], W[4], r), r
 
 
 def _euler_flux(W: Sequence[Any], U: Sequence[Any], p: Any, a: int) -> list[Any]:

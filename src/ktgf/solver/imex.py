@@ -261,7 +261,12 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     # Coefficient temperature: θ of Û plus the explicit implicit-part increment, an O(Δt²)
     # estimate of the stage θ (kept within a factor 2 of θ̂, which only matters far outside the
     # asymptotic range).
+    # A frictional stress's work 2μ_f S:S (docs/friction.md §7) is removed here, in the implicit part with
+    # the frictional heating it cancels, frozen with μ_f at the stage start (as a rate ∝ θ, or explicitly,
+    # the stage-start θ biased the steady θ by O(ζΔt), 4-7 % measured; explicitly a stiff one overshot).
+    sink = 1.5 * rho * theta * r.zeta_f if hasattr(r, "zeta_f") else 0.0
     fI = viscous_divergence(Wh, phys.transport(rho, theta, r), grid, phys, t)
+    fI[4] = fI[4] - sink
     heat = fI[4] - sum(x * f for x, f in zip(u, fI[1:4]))
     theta = jnp.clip(theta + adt * heat / (1.5 * rho), 0.5 * theta, 2.0 * theta)
 
@@ -325,7 +330,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
 
         # Right-hand side: Ê − ρ̂|u|²/2 + aΔt∇·(τ·u + ω∇φ), i.e. the stage equation with κ = 0.
         fI0 = viscous_divergence((rho, *u, jnp.zeros_like(theta)), transport, grid, phys, t, walls)
-        rhs_E = E_hat - 0.5 * rho * sum(x * x for x in u) + adt * fI0[4]
+        rhs_E = E_hat - 0.5 * rho * sum(x * x for x in u) + adt * (fI0[4] - sink)
         kap_m = jnp.mean(transport[2])
         hscale = jnp.sqrt((1.5 * rho + adt * sum(_face_sum(kap_f, grid, a) * inv_dx2[a] for a in range(grid.ndim)))
                           / (1.5 * rho_mean + 2.0 * adt * kap_m * sum(inv_dx2)))
@@ -339,6 +344,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
 
         # The conservative stage state and the residual of its two linear problems.
         fI = viscous_divergence((rho, *u, theta), transport, grid, phys, t, walls)
+        fI[4] = fI[4] - sink
         U = (rho, *(m + adt * f for m, f in zip(m_hat, fI[1:4])), E_hat + adt * fI[4])
         res_m = _norm(tuple(rho * x - m for x, m in zip(u, U[1:4])), acc)
         res_E = _norm(U[4] - rho * (0.5 * sum(x * x for x in u) + 1.5 * theta), acc)

@@ -33,7 +33,7 @@ def uniform_fields(grid: Grid, phys: Physics, phi0: float, theta0: float) -> tup
 
 def haff_time(phys: Physics, phi0: float, theta0: float) -> float:
     """Haff time t0 = 2/ζ0(θ0) [s]: θ_H(t) = θ0/(1 + t/t0)²."""
-    r = phys.model.reduced(phi0, phys.restitution)
+    r = phys.model.reduced(phi0, phys.restitution, hcs=phys.hcs)
     return float(2.0 / (nu0(phi0, theta0, phys.diameter) * r.zeta0))
 
 
@@ -73,7 +73,7 @@ def single_mode(
     khat, perp = _direction(k)
     x = grid.mesh()
     phase = np.exp(1j * sum(k[a] * x[a] for a in range(grid.ndim)))
-    r = phys.model.reduced(phi0, phys.restitution)
+    r = phys.model.reduced(phi0, phys.restitution, hcs=phys.hcs)
     rho, u, theta = uniform_fields(grid, phys, phi0, theta0)
     w_scale = math.sqrt(2.0 * theta0)
     if kind == "transverse":

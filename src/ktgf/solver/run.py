@@ -44,6 +44,7 @@ from .flows import (CASE_COLUMNS, CASE_UNITS, PROFILES, VERIFICATION_FILE, add_b
 from .flows import boundaries as case_boundaries
 from .flows import gravity as case_gravity
 from .flows import describe as describe_boundaries
+from .friction import for_case
 from .grid import Grid
 from .initial import haff_time, random_velocity, shear_mode, single_mode, t_of_tau, tau_of_t, uniform_fields
 from .interrupt import STOP, Interrupted, fault_hook
@@ -129,7 +130,7 @@ def box_lengths(cfg: Config) -> tuple[float, ...]:
         return per_axis(g.length_d, d)
     phi0 = cfg.initial.solid_fraction
     model = get_model(cfg.model.name, **cfg.model.options)
-    kp, kl = critical_wavenumbers(model.reduced(phi0, cfg.model.restitution))
+    kp, kl = critical_wavenumbers(model.reduced(phi0, cfg.model.restitution, hcs=True))
     k = float(kp if g.relative_to == "transverse" else kl)
     return per_axis(g.factor * BOX_CONSTANT / (phi0 * k), d)
 
@@ -180,6 +181,7 @@ class Simulation:
         self.case = cfg.case.kind
         bc = case_boundaries(cfg)
         self.grid = Grid(tuple(cfg.grid.cells), box_lengths(cfg), None if bc.all_periodic else bc)
+        self.phys = for_case(self.phys, self.case, self.grid)  # the case's dissipation and shear-rate scale
         self.history_keys = (*HISTORY_KEYS, *CASE_COLUMNS[self.case])
         n = cfg.numerics
         self.num = Numerics(n.cfl, n.cfl_diffusion, n.cfl_source, n.limiter, n.riemann, scheme="ssprk3",

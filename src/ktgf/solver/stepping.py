@@ -35,6 +35,7 @@ from typing import Any
 import jax
 import jax.numpy as jnp
 
+from .friction import cell_coefficients, explicit_part
 from .fluxes import LIMITERS, RIEMANN_SOLVERS, cell_divergence, flux_divergence, materialise, pad_fields
 from .grid import Grid
 from .imex import EXPLICIT_WEIGHTS, GAMMA, IMPLICIT_WEIGHTS, implicit_stage
@@ -136,8 +137,8 @@ def explicit_rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, viscous: bool
     """
     W = materialise(primitive_fields(U))
     if r is None:
-        r = phys.reduced(W[0])
-    eos = (r.p, phys.sound_factor(r))
+        r = cell_coefficients(W, grid, phys, t)
+    eos = phys.eos(W[0], W[4], r)
     transport = phys.transport(W[0], W[4], r) if viscous else ()
     dU, divu = flux_divergence(W, (eos, transport), grid, phys, num.limiter, num.riemann, viscous=viscous, t=t)
     source, _ = cooling_source(W, divu, phys, r)
@@ -158,7 +159,7 @@ def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None)
     W = primitive_fields(U)
     rho, u, theta = W[0], W[1:4], W[4]
     if r is None:
-        r = phys.reduced(rho)
+        r = cell_coefficients(W, grid, phys)
     c = phys.sound_speed(theta, r)
     wave = sum((jnp.abs(u[a]) + c) / grid.spacing[a] for a in range(grid.ndim))
     eta, lam, kap, _ = phys.transport(rho, theta, r)
@@ -220,7 +221,7 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
 
     def stage(k: Any, carry: tuple) -> tuple:
         Uk, rk, KE1, KI2, worst = carry
-        KE = explicit_rhs(Uk, grid, phys, num, viscous=False, r=rk, t=t_explicit[k])
+        KE = explicit_rhs(Uk, grid, phys, num, viscous=False, r=explicit_part(rk), t=t_explicit[k])
         KE1 = tuple(jnp.where(k == 0, a, b) for a, b in zip(KE, KE1))
         Uhat = tuple(u + dt * (wE[k, 0] * e1 + wE[k, 1] * e + wI[k] * i2)
                      for u, e1, e, i2 in zip(Un, KE1, KE, KI2))
@@ -228,7 +229,7 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
         # the tolerance: residual 67x the limit after a few steps).  Mixed: float32 vectors,
         # float64 inner products (docs/solver.md, Speed).
         Uhat64 = Uhat if num.mixed else tuple(u.astype(jnp.float64) for u in Uhat)
-        r = phys.reduced(Uhat64[0])
+        r = cell_coefficients(primitive_fields(Uhat64), grid, phys, t_implicit[k])
         Ui, fI, res = implicit_stage(Uhat64, GAMMA * jnp.asarray(dt, jnp.float64).astype(Uhat64[0].dtype), grid, phys,
                                      r, jnp.asarray(num.implicit_tol, jnp.float64), num.implicit_maxiter, num.sweeps,
                                      t_implicit[k], mixed=num.mixed)
@@ -237,7 +238,7 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
             tuple(jnp.broadcast_to(f, Un[0].shape).astype(dtype) for f in fI), jnp.maximum(worst, res.astype(dtype))
 
     zeros = tuple(jnp.zeros_like(u) for u in Un)
-    r0 = jax.tree_util.tree_map(lambda x: jnp.asarray(x).astype(dtype), phys.reduced(Un[0]))
+    r0 = jax.tree_util.tree_map(lambda x: jnp.asarray(x).astype(dtype), cell_coefficients(primitive_fields(Un), grid, phys, t))
     init = (Un, r0, zeros, zeros, jnp.zeros((), dtype))
     Ui, _, _, _, worst = jax.lax.fori_loop(0, 2, stage, init)
     return Ui, worst

@@ -1,0 +1,135 @@
+"""Frictional models in the 3D solver: the case's dissipation and the frictional stress at the cells.
+
+The closures are the friction part's own (:mod:`ktgf.closures.friction.model_slot`, the ones the
+Couette solver calls in :mod:`ktgf.couette.frictional_stress`); this module only evaluates them at
+the cells, once per stage (``docs/friction.md`` §7):
+
+* **Dissipation per case** (:func:`for_case`): the freely cooling box takes the homogeneous-cooling
+  dissipation (``Model.reduced(hcs=True)``), the sheared cases (uniform shear, Couette, chute) the
+  steady-shear one, with the local shear measure dγ̇/√θ of a dissipation correction (extended
+  kinetic theory), γ̇ = √(2 S:S) — |∂u_f/∂x_a| in simple shear, as in the Couette solver.
+* **Frictional stress** (a model whose friction part has ``stress``): σ_f = −w p_f I + 2μ_f S with
+
+      Schaeffer:               μ_f = w p_f sin φ_fr / (2 √(S:S/2 + ε² γ̇_ref²))
+      Srivastava–Sundaresan:   μ_f = √2 w p_f sin φ_fr / (2 √(S:S + 2ε² γ̇_ref² + θ/d²))
+
+  S = D − (1/3)(tr D) I the deviatoric strain rate of the full tensor (central differences at the
+  cells), γ̇_ref the case's shear-rate scale (U/H, the Lees–Edwards γ̇), ε the option
+  ``regularisation`` — in simple shear exactly the Couette solver's expressions.  As there, the
+  Srivastava–Sundaresan dilatancy factor is taken at ∇·u = 0 (p_f = p_c).  w p_f is added to the
+  pressure (and d(w p_f)/dρ to the sound speed² of the upwind flux), μ_f to the shear viscosity, so
+  it enters the implicit viscous operator of the IMEX stages frozen at the stage start like η.
+* **Frictional work**: as in the Couette solver (``P = F_kinetic Δω``) the work of the frictional
+  stress is dissipated at the contacts and does not feed θ: the fluxes carry σ_f (momentum and the
+  mechanical work in the total energy) and the energy gets the sink σ_f:∇u = 2μ_f S:S − w p_f ∇·u,
+  written as the cooling rates ζ_f = 2μ_f S:S/((3/2)ρθ) and −w p_f/((3/2)ρθ) added to ζ_U (so the
+  sink scales with θ like the collisional one and the step's cooling limit covers it).  SSP-RK3 takes
+  ζ_f explicitly; the IMEX scheme implicitly, in the energy stage solve together with the implicit
+  frictional heating (:func:`explicit_part`; explicitly, with ζ_f frozen at the stage start, a stiff
+  frictional work overshot and θ collapsed in homogeneous shear, measured).
+"""
+
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import jax
+import jax.numpy as jnp
+
+from .fluxes import pad_fields
+from .grid import Grid
+from .physics import Physics
+
+
+class FrictionalReduced(NamedTuple):
+    """Cell coefficients of a model with a frictional stress: the :class:`~ktgf.closures.Reduced`
+    fields (ζ_U including the frictional pressure work) plus the frictional fields [SI]."""
+
+    p: Any
+    eta: Any
+    lambda_b: Any
+    kappa: Any
+    mu: Any
+    zeta0: Any
+    zeta_u: Any
+    g: Any
+    C: Any
+    p_f: Any  # w p_f [Pa]
+    c2_f: Any  # d(w p_f)/dρ [m²/s²]
+    mu_f: Any  # frictional viscosity [Pa s]
+    zeta_f: Any  # 2μ_f S:S/((3/2)ρθ) [1/s]
+
+
+def for_case(phys: Physics, kind: str, grid: Grid) -> Physics:
+    """The physics of a case: the HCS dissipation for ``cooling``, and the case's shear-rate scale."""
+    import dataclasses
+
+    from .flows import shear_rate
+
+    return dataclasses.replace(phys, hcs=kind == "cooling", shear_rate_scale=abs(float(shear_rate(grid))))
+
+
+def needs_rate(phys: Physics) -> bool:
+    """Whether the cell coefficients depend on the velocity gradient (static)."""
+    model = phys.model
+    return model.friction.has_stress or (model.dissipation.key != "none" and not phys.hcs)
+
+
+def strain_invariants(u: Any, grid: Grid, t: Any = 0.0) -> tuple[Any, Any]:
+    """(S:S, ∇·u) at the cells, S the deviatoric strain rate, by central differences of the padded u
+    (Lees–Edwards images at time t; extrapolated ghosts at walls)."""
+    from .flows import _gradients
+
+    g = _gradients(pad_fields(tuple(u), grid, t, velocity=0), grid)
+    divu = g[0][0] + g[1][1] + g[2][2]
+    dd = sum(0.25 * (g[b][j] + g[j][b]) ** 2 for b in range(3) for j in range(3))
+    return dd - divu * divu / 3.0, divu
+
+
+def cell_coefficients(W: Any, grid: Grid, phys: Physics, t: Any = 0.0) -> Any:
+    """The closures at the cells of the primitive state W = (ρ, u, θ) at time t (once per stage).
+
+    A plain :meth:`Physics.reduced` (bit for bit the former coefficients) unless the model needs the
+    velocity gradient: a dissipation correction in a sheared case, or a frictional stress
+    (then a :class:`FrictionalReduced`).
+    """
+    if not needs_rate(phys):
+        return phys.reduced(W[0])
+    rho, theta = W[0], W[4]
+    ss, _ = strain_invariants(W[1:4], grid, t)
+    ss = jnp.maximum(ss, 0.0)  # round-off
+    model = phys.model
+    shear = None
+    if model.dissipation.key != "none" and not phys.hcs:
+        shear = phys.diameter * jnp.sqrt(2.0 * ss / theta)
+    r = phys.reduced(rho, shear)
+    if not model.friction.has_stress:
+        return r
+    friction = model.friction
+
+    def pressure(rho_: Any) -> Any:
+        return friction.frictional_pressure(rho_ / phys.material_density, model.phi_max)
+
+    p_f, dp = jax.jvp(pressure, (rho,), (jnp.ones_like(rho),))
+    reg2 = (friction.regularisation * phys.shear_rate_scale) ** 2
+    mu_f = friction.frictional_viscosity(p_f, ss, theta / phys.diameter**2, reg2)
+    heat = 1.5 * rho * theta
+    return FrictionalReduced(*r[:6], r.zeta_u - p_f / heat, r.g, r.C, p_f, dp, mu_f, 2.0 * mu_f * ss / heat)
+
+
+def explicit_part(r: Any) -> Any:
+    """The cell coefficients of the IMEX scheme's explicit part: without the frictional work ζ_f, which
+    its implicit stages take with the frictional heating (:func:`ktgf.solver.imex.implicit_stage`)."""
+    return r._replace(zeta_f=jnp.zeros_like(r.zeta_f)) if isinstance(r, FrictionalReduced) else r
+
+
+def frictional_shear_reference(phys: Physics, phi: float, rate: float) -> dict[str, float]:
+    """Steady θ [m²/s²], η = τ/γ̇ [Pa s] and p [Pa] of uniform shear with a frictional stress: the closed
+    form of ``ktgf shear --mu`` (:func:`ktgf.closures.friction_shear.model_uniform_shear`, unregularised)."""
+    from ..closures.friction_shear import model_uniform_shear
+
+    d, rho_s = float(phys.diameter), float(phys.material_density)
+    scale = rho_s * (d * rate) ** 2
+    s = model_uniform_shear(phys.model, phi, float(phys.restitution), stress_scale=scale)
+    p = float(s.p_star[0]) * scale
+    return {"theta": float(s.T[0]) * (rate * d) ** 2, "eta": float(s.tau_over_p[0]) * p / rate, "p": p}
