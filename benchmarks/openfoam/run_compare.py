@@ -77,8 +77,10 @@ def run_ktgf(cfg_path: Path, work: Path) -> dict:
     import xarray as xr
 
     with xr.open_dataset(work / "ktgf" / "hcs.nc") as ds:
-        return {"wall_s": wall, "cpu_s": cpu, "t": ds["t"].values.tolist() if "t" in ds else ds["time"].values.tolist(),
-                "theta": ds["theta_mean"].values.tolist(), "density_variance": ds["density_variance"].values.tolist(), "steps": int(ds.attrs.get("step_count", -1))}
+        series = {k: ds[v].values.tolist() for k, v in (("t", "time"), ("theta", "theta_mean"),
+                                                         ("density_variance", "density_variance"))}
+        return {"wall_s": wall, "cpu_s": cpu, **series, "steps": int(ds.attrs["step_count"]),
+                "scheme": str(ds.attrs["time_scheme"])}
 
 
 def _set(control: Path, key: str, value: str) -> None:
@@ -108,7 +110,8 @@ def run_openfoam(cfg, work: Path, segments: int, info: dict) -> dict:
         wall, cpu = wall + w, cpu + c
         steps += len(re.findall(r"^Time = ", (case / f"log.twoPhaseEulerFoam.{i}").read_text(), flags=re.M))
     t, theta, alpha = [0.0], [theta0], [info["phi"] * (1.0 + info["density_variance0"])]
-    for f in sorted((case / "postProcessing" / "thetaMean").glob("*/volFieldValue*.dat"), key=lambda p: float(p.parent.name)):
+    files = (case / "postProcessing" / "thetaMean").glob("*/volFieldValue*.dat")
+    for f in sorted(files, key=lambda p: float(p.parent.name)):  # one folder per restart
         for line in f.read_text().splitlines():
             if line.strip() and not line.startswith("#"):
                 a, b, c = (float(x) for x in line.split()[:3])
@@ -128,10 +131,10 @@ def compare(ktgf: dict, foam: dict, info: dict) -> dict:
     return {"t_over_t0": (t / info["t_haff"]).tolist(), "ktgf_over_haff": k.tolist(), "openfoam_over_haff": f.tolist(),
             "max_ktgf_haff_dev": float(np.max(np.abs(k - 1))), "max_openfoam_haff_dev": float(np.max(np.abs(f - 1))),
             "max_openfoam_ktgf_diff": float(np.max(np.abs(f / k - 1))),
-            # ⟨α²⟩/⟨α⟩ (the alpha-weighted mean of alpha) / φ − 1 = ⟨δφ²⟩/φ², ktgf's density_variance
+            # ⟨α²⟩/⟨α⟩ (alpha-weighted mean of alpha)/φ − 1 = ⟨δφ²⟩/φ², ktgf's density_variance
             # (⟨α⟩ = φ: OpenFOAM prints the volume fraction, conserved to its 8 digits)
             "density_variance_ktgf": [ktgf["density_variance"][0], ktgf["density_variance"][-1]],
-            "density_variance_openfoam": [foam["alpha_mean"][0] / info["phi"] - 1, foam["alpha_mean"][-1] / info["phi"] - 1]}
+            "density_variance_openfoam": [a / info["phi"] - 1 for a in (foam["alpha_mean"][0], foam["alpha_mean"][-1])]}
 
 
 def main(argv: list[str] | None = None) -> dict:
@@ -164,13 +167,14 @@ def main(argv: list[str] | None = None) -> dict:
     load1 = os.getloadavg()
     ktgf = None if args.skip_ktgf else run_ktgf(cfg_path, work)
     load2 = os.getloadavg()
-    out = {"cells": info["cells"], "phi": info["phi"], "e": info["e"], "t_end_s": info["t_end"], "t_haff_s": info["t_haff"],
+    out = {"cells": info["cells"], "phi": info["phi"], "e": info["e"], "t_end_s": info["t_end"],
+           "t_haff_s": info["t_haff"],
            "gas": info["gas"], "granular": info["granular"], "drag_over_collisional_dissipation":
            info["drag_over_collisional_dissipation"], "density_ratio": info["density_ratio"],
            "openfoam": {k: v for k, v in foam.items() if k in ("wall_s", "cpu_s", "steps")},
            "load_average": {"start": load0, "after_openfoam": load1, "after_ktgf": load2}}
     if ktgf is not None:
-        out["ktgf"] = {k: v for k, v in ktgf.items() if k in ("wall_s", "cpu_s", "steps")}
+        out["ktgf"] = {k: v for k, v in ktgf.items() if k in ("wall_s", "cpu_s", "steps", "scheme")}
         out["ratio_wall"] = foam["wall_s"] / ktgf["wall_s"]
         out["ratio_cpu"] = foam["cpu_s"] / ktgf["cpu_s"]
         out["theta"] = compare(ktgf, foam, info)
@@ -181,9 +185,11 @@ def main(argv: list[str] | None = None) -> dict:
         print("t/t0   ktgf/Haff  OpenFOAM/Haff")
         for a, b, c in zip(th["t_over_t0"], th["ktgf_over_haff"], th["openfoam_over_haff"]):
             print(f"{a:5.2f}  {b:.5f}    {c:.5f}")
-        print(f"max |ktgf/Haff - 1| {th['max_ktgf_haff_dev']:.4f}, max |OpenFOAM/Haff - 1| {th['max_openfoam_haff_dev']:.4f}, "
+        print(f"max |ktgf/Haff - 1| {th['max_ktgf_haff_dev']:.4f}, "
+              f"max |OpenFOAM/Haff - 1| {th['max_openfoam_haff_dev']:.4f}, "
               f"max |OpenFOAM/ktgf - 1| {th['max_openfoam_ktgf_diff']:.4f}")
-        print("density variance start, end: ktgf", th["density_variance_ktgf"], "OpenFOAM", th["density_variance_openfoam"])
+        print("density variance start, end: ktgf", th["density_variance_ktgf"],
+              "OpenFOAM", th["density_variance_openfoam"])
         print(f"time-to-solution OpenFOAM/ktgf: wall {out['ratio_wall']:.2f}, CPU {out['ratio_cpu']:.2f}")
     return out
 
