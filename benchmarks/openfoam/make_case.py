@@ -50,6 +50,12 @@ def _header(cls: str, obj: str, location: str) -> str:
             f"    class       {cls};\n    location    \"{location}\";\n    object      {obj};\n}}\n\n")
 
 
+def _hdr(rel: str, cls: str = "dictionary") -> str:
+    """Header of the file at ``rel`` (e.g. ``constant/g``): object and location from the path."""
+    location, obj = rel.split("/")
+    return _header(cls, obj, location)
+
+
 def _dict(body: dict[str, Any], indent: int = 0) -> str:
     """OpenFOAM dictionary text of a nested dict (values: str, number, dict, or raw text)."""
     pad = " " * indent
@@ -96,24 +102,27 @@ def _field(name: str, cls: str, values: np.ndarray | float | tuple, dims: str) -
 
 
 def case_parameters(cfg: Any) -> dict[str, Any]:
-    """Everything the case needs from a validated ktgf config: box, cells, φ, e, d, ρ_s, θ0, end time [s]."""
+    """Everything the case needs from a validated ktgf config: box, cells, φ, e, d, ρ_s, θ0, end time [s],
+    and ktgf's acoustic step limit cfl·Δx/(3c) of the uniform initial state (c: granular sound speed)."""
     import jax.numpy as jnp
 
+    from ktgf.errors import InputError
     from ktgf.solver.run import Simulation
 
-    if cfg.case.kind != "cooling" or len(cfg.grid.cells) != 3 or len(set(cfg.grid.cells)) != 1:
-        raise ValueError("make_case: a 3D cooling box with N³ cells is needed (case.kind = 'cooling', cells = [N, N, N])")
+    cells = cfg.grid.cells
+    if cfg.case.kind != "cooling" or len(cells) != 3 or len(set(cells)) != 1:
+        raise InputError(f"make_case: field grid.cells = {cells}, case.kind = {cfg.case.kind!r}: "
+                         "valid a cooling box with N³ cells (cells = [N, N, N])")
     sim = Simulation(cfg)
-    lengths = sim.grid.lengths
+    side, n = float(sim.grid.lengths[0]), int(cells[0])
     with sim.precision():
         rho0 = jnp.asarray(cfg.initial.solid_fraction * cfg.particles.density)
         c0 = float(sim.phys.sound_speed(jnp.asarray(sim.theta0), sim.phys.reduced(rho0)))
-    return {"sound_speed0": c0,
-            # ktgf's acoustic limit (cfl 0.4, summed over the 3 axes) of the uniform initial state
-            "acoustic_dt0": 0.4 * lengths[0] / cfg.grid.cells[0] / (3.0 * c0),"sim": sim, "cells": int(cfg.grid.cells[0]), "length": float(lengths[0]), "phi": cfg.initial.solid_fraction,
-            "e": cfg.model.restitution, "d": cfg.particles.diameter, "rho_s": cfg.particles.density,
-            "theta0": float(sim.theta0), "t_end": float(sim.output_times[-1]), "t_haff": float(sim.t_haff),
-            "output_times": np.asarray(sim.output_times)}
+    return {"sim": sim, "cells": n, "length": side, "phi": cfg.initial.solid_fraction, "e": cfg.model.restitution,
+            "d": cfg.particles.diameter, "rho_s": cfg.particles.density, "theta0": float(sim.theta0),
+            "t_end": float(sim.output_times[-1]), "t_haff": float(sim.t_haff),
+            "output_times": np.asarray(sim.output_times), "sound_speed0": c0,
+            "acoustic_dt0": cfg.numerics.cfl * side / n / (3.0 * c0)}
 
 
 def initial_fields(sim: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -136,7 +145,8 @@ def gas_effect(p: dict[str, Any], gas: dict[str, Any] = GAS) -> dict[str, float]
     rho_gas = gas["p"] * gas["molWeight"] * 1e-3 / (8.314462618 * gas["T"])
     drag = 3 * 18 * gas["mu"] * phi / d**2
     coll = 12 * (1 - p["e"] ** 2) * phi**2 * p["rho_s"] * g0 * math.sqrt(p["theta0"]) / (d * math.sqrt(math.pi))
-    return {"drag_over_collisional_dissipation": drag / coll, "gas_density": rho_gas, "density_ratio": rho_gas / p["rho_s"]}
+    return {"drag_over_collisional_dissipation": drag / coll, "gas_density": rho_gas,
+            "density_ratio": rho_gas / p["rho_s"]}
 
 
 def write_case(cfg: Any, directory: str | Path, *, max_co: float = 0.2, writes: int | None = None,
@@ -149,9 +159,11 @@ def write_case(cfg: Any, directory: str | Path, *, max_co: float = 0.2, writes: 
     n, L = p["cells"], p["length"]
     files: dict[str, str] = {}
     v = [(0, 0, 0), (L, 0, 0), (L, L, 0), (0, L, 0), (0, 0, L), (L, 0, L), (L, L, L), (0, L, L)]
-    faces = {"x0": "(0 4 7 3)", "x1": "(1 2 6 5)", "y0": "(0 1 5 4)", "y1": "(3 7 6 2)", "z0": "(0 3 2 1)", "z1": "(4 5 6 7)"}
-    boundary = "".join(f"    {name}\n    {{\n        type cyclic;\n        neighbourPatch {name[0]}{1 - int(name[1])};\n"
-                       f"        faces ({f});\n    }}\n" for name, f in faces.items())
+    faces = {"x0": "(0 4 7 3)", "x1": "(1 2 6 5)", "y0": "(0 1 5 4)", "y1": "(3 7 6 2)",
+             "z0": "(0 3 2 1)", "z1": "(4 5 6 7)"}
+    boundary = "".join(f"    {name}\n    {{\n        type cyclic;\n"
+                       f"        neighbourPatch {name[0]}{1 - int(name[1])};\n        faces ({f});\n    }}\n"
+                       for name, f in faces.items())
     files["system/blockMeshDict"] = (
         _header("dictionary", "blockMeshDict", "system") + "scale 1;\n\nvertices\n(\n"
         + "".join(f"    ({a:.12g} {b:.12g} {c:.12g})\n" for a, b, c in v) + ");\n\n"
@@ -211,7 +223,7 @@ def write_case(cfg: Any, directory: str | Path, *, max_co: float = 0.2, writes: 
         "        swarmCorrection { type none; }\n    }\n);\n\n"
         "virtualMass ();\n\nheatTransfer\n(\n    (particles in air) { type RanzMarshall; residualAlpha 1e-3; }\n);\n\n"
         "lift ();\n\nwallLubrication ();\n\nturbulentDispersion ();\n\nphaseTransfer ();\n\npMin 1e2;\n")
-    files["constant/turbulenceProperties.particles"] = _header("dictionary", "turbulenceProperties.particles", "constant") + _dict({
+    files["constant/turbulenceProperties.particles"] = _hdr("constant/turbulenceProperties.particles") + _dict({
         "simulationType": "RAS",
         "RAS": {"RASModel": "kineticTheory", "turbulence": "on", "printCoeffs": "on", "kineticTheoryCoeffs": {
             "equilibrium": "off", "e": p["e"], "alphaMax": 0.64, "alphaMinFriction": 0.63, "residualAlpha": 1e-6,
@@ -219,7 +231,7 @@ def write_case(cfg: Any, directory: str | Path, *, max_co: float = 0.2, writes: 
             "SchaefferCoeffs": {"phi": 28.5},
         }},
     })
-    files["constant/turbulenceProperties.air"] = _header("dictionary", "turbulenceProperties.air", "constant") + "simulationType laminar;\n"
+    files["constant/turbulenceProperties.air"] = _hdr("constant/turbulenceProperties.air") + "simulationType laminar;\n"
     for phase in ("particles", "air"):
         solid = phase == "particles"
         eos = {"equationOfState": "rhoConst"} if solid else {"equationOfState": "perfectGas"}
@@ -228,7 +240,8 @@ def write_case(cfg: Any, directory: str | Path, *, max_co: float = 0.2, writes: 
             mixture["equationOfState"] = {"rho": float(p["rho_s"])}
         mixture.update({"thermodynamics": {"Cp": HEAT_CAPACITY, "Hf": 0},
                         "transport": {"mu": 0.0 if solid else float(gas["mu"]), "Pr": 1}})
-        files[f"constant/thermophysicalProperties.{phase}"] = _header("dictionary", f"thermophysicalProperties.{phase}", "constant") + _dict({
+        rel = f"constant/thermophysicalProperties.{phase}"
+        files[rel] = _hdr(rel) + _dict({
             "thermoType": {"type": "heRhoThermo", "mixture": "pureMixture", "transport": "const", "thermo": "hConst",
                            **eos, "specie": "specie", "energy": "sensibleInternalEnergy"},
             "mixture": mixture,
@@ -237,7 +250,8 @@ def write_case(cfg: Any, directory: str | Path, *, max_co: float = 0.2, writes: 
     files["0/alpha.particles"] = _field("alpha.particles", "volScalarField", phi, "[0 0 0 0 0 0 0]")
     files["0/alpha.air"] = _field("alpha.air", "volScalarField", 1.0 - phi, "[0 0 0 0 0 0 0]")
     files["0/U.particles"] = _field("U.particles", "volVectorField", u, "[0 1 -1 0 0 0 0]")
-    files["0/U.air"] = _field("U.air", "volVectorField", u, "[0 1 -1 0 0 0 0]")  # no slip at the start: no drag transient
+    # the gas starts with the particles' velocity: no drag transient
+    files["0/U.air"] = _field("U.air", "volVectorField", u, "[0 1 -1 0 0 0 0]")
     files["0/Theta.particles"] = _field("Theta.particles", "volScalarField", theta, "[0 2 -2 0 0 0 0]")
     for name, val, dims in (("p", gas["p"], "[1 -1 -2 0 0 0 0]"), ("p_rgh", gas["p"], "[1 -1 -2 0 0 0 0]"),
                             ("T.particles", gas["T"], "[0 0 0 1 0 0 0]"), ("T.air", gas["T"], "[0 0 0 1 0 0 0]"),
