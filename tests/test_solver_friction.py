@@ -88,7 +88,8 @@ def _sheared_run(model: Model, phi: float, scheme: str, steps: int = 6) -> np.nd
     return np.asarray(U)
 
 
-@pytest.mark.parametrize("scheme", ["imex", "ssprk3"])
+# IMEX variants are ``slow`` (their compile dominates); the explicit ones cover the same closures.
+@pytest.mark.parametrize("scheme", [pytest.param("imex", marks=pytest.mark.slow), "ssprk3"])
 def test_mu_zero_is_bit_for_bit_the_frictionless_run(scheme: str) -> None:
     """``frictional`` at μ = 0 and the same composition without a friction part: identical states."""
     frictional = get_model("frictional", mu=0.0)
@@ -97,11 +98,16 @@ def test_mu_zero_is_bit_for_bit_the_frictionless_run(scheme: str) -> None:
     np.testing.assert_array_equal(_sheared_run(frictional, 0.4, scheme), _sheared_run(frictionless, 0.4, scheme))
 
 
-def test_a_frictional_stress_that_vanishes_changes_no_bit() -> None:
+@pytest.mark.parametrize("scheme", [pytest.param("imex", marks=pytest.mark.slow), "ssprk3"])
+def test_a_frictional_stress_that_vanishes_changes_no_bit(scheme: str) -> None:
     """Below φ_min the Johnson–Jackson p_f (and so μ_f and its work) is 0: the run is the one without a stress."""
     with_stress = get_model("frictional", stress="schaeffer")
     assert with_stress.friction.jj_phi_min == 0.5
-    np.testing.assert_array_equal(_sheared_run(with_stress, 0.4, "imex"), _sheared_run(get_model("frictional"), 0.4, "imex"))
+    a, b = _sheared_run(with_stress, 0.4, scheme), _sheared_run(get_model("frictional"), 0.4, scheme)
+    if scheme == "imex":
+        np.testing.assert_array_equal(a, b)
+    else:  # the explicit step's compiled graph differs by the zero terms: equal to round-off only
+        np.testing.assert_allclose(a, b, rtol=1e-14, atol=1e-14 * np.abs(b).max())
 
 
 # --- 3. uniform shear: the closed form of ktgf shear --mu ----------------------------------------------
