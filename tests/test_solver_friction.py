@@ -172,7 +172,7 @@ def test_frictional_couette_keeps_the_1d_solution_within_one_percent() -> None:
     JJ walls, 10 d gap, 128 cells, started from the 1D steady profile: after strain 10 the 3D profiles are
     the 1D ones within 1 % in u, φ, θ (measured 0.08, 0.08, 0.92 %; θ converges at second order with the
     cells, docs/friction.md §7), the wall stress within 1 % (0.35 %).  ~140 s wall at load 8."""
-    from test_solver_shear import RHO_S as RHO, _couette, _parse
+    from test_solver_shear import _couette, _parse, run_from_profile_within_one_percent
 
     from ktgf.solver.flows import couette_reference
     from ktgf.solver.run import Simulation
@@ -183,20 +183,7 @@ def test_frictional_couette_keeps_the_1d_solution_within_one_percent() -> None:
     sim = Simulation(_parse(text.replace("solid_fraction = 0.3", f"solid_fraction = {phi0}")))
     ref = couette_reference(sim.phys, sim.grid, phi0)
     assert float(ref["p_frictional"].max()) > 0.9 * float(ref["p"].max())
-    y = sim.grid.centres(0) - 0.5 * sim.grid.lengths[0]
-    yr = ref["y"].values
-    u = np.zeros((3, n))
-    u[1] = np.interp(y, yr, ref["u"].values)
-    with sim.precision():
-        U0 = conservative(jnp.asarray(RHO * np.interp(y, yr, ref["phi"].values)), jnp.asarray(u),
-                          jnp.asarray(np.interp(y, yr, ref["theta"].values)))
-        U0 = U0 * (phi0 * RHO * n / float(U0[0].sum()))
-    sim.initial_state = lambda: sim.place(U0)
-    sim.run(progress=False, write_files=False)
-    ver = sim.verification
-    assert max(ver["max_rel_error"].values()) < 0.01, ver["max_rel_error"]
-    tau_run, tau_ref = ver["wall_shear_stress_Pa"]["run"], ver["wall_shear_stress_Pa"]["reference"]
-    assert abs(tau_run[0] / tau_ref[0] - 1) < 0.01 and abs(tau_run[1] / tau_ref[1] - 1) < 0.01
+    run_from_profile_within_one_percent(sim, ref, phi0)
 
 
 # --- 5. configs --------------------------------------------------------------------------------------

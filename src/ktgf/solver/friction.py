@@ -31,33 +31,22 @@ the cells, once per stage (``docs/friction.md`` §7):
 
 from __future__ import annotations
 
-from typing import Any, NamedTuple
+from collections import namedtuple
+from typing import Any
 
 import jax
 import jax.numpy as jnp
 
+from ..closures.coefficients import Reduced
 from .fluxes import pad_fields
 from .grid import Grid
 from .physics import Physics
 
 
-class FrictionalReduced(NamedTuple):
-    """Cell coefficients of a model with a frictional stress: the :class:`~ktgf.closures.Reduced`
-    fields (ζ_U including the frictional pressure work) plus the frictional fields [SI]."""
-
-    p: Any
-    eta: Any
-    lambda_b: Any
-    kappa: Any
-    mu: Any
-    zeta0: Any
-    zeta_u: Any
-    g: Any
-    C: Any
-    p_f: Any  # w p_f [Pa]
-    c2_f: Any  # d(w p_f)/dρ [m²/s²]
-    mu_f: Any  # frictional viscosity [Pa s]
-    zeta_f: Any  # 2μ_f S:S/((3/2)ρθ) [1/s]
+#: Cell coefficients of a model with a frictional stress: the :class:`~ktgf.closures.Reduced` fields
+#: (ζ_U including the frictional pressure work) plus the frictional fields [SI]: ``p_f`` = w p_f [Pa],
+#: ``c2_f`` = d(w p_f)/dρ [m²/s²], ``mu_f`` the frictional viscosity [Pa s], ``zeta_f`` = 2μ_f S:S/((3/2)ρθ) [1/s].
+FrictionalReduced = namedtuple("FrictionalReduced", Reduced._fields + ("p_f", "c2_f", "mu_f", "zeta_f"))
 
 
 def for_case(phys: Physics, kind: str, grid: Grid) -> Physics:
