@@ -2,7 +2,8 @@
 
 Kernels work on tuples of field arrays (see :mod:`.state`).  Face ``i+1/2`` along axis ``a``
 is stored at index ``i``.  The closures are evaluated once per cell and stage
-(:func:`cell_fields`); nothing here calls a closure.  The convective flux uses the granular
+(:func:`.friction.cell_coefficients`, called by :func:`.stepping.explicit_rhs`); nothing here
+calls a closure.  The convective flux uses the granular
 equation of state p = ρθp*(φ) and the sound speed c² = θg, g = C + 2p*²/3
 (:class:`~ktgf.solver.physics.Physics`): the primitive variables (ρ, u, θ) and the cell values
 of p* and g are reconstructed with the same slope limiter (face ρ, θ, p*, g stay within their
@@ -159,21 +160,6 @@ def reconstruct(P: Sequence[Any], cells: tuple[int, ...], axis: int, limiter: st
     return left, right
 
 
-def cell_fields(W: Sequence[Any], phys: Physics, grid: Grid | None = None,
-                t: Any = 0.0) -> tuple[tuple[Any, ...], tuple[Any, ...], Any]:
-    """The closures once per cell: (eos, transport, r).
-
-    ``eos`` = (p*, g) for the convective flux, ``transport`` = (η, λ_b, κ, ω) in SI for the
-    viscous and heat fluxes, ``r`` the cell :class:`~ktgf.closures.Reduced` (cooling rate, Δt);
-    with the ``grid`` (and time ``t``), the coefficients that need the velocity gradient too
-    (frictional stress, shear-dependent dissipation: :func:`.friction.cell_coefficients`).
-    """
-    from .friction import cell_coefficients
-
-    r = phys.reduced(W[0]) if grid is None else cell_coefficients(W, grid, phys, t)
-    return phys.eos(W[0], W[4], r), phys.transport(W[0], W[4], r), r
-
-
 def _euler_flux(W: Sequence[Any], U: Sequence[Any], p: Any, a: int) -> list[Any]:
     un = W[1 + a]
     mom = [U[1 + j] * un + (p if j == a else 0.0) for j in range(3)]
@@ -322,7 +308,7 @@ def flux_divergence(W: Sequence[Any], coefficients: tuple[tuple[Any, ...], tuple
                     t: Any = 0.0) -> tuple[list[Any], Any]:
     """−∇·F per field of the convective (+ viscous and heat, if ``viscous``) flux, and the cell ∇·u.
 
-    ``coefficients`` = (eos, transport) cell fields of :func:`cell_fields`; ``t`` the time (the
+    ``coefficients`` = (eos, transport) cell fields (:meth:`.Physics.eos`, :meth:`.Physics.transport`); ``t`` the time (the
     Lees–Edwards images move).
     """
     eos, transport = coefficients

@@ -53,7 +53,7 @@ from ..closures.coefficients import Reduced
 from .fluxes import face_coefficients, face_divergence, face_jump, has_walls, pad_fields, pad_viscous, stress, viscous_flux
 from .boundaries import lees_edwards_faces, wall_terms
 from .grid import Grid
-from .physics import Physics
+from .physics import Physics, is_frictional
 from .state import primitive_fields
 
 GAMMA = 1.0 - 1.0 / math.sqrt(2.0)
@@ -264,7 +264,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     # A frictional stress's work 2μ_f S:S (docs/friction.md §7) is removed here, in the implicit part with
     # the frictional heating it cancels, frozen with μ_f at the stage start (as a rate ∝ θ, or explicitly,
     # the stage-start θ biased the steady θ by O(ζΔt), 4-7 % measured; explicitly a stiff one overshot).
-    sink = 1.5 * rho * theta * r.zeta_f if hasattr(r, "zeta_f") else 0.0
+    sink = 1.5 * rho * theta * r.zeta_f if is_frictional(r) else 0.0
     fI = viscous_divergence(Wh, phys.transport(rho, theta, r), grid, phys, t)
     fI[4] = fI[4] - sink
     heat = fI[4] - sum(x * f for x, f in zip(u, fI[1:4]))

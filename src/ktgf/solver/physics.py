@@ -97,13 +97,13 @@ class Physics:
     def pressure(self, rho: Any, theta: Any, r: Reduced) -> Any:
         """Equation of state p = ρθp*(φ) [Pa] (model.md §1), plus the frictional pressure w p_f if any."""
         p = rho * theta * r.p
-        return p + r.p_f if _frictional(r) else p
+        return p + r.p_f if is_frictional(r) else p
 
     def eos(self, rho: Any, theta: Any, r: Reduced) -> tuple[Any, Any]:
         """(p*, g) of the convective flux, p = ρθp* and c² = θg; with a frictional stress
         p* + w p_f/(ρθ) and g + c_f²/θ (c_f² = d(w p_f)/dρ), so that both include it."""
         g = self.sound_factor(r)
-        if not _frictional(r):
+        if not is_frictional(r):
             return r.p, g
         return r.p + r.p_f / (rho * theta), g + r.c2_f / theta
 
@@ -118,14 +118,14 @@ class Physics:
         C = ∂(φp*)/∂φ.
         """
         c2 = theta * self.sound_factor(r)
-        return jnp.sqrt(c2 + r.c2_f if _frictional(r) else c2)
+        return jnp.sqrt(c2 + r.c2_f if is_frictional(r) else c2)
 
     def transport(self, rho: Any, theta: Any, r: Reduced) -> tuple[Any, Any, Any, Any]:
         """(η, λ_b, κ, ω) in SI at states (ρ, θ): η0 times the reduced values, ω = θκ0μ*/φ."""
         e0 = eta0(theta, self.diameter, self.material_density)
         phi = rho / self.material_density
         k0 = 3.75 * e0
-        eta = e0 * r.eta + r.mu_f if _frictional(r) else e0 * r.eta  # μ_f frozen with r (docs/friction.md §7)
+        eta = e0 * r.eta + r.mu_f if is_frictional(r) else e0 * r.eta  # μ_f frozen with r (docs/friction.md §7)
         return eta, e0 * r.lambda_b, k0 * r.kappa, theta * k0 * r.mu / phi
 
     def cooling_rate(self, rho: Any, theta: Any, divu: Any, r: Reduced) -> Any:
@@ -136,9 +136,9 @@ class Physics:
         """
         phi = rho / self.material_density
         zeta = nu0(phi, theta, self.diameter) * r.zeta0 + r.zeta_u * divu
-        return zeta + r.zeta_f if _frictional(r) else zeta
+        return zeta + r.zeta_f if is_frictional(r) else zeta
 
 
-def _frictional(r: Any) -> bool:
+def is_frictional(r: Any) -> bool:
     """Whether the cell coefficients carry a frictional stress (static: decided by the pytree's type)."""
     return hasattr(r, "mu_f")
