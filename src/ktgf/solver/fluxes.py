@@ -20,6 +20,7 @@ Flux along a of (ρ, ρu, E):  (ρu_a,  ρu u_a + P·e_a,  E u_a + (P·u)_a + q_
 from __future__ import annotations
 
 import functools
+import os
 from collections.abc import Sequence
 from typing import Any
 
@@ -104,6 +105,10 @@ def pad_viscous(W: Sequence[Any], transport: Sequence[Any], grid: Grid, phys: Ph
 #: the same process against ``"pad"`` ranged from 1.25× faster to 0.88× (float32, IMEX) on the
 #: shared machine, so it is not the default (docs/solver.md, Speed).
 PERIODIC_PAD = "pad"
+
+#: Use the C++ kernel (:mod:`.flux_kernel`) for :func:`flux_divergence` where it applies (CPU,
+#: one device, 3D fully periodic grid).  Default on; ``KTGF_FLUX_KERNEL=0`` switches it off.
+FLUX_KERNEL = os.environ.get("KTGF_FLUX_KERNEL", "1").lower() not in ("0", "off", "false", "no")
 
 
 @functools.lru_cache(maxsize=16)
@@ -312,6 +317,12 @@ def flux_divergence(W: Sequence[Any], coefficients: tuple[tuple[Any, ...], tuple
     Lees–Edwards images move).
     """
     eos, transport = coefficients
+    if FLUX_KERNEL:
+        from . import flux_kernel
+
+        if flux_kernel.applies(grid, W[0].dtype):
+            return flux_kernel.flux_divergence(W, eos, transport, grid, phys.material_density, limiter, riemann,
+                                               viscous)
     P = pad_fields((*W, *eos), grid, t, velocity=1)
     Pk = pad_fields(transport, grid, t) if viscous else ()
     Pv = (pad_viscous(W, transport, grid, phys, t) if has_walls(grid) else P[:5]) if viscous else ()

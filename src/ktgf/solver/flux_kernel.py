@@ -1,0 +1,109 @@
+"""CPU fast path of :func:`.fluxes.flux_divergence`: an XLA FFI custom call (``flux_kernel.cc``).
+
+The kernel does the numerics of :mod:`.fluxes` only (MUSCL reconstruction with the configured
+limiter, HLL/Rusanov, central viscous stress and heat flux, face divergence, ∇·u) from the same
+cell fields the JAX path gets; every closure stays in Python.  It computes each face once
+instead of once per flux component (docs/solver.md, Speed) and agrees with the JAX path to
+round-off (tests/test_solver_flux_kernel.py).
+
+It is used where it applies — CPU backend, one device, a 3D fully periodic grid, float32 or
+float64 — and when it is switched on: :data:`.fluxes.FLUX_KERNEL` (default from the environment
+variable ``KTGF_FLUX_KERNEL``; ``0`` switches it off).  The JAX path remains the reference and
+the path for GPUs, sharding, walls and Lees–Edwards boundaries.
+
+Build: compiled on first use with the C++ compiler ``$CXX`` (default ``g++``; OpenMP, ``-O3
+-march=native``) into ``$KTGF_CACHE_DIR`` (default ``~/.cache/ktgf``), keyed by the source, the
+flags, jaxlib's version and the host; without a compiler (or if the build fails) the JAX path
+runs and one warning says why.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import platform
+import shutil
+import subprocess
+import tempfile
+import warnings
+from pathlib import Path
+from typing import Any
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+SOURCE = Path(__file__).with_name("flux_kernel.cc")
+TARGET = "ktgf_flux_divergence"
+FLAGS = ("-O3", "-march=native", "-fopenmp", "-ffp-contract=off", "-fno-math-errno", "-shared", "-fPIC", "-std=c++17")
+_loaded: dict[str, Any] = {}
+
+
+def _cache_dir() -> Path:
+    return Path(os.environ.get("KTGF_CACHE_DIR", Path.home() / ".cache" / "ktgf"))
+
+
+def build() -> Path:
+    """The compiled library (built now if not in the cache); raises RuntimeError if it cannot be."""
+    cxx = shutil.which(os.environ.get("CXX", "g++"))
+    if cxx is None:
+        raise RuntimeError(f"no C++ compiler ({os.environ.get('CXX', 'g++')!r} not found)")
+    key = hashlib.sha256(b"\0".join([SOURCE.read_bytes(), " ".join(FLAGS).encode(), cxx.encode(),
+                                     jax.__version__.encode(), platform.node().encode()])).hexdigest()[:16]
+    lib = _cache_dir() / f"flux_kernel-{key}.so"
+    if lib.exists():
+        return lib
+    lib.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".so", dir=lib.parent)
+    os.close(fd)
+    cmd = [cxx, *FLAGS, f"-I{jax.ffi.include_dir()}", str(SOURCE), "-o", tmp]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        os.unlink(tmp)
+        last = (proc.stderr.strip().splitlines() or ["?"])[-1]
+        raise RuntimeError(f"compiling {SOURCE.name} failed: {last}")
+    os.replace(tmp, lib)  # atomic: parallel test workers may build at the same time
+    return lib
+
+
+def available() -> bool:
+    """Whether the kernel is built and registered with XLA (tried once per process)."""
+    if "ok" not in _loaded:
+        try:
+            # Idle OpenMP threads must sleep, not spin: between calls XLA's own threads need the cores.
+            os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+            lib = ctypes.cdll.LoadLibrary(str(build()))
+            jax.ffi.register_ffi_target(TARGET, jax.ffi.pycapsule(lib.KtgfFluxDivergence), platform="cpu")
+            _loaded["ok"] = True
+        except (RuntimeError, OSError) as err:
+            warnings.warn(f"ktgf flux kernel unavailable, using the JAX path: {err}", RuntimeWarning, stacklevel=2)
+            _loaded["ok"] = False
+    return _loaded["ok"]
+
+
+def applies(grid: Any, dtype: Any) -> bool:
+    """Whether the kernel can replace the JAX flux divergence here (see the module docstring)."""
+    periodic = grid.boundaries is None or grid.boundaries.all_periodic
+    return (grid.ndim == 3 and periodic and jnp.dtype(dtype) in (jnp.float32, jnp.float64)
+            and jax.default_backend() == "cpu" and jax.device_count() == 1 and available())
+
+
+def flux_divergence(W: Any, eos: Any, transport: Any, grid: Any, rho_s: Any, limiter: str, riemann: str,
+                    viscous: bool) -> tuple[list[Any], Any]:
+    """−∇·F of the five conservative fields and the central ∇·u, as :func:`.fluxes.flux_divergence`."""
+    from .fluxes import GHOST, LIMITERS, RIEMANN_SOLVERS
+
+    dtype = W[0].dtype
+    cells = tuple(grid.cells)
+    fields = [jnp.asarray(f, dtype) for f in (*W, *eos)]
+    # Non-viscous calls pass ρ in the unused transport slots (no copy; the kernel ignores them).
+    fields += [jnp.asarray(f, dtype) for f in transport] if viscous else [fields[0]] * 4
+    field = jax.ShapeDtypeStruct(cells, dtype)
+    nfield = 11 if viscous else 7
+    work = jax.ShapeDtypeStruct((nfield, *(n + 2 * GHOST for n in cells)), dtype)
+    call = jax.ffi.ffi_call(TARGET, (field,) * 6 + (work,))
+    params = jnp.stack([jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)])
+    out = call(*fields, params, limiter=np.int32(LIMITERS.index(limiter)), riemann=np.int32(RIEMANN_SOLVERS.index(riemann)),
+               viscous=np.int32(viscous))
+    return list(out[:5]), out[5]
