@@ -75,8 +75,9 @@ def test_gather_padding_matches_jnp_pad(kind: str, scheme: str, model: str) -> N
         U = add_base_flow(U, grid)
     U = tuple(jnp.asarray(U))
     num = Numerics(scheme=scheme)
-    L_new, U_new = _run({"PERIODIC_PAD": "gather"}, U, grid, phys, num)
-    L_ref, U_ref = _run({"PERIODIC_PAD": "pad"}, U, grid, phys, num)
+    # The C++ flux kernel (tests/test_solver_flux_kernel.py) would bypass the padding on periodic grids.
+    L_new, U_new = _run({"PERIODIC_PAD": "gather", "FLUX_KERNEL": False}, U, grid, phys, num)
+    L_ref, U_ref = _run({"PERIODIC_PAD": "pad", "FLUX_KERNEL": False}, U, grid, phys, num)
     assert np.all(np.isfinite(L_new)) and np.abs(L_new).max() > 0
     assert _close(L_new, L_ref) < RTOL
     assert _close(U_new, U_ref) < RTOL
