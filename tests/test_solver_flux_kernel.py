@@ -59,10 +59,19 @@ def _physics(model: str) -> Physics:
     return Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max)
 
 
-@pytest.mark.parametrize("dtype", [jnp.float64, jnp.float32])
-@pytest.mark.parametrize("viscous", [True, False])
-@pytest.mark.parametrize("riemann", fluxes.RIEMANN_SOLVERS)
-@pytest.mark.parametrize("limiter", fluxes.LIMITERS)
+#: The default suite runs every limiter and Riemann solver once and both precisions; the full matrix is ``slow``.
+FAST_RHS = {("vanleer", "hll", True, jnp.float64), ("vanleer", "hll", False, jnp.float64),
+            ("vanleer", "hll", True, jnp.float32), ("minmod", "rusanov", True, jnp.float64),
+            ("mc", "hll", False, jnp.float64), ("none", "rusanov", True, jnp.float64)}
+RHS_CASES = [pytest.param(lim, rie, v, dt, marks=() if (lim, rie, v, dt) in FAST_RHS else pytest.mark.slow)
+             for lim in fluxes.LIMITERS for rie in fluxes.RIEMANN_SOLVERS for v in (True, False)
+             for dt in (jnp.float64, jnp.float32)]
+FAST_STEPS = {("ssprk3", "ret"), ("imex", "proposed")}
+STEP_CASES = [pytest.param(s, m, marks=() if (s, m) in FAST_STEPS else pytest.mark.slow)
+              for s in ("ssprk3", "imex") for m in ("ret", "proposed")]
+
+
+@pytest.mark.parametrize(("limiter", "riemann", "viscous", "dtype"), RHS_CASES)
 def test_kernel_rhs_matches_jax(limiter: str, riemann: str, viscous: bool, dtype) -> None:
     grid, phys = _grid(), _physics("ret")
     U = _state(grid, phys, dtype)
@@ -74,8 +83,7 @@ def test_kernel_rhs_matches_jax(limiter: str, riemann: str, viscous: bool, dtype
     assert _close(new, ref) < RTOL[dtype]
 
 
-@pytest.mark.parametrize("model", ["ret", "proposed"])
-@pytest.mark.parametrize("scheme", ["ssprk3", "imex"])
+@pytest.mark.parametrize(("scheme", "model"), STEP_CASES)
 def test_kernel_steps_match_jax(scheme: str, model: str) -> None:
     grid, phys = _grid(), _physics(model)
     U = _state(grid, phys, jnp.float64)
