@@ -122,6 +122,8 @@ def _leaves(d: Any, prefix: str = "") -> dict[str, Any]:
 def check_compatible(old: Any, new: Any, old_lengths: tuple[float, ...], new_lengths: tuple[float, ...],
                      source: str) -> None:
     """Refuse (one line naming the field) an earlier run that is not the same flow on a mappable box."""
+    from .run import _get  # (run.py imports this module)
+
     a, b = old.model_dump(mode="json"), new.model_dump(mode="json")
     where = f"(initial.from_run = {source!r})"
     for name in SAME_FIELDS:
@@ -145,12 +147,6 @@ def check_compatible(old: Any, new: Any, old_lengths: tuple[float, ...], new_len
         elif ratio < 1.0 - LENGTH_RTOL or abs(ratio - round(ratio)) > LENGTH_RTOL * ratio:
             raise InputError(f"field grid length along {'xyz'[ax]} = {ln:.6g} m is not a whole multiple of the earlier "
                              f"run's {lo:.6g} m {where}: a periodic axis is the same or tiled (valid: m × {lo:.6g} m)")
-
-
-def _get(d: Any, dotted: str) -> Any:
-    for key in dotted.split("."):
-        d = d.get(key) if isinstance(d, dict) else None
-    return d
 
 
 def _slopes(f: np.ndarray, axis: int, periodic: bool, limiter: str = "minmod") -> np.ndarray:
