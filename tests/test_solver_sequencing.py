@@ -323,3 +323,18 @@ def test_the_sequenced_dense_couette_at_128_cells_reaches_the_1d_solver_within_o
     assert max(ver["max_rel_error"].values()) < 0.01, ver["max_rel_error"]
     tau = np.asarray(ver["wall_shear_stress_Pa"]["run"]) / np.asarray(ver["wall_shear_stress_Pa"]["reference"])
     assert np.max(np.abs(tau - 1.0)) < 0.01, ver["wall_shear_stress_Pa"]
+
+
+def test_the_cost_of_a_sequence_counts_every_earlier_run_once(tmp_path: Path) -> None:
+    """Stage 3 of a chain: the earlier run's verification.json already holds the sum of stages 1–2."""
+    from ktgf.solver.sequencing import _earlier_cost
+
+    first = {"run": {"step_count": 10, "wall_time_s": 1.0, "cpu_time_s": 0.5}}
+    second = {"run": {"step_count": 20, "wall_time_s": 2.0, "cpu_time_s": 1.5,
+                      "sequence": {"steps": 30, "wall_time_s": 3.0, "cpu_time_s": 2.0}}}
+    for name, ver in (("a", first), ("b", second)):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "verification.json").write_text(json.dumps(ver))
+    assert _earlier_cost(tmp_path / "a", 10)["sequence"] == {"steps": 10, "wall_time_s": 1.0, "cpu_time_s": 0.5}
+    assert _earlier_cost(tmp_path / "b", 20)["sequence"] == {"steps": 30, "wall_time_s": 3.0, "cpu_time_s": 2.0}
+    assert _earlier_cost(tmp_path / "nothing", 7) == {"steps": 7}

@@ -83,9 +83,8 @@ def _earlier_cost(path: str | Path, steps: int) -> dict[str, Any]:
     except (OSError, ValueError, KeyError, TypeError):
         return {"steps": steps}
     stage = {"steps": steps, "wall_time_s": run.get("wall_time_s"), "cpu_time_s": run.get("cpu_time_s")}
-    before = run.get("sequence", {})
-    total = {k: (v or 0) + (before.get(k) or 0) for k, v in stage.items()} if before else stage
-    return {**stage, "sequence": total}
+    # the earlier run's own sequence already counts it (and the runs before it)
+    return {**stage, "sequence": run.get("sequence") or stage}
 
 
 def start_from_run(cfg: Any, cells: tuple[int, ...], lengths: tuple[float, ...]) -> tuple[np.ndarray, dict[str, Any]]:
