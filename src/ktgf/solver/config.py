@@ -79,9 +79,18 @@ class InitialSection(_Section):
     kind: Literal["transverse", "longitudinal"] = "transverse"
     branch: int = Field(0, ge=0, le=4, description="eigenmode by decreasing growth rate: HCS 0-2, shear 0-4")
     shear_rate: float | None = Field(None, gt=0.0, description="chute: initial u = shear_rate * height above the base [1/s]")
+    from_run: str | None = Field(None, min_length=1, description="start from this earlier run (its output folder or "
+                                 "checkpoint.npz) mapped onto this grid (ktgf.solver.sequencing)")
 
     @model_validator(mode="after")
     def _temperature(self) -> InitialSection:
+        if self.from_run is not None:
+            bad = [k for k in ("temperature", "shear_rate", "mode") if getattr(self, k) is not None]
+            if self.perturbation in ("mode", "shear-mode") or bad:
+                what = f"perturbation = {self.perturbation!r}" if not bad else ", ".join(bad)
+                raise ValueError(f"from_run starts from the earlier run's state: it takes no {what} (valid: "
+                                 "perturbation = 'random' or 'none', amplitude, seed, max_mode)")
+            return self
         # A shear-mode seed sits on the steady θ of the closed form (check_shear_mode): nothing to give.
         if self.temperature is None and self.perturbation != "shear-mode":
             raise ValueError("temperature is missing: give initial.temperature = theta0 > 0 [m^2/s^2] (optional "

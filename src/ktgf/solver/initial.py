@@ -22,7 +22,7 @@ from ..hcs.stability import longitudinal_growth_rates, longitudinal_matrix, tran
 from ..shear.stability import ShearModes, shear_modes
 from .grid import Grid
 from .physics import Physics
-from .state import conservative
+from .state import conservative, conservative_fields
 
 
 def uniform_fields(grid: Grid, phys: Physics, phi0: float, theta0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -143,15 +143,8 @@ def shear_mode(
     return conservative(jnp.asarray(rho), jnp.asarray(u), jnp.asarray(theta)), modes
 
 
-def random_velocity(
-    grid: Grid, phys: Physics, phi0: float, theta0: float, amplitude: float, seed: int, max_mode: int = 2,
-) -> Any:
-    """HCS plus seeded random velocity and density fields of the Fourier modes |n_a| ≤ ``max_mode``.
-
-    The velocity has zero mean and root-mean-square amplitude ``amplitude``·√θ0 per
-    component, δφ/φ0 has rms ``amplitude``; both are the same physical fields on every grid
-    that resolves those modes.
-    """
+def _random_modes(grid: Grid, seed: int, max_mode: int) -> np.ndarray:
+    """Four seeded random fields (three velocity components and δρ) of the Fourier modes |n_a| ≤ ``max_mode``."""
     rng = np.random.default_rng(seed)
     x = grid.mesh()
     ranges = [range(-max_mode, max_mode + 1)] * grid.ndim
@@ -163,6 +156,19 @@ def random_velocity(
         arg = sum(k[a] * x[a] for a in range(grid.ndim))
         amp = rng.normal(size=4) + 1j * rng.normal(size=4)
         f += np.real(amp.reshape((4,) + (1,) * grid.ndim) * np.exp(1j * arg)[None])
+    return f
+
+
+def random_velocity(
+    grid: Grid, phys: Physics, phi0: float, theta0: float, amplitude: float, seed: int, max_mode: int = 2,
+) -> Any:
+    """HCS plus seeded random velocity and density fields of the Fourier modes |n_a| ≤ ``max_mode``.
+
+    The velocity has zero mean and root-mean-square amplitude ``amplitude``·√θ0 per
+    component, δφ/φ0 has rms ``amplitude``; both are the same physical fields on every grid
+    that resolves those modes.
+    """
+    f = _random_modes(grid, seed, max_mode)
     u = f[:3] * (amplitude * math.sqrt(theta0) / np.sqrt(np.mean(f[:3] ** 2)))
     drho = f[3] * (amplitude / np.sqrt(np.mean(f[3] ** 2)))
     rho, _, theta = uniform_fields(grid, phys, phi0, theta0)
@@ -170,3 +176,29 @@ def random_velocity(
     # Zero total momentum: the box frame is the centre-of-mass frame (no uniform drift).
     u -= (np.sum(rho * u, axis=tuple(range(1, grid.ndim + 1))) / np.sum(rho)).reshape((3,) + (1,) * grid.ndim)
     return conservative(jnp.asarray(rho), jnp.asarray(u), jnp.asarray(theta))
+
+
+def perturb(U: np.ndarray, grid: Grid, amplitude: float, seed: int, max_mode: int = 2) -> np.ndarray:
+    """A state (NumPy, conservative) plus the random fields of :func:`random_velocity`, keeping its mass and momentum.
+
+    δρ/ρ has rms ``amplitude`` (less its mass-weighted mean: the mass is unchanged), the velocity
+    perturbation rms ``amplitude``·√θ̄ per component (θ̄ the mass-weighted mean θ; less a uniform
+    part that restores the total momentum); θ is kept cell by cell, so the energy grows by the
+    kinetic energy of the perturbation.  A started-from-earlier-run state (:mod:`.sequencing`)
+    is perturbed with it so that instabilities the earlier grid could not hold (a 3D mode in a
+    tiled quasi-2D state) are seeded.
+    """
+    rho, m = U[0], U[1:4]
+    u = m / rho
+    theta = (U[4] / rho - 0.5 * np.sum(u * u, axis=0)) / 1.5
+    axes = tuple(range(1, grid.ndim + 1))
+    f = _random_modes(grid, seed, max_mode)
+    theta_bar = float(np.sum(rho * theta) / np.sum(rho))
+    du = f[:3] * (amplitude * math.sqrt(theta_bar) / np.sqrt(np.mean(f[:3] ** 2)))
+    drho = f[3] * (amplitude / np.sqrt(np.mean(f[3] ** 2)))
+    drho -= np.sum(rho * drho) / np.sum(rho)
+    new_rho = rho * (1.0 + drho)
+    new_u = u + du
+    new_u += ((np.sum(m, axis=axes) - np.sum(new_rho * new_u, axis=axes)) / np.sum(new_rho)).reshape(
+        (3,) + (1,) * grid.ndim)
+    return np.stack(conservative_fields((new_rho, *new_u, theta)))

@@ -46,10 +46,11 @@ from .flows import gravity as case_gravity
 from .flows import describe as describe_boundaries
 from .friction import for_case
 from .grid import Grid
-from .initial import haff_time, random_velocity, shear_mode, single_mode, t_of_tau, tau_of_t, uniform_fields
+from .initial import haff_time, perturb, random_velocity, shear_mode, single_mode, t_of_tau, tau_of_t, uniform_fields
 from .interrupt import STOP, Interrupted, fault_hook
 from .io import load_checkpoint, save_checkpoint, save_slices, write_vti
 from .physics import Physics
+from .sequencing import mean_temperature, start_from_run
 from .state import PRIMITIVE_NAMES, conservative, primitive
 from .stepping import LIMIT_NAMES, STATUS_MESSAGES, Numerics, advance, binding_limit, choose_scheme, limits, state_status, step
 
@@ -189,7 +190,11 @@ class Simulation:
                             mixed=n.precision == "mixed")
         self.dtype = jnp.float64 if n.precision == "float64" else jnp.float32
         self.directory = Path(directory if directory is not None else cfg.output.directory)
-        self.phi0, self.theta0 = cfg.initial.solid_fraction, initial_temperature(cfg)
+        self.started_from = None  # with initial.from_run: the earlier run's state mapped onto this grid
+        if cfg.initial.from_run is not None:
+            self.mapped, self.started_from = start_from_run(cfg, self.grid.cells, self.grid.lengths)
+        self.phi0 = cfg.initial.solid_fraction
+        self.theta0 = initial_temperature(cfg) if self.started_from is None else mean_temperature(self.mapped)
         self.t_haff = haff_time(self.phys, self.phi0, self.theta0)
         end, n_out = cfg.time.end, cfg.time.outputs
         if cfg.time.unit == "tau":  # equal steps in τ: the natural clock of a cooling gas
@@ -239,6 +244,11 @@ class Simulation:
     def initial_state(self) -> Any:
         """The configured HCS initial state (conservative, on the configured devices)."""
         ini = self.cfg.initial
+        if self.started_from is not None:  # the base flow is in the earlier state
+            U = self.mapped
+            if ini.perturbation == "random":
+                U = perturb(U, self.grid, ini.amplitude, ini.seed, ini.max_mode)
+            return self.place(U)
         if ini.perturbation == "random":
             U = random_velocity(self.grid, self.phys, self.phi0, self.theta0, ini.amplitude, ini.seed, ini.max_mode)
         elif ini.perturbation == "mode":
@@ -382,6 +392,14 @@ class Simulation:
                                         "wall_time_s": _time.perf_counter() - started[0],
                                         "cpu_time_s": _time.process_time() - started[1],
                                         "load_average": list(os.getloadavg())}
+            if self.started_from is not None:  # the cost of the whole sequence, this stage included
+                self.verification["started_from"] = self.started_from
+                run = self.verification["run"]
+                before = self.started_from["earlier_run"].get("sequence")
+                if before is not None:
+                    run["sequence"] = {k: (before.get(k) or 0) + run[v] for k, v in
+                                       (("steps", "step_count"), ("wall_time_s", "wall_time_s"),
+                                        ("cpu_time_s", "cpu_time_s"))}
         if write_files:
             ds.attrs["run_complete"] = 1
             write_netcdf(ds, self.directory / TIMESERIES)
@@ -617,6 +635,8 @@ class Simulation:
             haff_time_s=self.t_haff, mean_free_path_m=float(mean_free_path(self.phi0, self.phys.diameter)),
             steps=steps if steps is not None else getattr(self, "steps", None),
         ))
+        if self.started_from is not None:
+            ds.attrs["from_run"] = f"{self.started_from['from_run']} ({self.started_from['cells']} cells, mapped)"
         if not cooling:
             ds.attrs.update({"case": self.case, "boundaries": describe_boundaries(self.grid),
                              "shear_rate_per_s": shear_rate(self.grid)})
