@@ -156,7 +156,10 @@ def report(files: list[str]) -> None:
         print(f"| {r['depth_d']:g} | {'×'.join(map(str, r['cells']))} | {r['steady']} | {r['t_s']:.1f} | "
               f"{r['steps']} | {wall:.0f} | {cpu:.0f} | {load[1] if isinstance(load, list) else load:.1f} | "
               f"{r['u_surface_3d']:.4f} | {r['u_surface_1d']:.4f} | {e['u']:.2e} | {e['phi']:.2e} | {e['theta']:.2e} |")
-    for a, b in zip(rows, rows[1:]):
+    steady = [r for r in rows if r["steady"]]  # the exponent between steady runs on the same spacing
+    for a, b in zip(steady, steady[1:]):
+        if b["depth_d"] == a["depth_d"] or abs(b["cells"][0] / b["depth_d"] - a["cells"][0] / a["depth_d"]) > 0.05:
+            continue
         dl = math.log(b["depth_d"] / a["depth_d"])
         s3 = math.log(b["u_surface_3d"] / a["u_surface_3d"]) / dl
         s1 = math.log(b["u_surface_1d"] / a["u_surface_1d"]) / dl
