@@ -131,3 +131,24 @@ def test_bad_acoustics_options_are_refused_in_one_line_naming_the_field() -> Non
         parse_config(shear)
     with pytest.raises(InputError, match="acoustics"):
         Numerics(acoustics="fast")
+
+
+@pytest.mark.slow
+def test_dense_couette_with_implicit_acoustics_reaches_the_1d_solver_within_one_percent() -> None:
+    """examples/couette_dense.toml (φ̄ 0.5, 4×64×4) with implicit acoustics: the criteria of the
+    explicit-acoustics run in tests/test_solver_dense_shear.py (1 % in u, φ, θ and the wall stresses)."""
+    import tomllib
+    from pathlib import Path
+
+    from ktgf.solver.run import Simulation
+
+    data = tomllib.loads((Path(__file__).resolve().parents[1] / "examples" / "couette_dense.toml").read_text())
+    data["numerics"] = {"acoustics": "implicit", "cfl_source": 0.2}
+    sim = Simulation(parse_config(data))
+    sim.run(progress=False, write_files=False)
+    ver = sim.verification
+    print(ver["max_rel_error"], ver["run"])
+    assert ver["steady"]["reached"] and ver["cells_across_gap"] == 64, ver["steady"]
+    assert max(ver["max_rel_error"].values()) < 0.01, ver["max_rel_error"]
+    tau = np.asarray(ver["wall_shear_stress_Pa"]["run"]) / np.asarray(ver["wall_shear_stress_Pa"]["reference"])
+    assert np.max(np.abs(tau - 1.0)) < 0.01, ver["wall_shear_stress_Pa"]
