@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 import pytest
-from _growth import fit_rate
+from _growth import fit_rate, temporal_orders
 
 from ktgf.closures import get_model
 from ktgf.closures.coefficients import mean_free_path
@@ -73,16 +73,7 @@ def test_implicit_acoustics_is_second_order_in_time_beyond_the_acoustic_limit() 
     dt1 = acoustic_step(U0, grid, phys)
     t_end = float(t_of_tau(math.pi / abs(s.imag), phys, phi, THETA0))  # half a sound period
     n0 = math.ceil(t_end / (8.0 * dt1))  # the coarsest step: 8 acoustic limits
-    runs = {}
-    for n in (n0, 2 * n0, 4 * n0, 64 * n0):
-        num = Numerics(acoustics="implicit", cfl=1.0, cfl_source=0.99, dt_max=t_end / n, implicit_tol=1e-10)
-        U, t, steps, status, _ = advance(U0, 0.0, t_end, 10**6, grid, phys, num)
-        assert int(status) == 0 and float(t) == t_end and int(steps) in (n, n + 1)
-        runs[n] = np.asarray(primitive(U))
-    ref = runs.pop(64 * n0)
-    scale = np.array([ref[0].mean(), 1.0, math.sqrt(THETA0), 1.0, THETA0])
-    errors = [float(np.max(np.abs(W - ref)[[0, 1, 4]] / scale[[0, 1, 4], None])) for W in runs.values()]
-    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    errors, orders = temporal_orders(U0, grid, phys, t_end, n0, [0, 1, 4], THETA0, acoustics="implicit")
     print("dt / acoustic limit", t_end / n0 / dt1, "errors", errors, "orders", orders)
     assert t_end / n0 / dt1 > 6.0
     assert np.all(orders > 1.8), orders
