@@ -81,19 +81,18 @@ def enthalpy(U: Any, r: Any, phys: Physics) -> Any:
     return (U[4] + pressure(W[0], W[4], r, phys)) / W[0]
 
 
-def _wall_faces(F: list[Any], grid: Grid, a: int, value: list[Any] | None = None) -> list[Any]:
-    """Face fluxes along ``a`` with the two wall faces replaced (by 0, or ``value`` = their
-    (lower, upper) face values per component) when ``a`` is a wall axis."""
+def _wall_faces(F: list[Any], grid: Grid, a: int) -> list[Any]:
+    """Face fluxes along ``a`` with the two wall faces set to 0 when ``a`` is a wall axis."""
     if not (has_walls(grid) and a in grid.boundaries.wall_axes):
         return F
     n = grid.cells[a]
     out = []
-    for i, f in enumerate(F):
+    for f in F:
         if jnp.ndim(f) == 0:
             out.append(f)
             continue
-        lo, hi = (jnp.zeros_like(jax.lax.slice_in_dim(f, 0, 1, axis=a)),) * 2 if value is None else value[i]
-        out.append(jnp.concatenate([lo, jax.lax.slice_in_dim(f, 1, n, axis=a), hi], axis=a))
+        zero = jnp.zeros_like(jax.lax.slice_in_dim(f, 0, 1, axis=a))
+        out.append(jnp.concatenate([zero, jax.lax.slice_in_dim(f, 1, n, axis=a), zero], axis=a))
     return out
 
 

@@ -37,6 +37,9 @@ stage state is then U = Û + aΔt f_I(ρ̂, u, θ) with f_I the same flux diverg
 scheme uses, so mass, momentum and energy are conserved exactly whatever the solver residual;
 the residual (stage equation minus that state) is checked, and a solve whose relative
 residual exceeds 10× the tolerance rejects the step (status 6).
+
+With ``numerics.acoustics = "implicit"`` f_I also holds the pressure waves (the mass, pressure and
+enthalpy fluxes of :mod:`.acoustics`), solved in the same momentum problem as a bulk viscosity.
 """
 
 from __future__ import annotations
