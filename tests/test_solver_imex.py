@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 import pytest
+from _growth import temporal_orders
 
 from ktgf.closures import get_model
 from ktgf.closures.coefficients import mean_free_path
@@ -23,8 +24,7 @@ from ktgf.solver.grid import Grid
 from ktgf.solver.initial import single_mode, t_of_tau
 from ktgf.solver.physics import Physics
 from ktgf.solver.run import CHECKPOINT, Simulation
-from ktgf.solver.state import primitive
-from ktgf.solver.stepping import Numerics, advance, limits
+from ktgf.solver.stepping import Numerics, limits
 
 PHI0, E, D, RHO_S, THETA0 = 0.5, 0.7, 1e-3, 2500.0, 1e-4
 
@@ -39,16 +39,7 @@ def test_imex_is_second_order_in_time_beyond_the_diffusive_limit() -> None:
     dt_diffusive = min(lim[1], lim[2])
     t_end = float(t_of_tau(1.0, phys, PHI0, THETA0))
     n0 = math.ceil(t_end / (0.9 * lim[0]))  # the coarsest step: 0.9 of the acoustic limit
-    runs = {}
-    for n in (n0, 2 * n0, 4 * n0, 64 * n0):
-        num = Numerics(scheme="imex", cfl=1.0, cfl_source=0.99, dt_max=t_end / n, implicit_tol=1e-10)
-        U, t, steps, status, _ = advance(U0, 0.0, t_end, 10**6, grid, phys, num)
-        assert int(status) == 0 and float(t) == t_end and int(steps) in (n, n + 1)
-        runs[n] = np.asarray(primitive(U))
-    ref = runs.pop(64 * n0)
-    scale = np.array([ref[0].mean(), 1, math.sqrt(THETA0), 1, THETA0])
-    errors = [float(np.max(np.abs(W - ref)[[0, 2, 4]] / scale[[0, 2, 4], None])) for W in runs.values()]
-    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    errors, orders = temporal_orders(U0, grid, phys, t_end, n0, [0, 2, 4], THETA0, scheme="imex")
     ratio = t_end / n0 / dt_diffusive
     print("dt / diffusive limit", ratio, "errors", errors, "orders", orders)
     assert ratio > 10.0

@@ -139,6 +139,8 @@ class NumericsSection(_Section):
     implicit_tol: float = Field(1e-6, gt=0.0, lt=1.0, description="IMEX: relative residual of the stage solves")
     implicit_maxiter: int = Field(5, ge=1, le=100, description="IMEX: Krylov iterations of the stage solves, in tens")
     sweeps: int = Field(1, ge=1, le=5, description="IMEX: Picard passes on the implicit coefficients")
+    acoustics: Literal["explicit", "implicit"] = Field(
+        "explicit", description="IMEX: pressure waves explicit (step from |u| + c) or implicit (step from |u|)")
 
     @field_validator("limiter")
     @classmethod
@@ -377,6 +379,12 @@ def check_case(cfg: Config, source: str = "config") -> None:
         raise InputError(f"{source}: field initial.shear_rate sets the start of a chute only (other cases: the boundaries)")
     if kind == "chute" and cfg.time.unit == "strain":
         raise InputError(f"{source}: field time.unit = 'strain': a chute has no imposed shear rate; valid 's'")
+    if cfg.numerics.acoustics == "implicit" and cfg.time.scheme == "ssprk3":
+        raise InputError(f"{source}: field numerics.acoustics = 'implicit' needs time.scheme = 'imex' or 'auto' "
+                         "(got 'ssprk3', an explicit scheme)")
+    if cfg.numerics.acoustics == "implicit" and shear is not None:
+        raise InputError(f"{source}: field numerics.acoustics = 'implicit' is not available with a 'lees-edwards' "
+                         f"boundary (boundaries.{shear}); valid: 'explicit'")
     if kind != "uniform-shear" and shear is not None:
         raise InputError(f"{source}: field boundaries.{shear}.kind = 'lees-edwards' needs case.kind = 'uniform-shear'")
     if kind not in ("couette", "chute") and wall is not None:

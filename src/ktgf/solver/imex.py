@@ -37,6 +37,9 @@ stage state is then U = Û + aΔt f_I(ρ̂, u, θ) with f_I the same flux diverg
 scheme uses, so mass, momentum and energy are conserved exactly whatever the solver residual;
 the residual (stage equation minus that state) is checked, and a solve whose relative
 residual exceeds 10× the tolerance rejects the step (status 6).
+
+With ``numerics.acoustics = "implicit"`` f_I also holds the pressure waves (the mass, pressure and
+enthalpy fluxes of :mod:`.acoustics`), solved in the same momentum problem as a bulk viscosity.
 """
 
 from __future__ import annotations
@@ -50,7 +53,9 @@ import numpy as np
 from jax.scipy.sparse.linalg import bicgstab, cg
 
 from ..closures.coefficients import Reduced
-from .fluxes import face_coefficients, face_divergence, face_jump, has_walls, pad_fields, pad_viscous, stress, viscous_flux
+from .acoustics import MIN_SWEEPS, AcousticStage, mass_energy_divergence, pressure, pressure_divergence
+from .fluxes import (face_coefficients, face_divergence, face_jump, face_mean, has_walls, pad_fields, pad_viscous,
+                     stress, viscous_flux)
 from .boundaries import lees_edwards_faces, wall_terms
 from .grid import Grid
 from .physics import Physics, is_frictional
@@ -238,8 +243,13 @@ def _unit(x: Any, acc: Any = None) -> Any:
 
 
 def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced, tol: Any, maxiter: int,
-                   sweeps: int, t: Any = 0.0, mixed: bool = False) -> tuple[tuple, list[Any], Any]:
+                   sweeps: int, t: Any = 0.0, mixed: bool = False,
+                   acoustic: AcousticStage | None = None) -> tuple[tuple, list[Any], Any]:
     """Solve U = Û + aΔt f_I(U) (see the module docstring) at the stage time ``t``.
+
+    ``acoustic``: f_I also holds the acoustic part of the convective flux (:mod:`.acoustics`): the
+    momentum problem gains the bulk viscosity aΔtρc² and the pressure of the latest iterate, and
+    mass and energy take their implicit fluxes; at least :data:`~.acoustics.MIN_SWEEPS` sweeps.
 
     ``mixed``: a float32 stage solved with float32 vectors and float64 inner products, norms and
     Krylov scalars (:func:`_bicgstab64`, :func:`_cg64`); else everything in the dtype of Û.
@@ -265,6 +275,10 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     # the frictional heating it cancels, frozen with μ_f at the stage start (as a rate ∝ θ, or explicitly,
     # the stage-start θ biased the steady θ by O(ζΔt), 4-7 % measured; explicitly a stiff one overshot).
     sink = 1.5 * rho * theta * r.zeta_f if is_frictional(r) else 0.0
+    rho_hat = rho
+    if acoustic is not None:
+        sweeps = max(sweeps, MIN_SWEEPS)
+        p_ref, d_ref = pressure(rho, theta, r, phys), [0.0] * grid.ndim  # Û holds no compression
     fI = viscous_divergence(Wh, phys.transport(rho, theta, r), grid, phys, t)
     fI[4] = fI[4] - sink
     heat = fI[4] - sum(x * f for x, f in zip(u, fI[1:4]))
@@ -274,12 +288,24 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     acc = jnp.float64 if mixed else None
     solve_m = (lambda *a, **k: (_bicgstab64(*a[:2], **k), None)) if mixed else bicgstab
     solve_E = (lambda *a, **k: (_cg64(*a[:2], **k), None)) if mixed else cg
-    for _ in range(sweeps):
+    for sweep in range(sweeps):
+        if acoustic is not None and sweep > 0:  # linearise about the previous sweep's state
+            r = acoustic.coefficients((rho, *u, theta))
+            p_ref = pressure(rho, theta, r, phys)
         transport = phys.transport(rho, theta, r)
         Pk = pad_fields(transport, grid, t)
         faces = [face_coefficients(Pk, grid.cells, a) for a in range(grid.ndim)]
         eta_f = [f[0] for f in faces]
-        c_f = [f[0] / 3.0 + f[1] for f in faces]
+        lam_f = [f[1] for f in faces]
+        lam_ac_m = 0.0
+        if acoustic is not None:
+            lam_ac = adt * rho * phys.sound_speed(theta, r) ** 2
+            lam_ac_m = jnp.mean(lam_ac)
+            Pac = pad_fields((lam_ac, p_ref), grid, t)
+            lam_ac_f = [face_mean(Pac[0], grid.cells, a) for a in range(grid.ndim)]
+            p_ref_f = [face_mean(Pac[1], grid.cells, a) for a in range(grid.ndim)]
+            lam_f = [lb + la for lb, la in zip(lam_f, lam_ac_f)]
+        c_f = [f[0] / 3.0 + lb for f, lb in zip(faces, lam_f)]
         kap_f = [f[2] for f in faces]
 
         # Wall coefficients frozen with the transport ones (their momentum part does not depend on u).
@@ -289,7 +315,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
             Pu = pad_fields(v, grid, t, velocity=0, affine=affine, walls=walls)
             out: list[Any] = [0.0, 0.0, 0.0]
             for a in range(grid.ndim):
-                tau = lees_edwards_faces([0.0, *stress(Pu, faces[a][0], faces[a][1], a, grid), 0.0], grid, a, t,
+                tau = lees_edwards_faces([0.0, *stress(Pu, faces[a][0], lam_f[a], a, grid), 0.0], grid, a, t,
                                          affine=False)[1:4]
                 dF = face_divergence(jnp.stack(tau), grid, a)
                 out = [o - dF[j] for j, o in enumerate(out)]
@@ -299,7 +325,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
             d = div_tau(v, affine)
             return tuple(rho * v[j] - adt * d[j] for j in range(3))
 
-        eta_m, lam_m = jnp.mean(transport[0]), jnp.mean(transport[1])
+        eta_m, lam_m = jnp.mean(transport[0]), jnp.mean(transport[1]) + lam_ac_m
         c_m = eta_m / 3.0 + lam_m
         iso = sum(_face_sum(eta_f, grid, a) * inv_dx2[a] for a in range(grid.ndim))
         iso_m = 2.0 * eta_m * sum(inv_dx2)
@@ -308,7 +334,11 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
                      / (rho_mean + adt * (iso_m + (2.0 * c_m * inv_dx2[j] if j < grid.ndim else 0.0))))
             for j in range(3))
         M = _scaled(momentum_preconditioner(grid, rho_mean, eta_m, lam_m, adt, dtype), scale)
-        b = tuple(m - a for m, a in zip(m_hat, A(u, True)))  # solve for the correction to the current u
+        m_base = m_hat
+        if acoustic is not None:  # the pressure of the iterate: m̂ − aΔt∇(p_k + λ_ac∇·u_k)
+            m_base = tuple(m + adt * d for m, d in zip(m_hat, pressure_divergence(
+                [p + la * d for p, la, d in zip(p_ref_f, lam_ac_f, d_ref)], grid) + [0.0] * (3 - grid.ndim)))
+        b = tuple(m - a for m, a in zip(m_base, A(u, True)))  # solve for the correction to the current u
         # Absolute floors from the scale of the state (thermal momentum ρ√θ, energy Ê), not of
         # the correction: in a nearly uniform gas the correction itself is round-off.
         atol_m = floor * _norm(rho, acc) * jnp.sqrt(jnp.mean(theta))
@@ -318,8 +348,19 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         sb = _unit(b, acc)
         du, _ = solve_m(A, tuple(x / sb for x in b), tol=tol, atol=atol_m / sb, maxiter=RESTART * maxiter, M=M)
         u = tuple(x + sb * dx for x, dx in zip(u, du))
-        if walls is not None:  # the wall heat terms need the slip of the new u
-            walls = wall_terms(rho, u, theta, transport, grid, phys)
+        rho_op = rho
+        if acoustic is not None:  # the face pressure of the solution, and mass and energy from its fluxes
+            Pu = pad_fields(u, grid, t, velocity=0, walls=walls)
+            div_f = [stress(Pu, 0.0, 1.0, a, grid)[a] for a in range(grid.ndim)]
+            m_base = tuple(m + adt * d for m, d in zip(m_hat, pressure_divergence(
+                [p + la * (d0 - d) for p, la, d0, d in zip(p_ref_f, lam_ac_f, d_ref, div_f)], grid)
+                + [0.0] * (3 - grid.ndim)))
+            d_rho, d_E = mass_energy_divergence(rho, u, acoustic.enthalpy, grid, t, walls)
+            rho, E_base, d_ref = rho_hat + adt * d_rho, E_hat + adt * d_E, div_f
+        else:
+            E_base = E_hat
+        if walls is not None:  # the wall heat terms need the slip of the new u (at the operator's ρ)
+            walls = wall_terms(rho_op, u, theta, transport, grid, phys)
 
         def B(th: Any) -> Any:
             Pt = pad_fields((th,), grid, t, affine=False, theta=0, walls=walls)[0]
@@ -330,12 +371,12 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
 
         # Right-hand side: Ê − ρ̂|u|²/2 + aΔt∇·(τ·u + ω∇φ), i.e. the stage equation with κ = 0.
         fI0 = viscous_divergence((rho, *u, jnp.zeros_like(theta)), transport, grid, phys, t, walls)
-        rhs_E = E_hat - 0.5 * rho * sum(x * x for x in u) + adt * (fI0[4] - sink)
+        rhs_E = E_base - 0.5 * rho * sum(x * x for x in u) + adt * (fI0[4] - sink)
         kap_m = jnp.mean(transport[2])
         hscale = jnp.sqrt((1.5 * rho + adt * sum(_face_sum(kap_f, grid, a) * inv_dx2[a] for a in range(grid.ndim)))
                           / (1.5 * rho_mean + 2.0 * adt * kap_m * sum(inv_dx2)))
         Mh = _scaled(heat_preconditioner(grid, rho_mean, kap_m, adt, dtype), hscale)
-        th0 = primitive_fields((rho, *(rho * x for x in u), E_hat))[4]  # θ of Û with the new u
+        th0 = primitive_fields((rho, *(rho * x for x in u), E_base))[4]  # θ of Û with the new u
         bE = rhs_E - B(th0)
         atol_E = floor * _norm(E_hat, acc)
         sE = _unit(bE, acc)
@@ -345,12 +386,14 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         # The conservative stage state and the residual of its two linear problems.
         fI = viscous_divergence((rho, *u, theta), transport, grid, phys, t, walls)
         fI[4] = fI[4] - sink
-        U = (rho, *(m + adt * f for m, f in zip(m_hat, fI[1:4])), E_hat + adt * fI[4])
-        res_m = _norm(tuple(rho * x - m for x, m in zip(u, U[1:4])), acc)
+        U = (rho, *(m + adt * f for m, f in zip(m_base, fI[1:4])), E_base + adt * fI[4])
+        res_m = _norm(tuple(rho_op * x - m for x, m in zip(u, U[1:4])), acc)
         res_E = _norm(U[4] - rho * (0.5 * sum(x * x for x in u) + 1.5 * theta), acc)
         tiny = float(jnp.finfo(dtype).tiny)  # a zero right-hand side (uniform gas) is solved exactly
         worst = jnp.maximum(worst, jnp.maximum(res_m / jnp.maximum(jnp.maximum(tol * _norm(b, acc), atol_m), tiny),
                                                res_E / jnp.maximum(jnp.maximum(tol * _norm(bE, acc), atol_E), tiny)
                                                ).astype(dtype))
         theta = primitive_fields(U)[4]
+    if acoustic is not None:  # f_I as applied: the increment of every conserved field
+        fI = [(x - y) / adt for x, y in zip(U, Uhat)]
     return U, fI, worst

@@ -38,6 +38,8 @@ import jax.numpy as jnp
 from .friction import cell_coefficients, explicit_part
 from .fluxes import LIMITERS, RIEMANN_SOLVERS, cell_divergence, flux_divergence, materialise, pad_fields
 from .grid import Grid
+from .acoustics import MODES as ACOUSTICS
+from .acoustics import AcousticStage, advective_divergence, enthalpy
 from .imex import EXPLICIT_WEIGHTS, GAMMA, IMPLICIT_WEIGHTS, implicit_stage
 from .physics import Physics
 from .sources import body_force, cooling_source
@@ -86,6 +88,9 @@ class Numerics:
         Krylov iterations of each stage solve, in units of :data:`~ktgf.solver.imex.RESTART` (10).
     sweeps : int
         Picard passes updating the frozen θ of the implicit coefficients (2 keeps second order).
+    acoustics : str
+        ``explicit`` (the HLL convective flux, Courant limit on |u| + c) or ``implicit`` (IMEX
+        only: the pressure waves in the implicit part, :mod:`.acoustics`; Courant limit on |u|).
     mixed : bool
         IMEX with a float32 state: solve the stages with float32 vectors and float64 inner
         products and norms (:func:`~ktgf.solver.imex.implicit_stage`), instead of casting the
@@ -103,9 +108,10 @@ class Numerics:
     implicit_maxiter: int = 5
     sweeps: int = 1
     mixed: bool = False
+    acoustics: str = "explicit"
 
     _LEAVES = ("cfl", "cfl_diffusion", "cfl_source", "dt_max", "implicit_tol")
-    _STATIC = ("limiter", "riemann", "scheme", "implicit_maxiter", "sweeps", "mixed")
+    _STATIC = ("limiter", "riemann", "scheme", "implicit_maxiter", "sweeps", "mixed", "acoustics")
 
     def tree_flatten(self) -> tuple[tuple, tuple]:
         return tuple(getattr(self, k) for k in self._LEAVES), tuple(getattr(self, k) for k in self._STATIC)
@@ -126,21 +132,29 @@ class Numerics:
             raise InputError(f"riemann solver {self.riemann!r} is not valid: choose one of {RIEMANN_SOLVERS}")
         if self.scheme not in SCHEMES:
             raise InputError(f"time scheme {self.scheme!r} is not valid: choose one of {SCHEMES}")
+        if self.acoustics not in ACOUSTICS:
+            raise InputError(f"acoustics {self.acoustics!r} is not valid: choose one of {ACOUSTICS}")
+        if self.acoustics == "implicit" and self.scheme != "imex":
+            raise InputError(f"acoustics 'implicit' needs the imex scheme (got scheme {self.scheme!r})")
 
 
 def explicit_rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, viscous: bool, r: Any = None,
-                 t: Any = 0.0) -> list[Any]:
+                 t: Any = 0.0, h0: Any = None) -> list[Any]:
     """−∇·F + S: the convective flux, sink and body force (+ viscous and heat flux if ``viscous``).
 
     ``r``: cell coefficients of ρ already evaluated (the closures run once per cell and stage);
-    ``t``: the time (of the moving boundaries).
+    ``t``: the time (of the moving boundaries); ``h0``: implicit acoustics, the frozen enthalpy
+    of the step start — the convective flux is then the explicit part of :mod:`.acoustics`.
     """
     W = materialise(primitive_fields(U))
     if r is None:
         r = cell_coefficients(W, grid, phys, t)
     eos = phys.eos(W[0], W[4], r)
-    transport = phys.transport(W[0], W[4], r) if viscous else ()
-    dU, divu = flux_divergence(W, (eos, transport), grid, phys, num.limiter, num.riemann, viscous=viscous, t=t)
+    if h0 is not None:
+        dU, divu = advective_divergence(W, eos, h0, grid, num.limiter, t)
+    else:
+        transport = phys.transport(W[0], W[4], r) if viscous else ()
+        dU, divu = flux_divergence(W, (eos, transport), grid, phys, num.limiter, num.riemann, viscous=viscous, t=t)
     source, _ = cooling_source(W, divu, phys, r)
     dU[4] = dU[4] + source
     if phys.gravity is not None:
@@ -160,7 +174,7 @@ def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None)
     rho, u, theta = W[0], W[1:4], W[4]
     if r is None:
         r = cell_coefficients(W, grid, phys)
-    c = phys.sound_speed(theta, r)
+    c = phys.sound_speed(theta, r) if num.acoustics == "explicit" else 0.0  # implicit: the flow speed only
     wave = sum((jnp.abs(u[a]) + c) / grid.spacing[a] for a in range(grid.ndim))
     eta, lam, kap, _ = phys.transport(rho, theta, r)
     inv_dx2 = sum(1.0 / h**2 for h in grid.spacing)
@@ -219,9 +233,14 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
     t_explicit = t + jnp.asarray([0.0, GAMMA], t.dtype) * dt
     t_implicit = t + jnp.asarray([GAMMA, 1.0], t.dtype) * dt
 
+    acoustic = num.acoustics == "implicit"
+    h0 = None
+    if acoustic:  # the enthalpy of the linear/non-linear split, frozen at Uⁿ for the step (:mod:`.acoustics`)
+        h0 = enthalpy(Un, cell_coefficients(primitive_fields(Un), grid, phys, t), phys)
+
     def stage(k: Any, carry: tuple) -> tuple:
         Uk, rk, KE1, KI2, worst = carry
-        KE = explicit_rhs(Uk, grid, phys, num, viscous=False, r=explicit_part(rk), t=t_explicit[k])
+        KE = explicit_rhs(Uk, grid, phys, num, viscous=False, r=explicit_part(rk), t=t_explicit[k], h0=h0)
         KE1 = tuple(jnp.where(k == 0, a, b) for a, b in zip(KE, KE1))
         Uhat = tuple(u + dt * (wE[k, 0] * e1 + wE[k, 1] * e + wI[k] * i2)
                      for u, e1, e, i2 in zip(Un, KE1, KE, KI2))
@@ -230,9 +249,11 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
         # float64 inner products (docs/solver.md, Speed).
         Uhat64 = Uhat if num.mixed else tuple(u.astype(jnp.float64) for u in Uhat)
         r = cell_coefficients(primitive_fields(Uhat64), grid, phys, t_implicit[k])
+        stage_acoustics = AcousticStage(h0.astype(Uhat64[0].dtype), lambda W: cell_coefficients(
+            W, grid, phys, t_implicit[k])) if acoustic else None
         Ui, fI, res = implicit_stage(Uhat64, GAMMA * jnp.asarray(dt, jnp.float64).astype(Uhat64[0].dtype), grid, phys,
                                      r, jnp.asarray(num.implicit_tol, jnp.float64), num.implicit_maxiter, num.sweeps,
-                                     t_implicit[k], mixed=num.mixed)
+                                     t_implicit[k], mixed=num.mixed, acoustic=stage_acoustics)
         r = jax.tree_util.tree_map(lambda x: jnp.asarray(x).astype(dtype), r)
         return tuple(u.astype(dtype) for u in Ui), r, KE1, \
             tuple(jnp.broadcast_to(f, Un[0].shape).astype(dtype) for f in fI), jnp.maximum(worst, res.astype(dtype))
