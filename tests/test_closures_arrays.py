@@ -116,3 +116,44 @@ def test_every_registered_model_is_hashable_and_documented():
         hash(m)
         assert m.label and m.description and m.theory.reference
         assert m.metadata()["model"] == m.name
+
+
+# ``power``: quarter exponents by multiplications and square roots (no XLA ``pow``), the rest by ``**``.
+QUARTER_EXPONENTS = [1.75, 0.75, -1.75, 2.5, 1.5, -3.0, 0.25, 4.0]
+
+
+@pytest.mark.parametrize("b", QUARTER_EXPONENTS)
+def test_power_quarter_exponents_match_pow(b):
+    from ktgf._array import power
+
+    x = np.geomspace(1e-3, 1e3, 2001)
+    exact = np.array([float(np.longdouble(v) ** np.longdouble(b)) for v in x])  # extended-precision oracle
+    assert np.max(np.abs(power(x, b) / exact - 1.0)) < 1e-15
+    assert np.max(np.abs(np.asarray(power(jnp.asarray(x), b)) / exact - 1.0)) < 1e-15
+
+
+def test_power_edge_values_and_fallback():
+    from ktgf._array import power
+
+    with np.errstate(invalid="ignore", divide="ignore"):
+        assert np.isnan(power(np.array(-1.0), 1.75)) and power(np.array(0.0), 1.75) == 0.0
+        assert power(np.array(0.0), -1.75) == np.inf
+    x = np.linspace(0.1, 2.0, 7)
+    assert np.array_equal(power(x, 0.678021), x**0.678021)  # not a quarter: plain pow
+    assert np.array_equal(power(x, 40.0), x**40.0)          # beyond the multiplication range
+
+
+def test_power_traced_exponent_differentiates():
+    from ktgf._array import power
+
+    g = jax.grad(lambda b: power(jnp.asarray(2.0), b))(1.75)  # a calibration differentiating in β
+    assert float(g) == pytest.approx(2.0**1.75 * np.log(2.0), rel=1e-14)
+
+
+@pytest.mark.parametrize("name", ["proposed", "visc-div"])
+def test_dense_models_compile_without_pow(name):
+    """The divergence exponents (β = 1.75, β − 1 = 0.75) cost no ``pow`` in the compiled closures
+    (the fitted β = 4.052 of ``dense`` is no quarter and keeps one)."""
+    m = get_model(name)
+    text = jax.jit(lambda phi: m.reduced(phi, 0.7, check=False)).lower(jnp.full((8,), 0.55)).compile().as_text()
+    assert " power(" not in text

@@ -3,8 +3,11 @@
 The oracle is the JAX path of :mod:`ktgf.solver.fluxes` (the reference implementation, and the
 path for GPUs, sharding and non-periodic grids), compiled in the same process: one right-hand
 side for every limiter and Riemann solver with and without the viscous fluxes, and three steps of
-both time schemes and two closure models.  Also: where the kernel does not apply it is not used,
-and without a compiler the solver falls back to the JAX path with one warning.
+both time schemes and two closure models.  The fused SSP-RK3 stage (:func:`.flux_kernel.ssprk_stage`)
+is checked the same way, in both precisions and with a frictional model, and its energy source
+s0 + s1∇·u against :func:`~ktgf.solver.sources.cooling_source` for every registered model.  Also:
+where the kernel does not apply it is not used, and without a compiler the solver falls back to
+the JAX path with one warning.
 """
 
 from __future__ import annotations
@@ -20,7 +23,11 @@ from ktgf.solver.boundaries import Boundaries
 from ktgf.solver.grid import Grid
 from ktgf.solver.initial import random_velocity
 from ktgf.solver.physics import Physics
-from ktgf.solver.stepping import Numerics, advance, explicit_rhs
+from ktgf.closures.models import list_models
+from ktgf.solver.friction import cell_coefficients, for_case
+from ktgf.solver.sources import cooling_source
+from ktgf.solver.state import primitive_fields
+from ktgf.solver.stepping import Numerics, advance, explicit_rhs, kernel_stage_inputs, ssprk3_step
 
 D, RHO_S = 1e-3, 2500.0
 #: float64: the kernel does the operations of the JAX path in the same order; XLA's fusion may round
@@ -35,17 +42,17 @@ def _grid() -> Grid:
     return Grid((6, 8, 10), (6 * D, 8 * 1.3 * D, 10 * 0.8 * D))
 
 
-def _state(grid: Grid, phys: Physics, dtype, amplitude: float = 0.05):
-    return tuple(jnp.asarray(random_velocity(grid, phys, 0.3, 1e-4, amplitude, 4), dtype=dtype))
+def _state(grid: Grid, phys: Physics, dtype, amplitude: float = 0.05, phi: float = 0.3):
+    return tuple(jnp.asarray(random_velocity(grid, phys, phi, 1e-4, amplitude, 4), dtype=dtype))
 
 
-def _with_kernel(on: bool, fn):
-    saved = fluxes.FLUX_KERNEL
+def _with_kernel(on: bool, fn, stage: bool = True):
+    saved = fluxes.FLUX_KERNEL, fluxes.STAGE_KERNEL
     try:
-        fluxes.FLUX_KERNEL = on
+        fluxes.FLUX_KERNEL, fluxes.STAGE_KERNEL = on, stage
         return fn()
     finally:
-        fluxes.FLUX_KERNEL = saved
+        fluxes.FLUX_KERNEL, fluxes.STAGE_KERNEL = saved
 
 
 def _close(a, b) -> float:
@@ -118,3 +125,83 @@ def test_without_a_compiler_the_jax_path_runs_with_one_warning(monkeypatch, tmp_
     with pytest.warns(RuntimeWarning, match="flux kernel unavailable.*no-such-compiler-ktgf"):
         assert not flux_kernel.applies(_grid(), jnp.float64)
     assert not flux_kernel.applies(_grid(), jnp.float64)  # decided once: no second warning, no retry
+
+
+def _steps(U, grid, phys, num, steps: int = 3):
+    return jax.jit(lambda U: advance.__wrapped__(U, 0.0, 1e30, steps, grid, phys, num))(U)
+
+
+#: (model, options, φ, perturbation, dtype) of the fused-stage step comparisons; a frictional stress
+#: (above its φ_min = 0.5) makes the cell coefficients depend on the velocity gradient and adds the
+#: frictional work to s0.
+STAGE_CASES = [("ret", {}, 0.3, 0.2, jnp.float64), ("ret", {}, 0.3, 0.2, jnp.float32),
+               ("proposed", {}, 0.52, 0.05, jnp.float64), ("frictional", {"stress": "schaeffer"}, 0.53, 0.01, jnp.float64)]
+
+
+@pytest.mark.parametrize(("model", "options", "phi", "amplitude", "dtype"), STAGE_CASES)
+def test_fused_stage_steps_match_jax(model: str, options: dict, phi: float, amplitude: float, dtype) -> None:
+    grid = _grid()
+    m = get_model(model, **options)
+    phys = for_case(Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max), "cooling", grid)
+    U = _state(grid, phys, dtype, amplitude=amplitude, phi=phi)
+    if m.friction.has_stress:  # the frictional stress is present in (nearly) every cell
+        assert float(jnp.mean(cell_coefficients(primitive_fields(U), grid, phys).p_f > 0.0)) > 0.9
+    num = Numerics(scheme="ssprk3")
+    fused = _with_kernel(True, lambda: _steps(U, grid, phys, num))
+    kernel = _with_kernel(True, lambda: _steps(U, grid, phys, num), stage=False)  # fluxes only
+    ref = _with_kernel(False, lambda: _steps(U, grid, phys, num))
+    for out in (fused, kernel, ref):
+        assert int(out[2]) == 3 and int(out[3]) == 0
+    assert fused[0].dtype == dtype
+    assert _close(fused[0], ref[0]) < RTOL[dtype]
+    assert _close(fused[0], kernel[0]) < RTOL[dtype]
+    assert _close(fused[0], U) > 100 * RTOL[dtype]  # the steps changed the state
+
+
+@pytest.mark.parametrize("model", [m.name for m in list_models()])
+def test_stage_source_is_the_cooling_source(model: str) -> None:
+    """s0 + s1∇·u (what the fused stage adds) equals −(3/2)ρθζ for any ∇·u, for every registered model."""
+    grid = _grid()
+    m = get_model(model)
+    phys = for_case(Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max), "uniform-shear", grid)
+    U = _state(grid, phys, jnp.float64, amplitude=0.2)
+    W = primitive_fields(U)
+    r = cell_coefficients(W, grid, phys)
+    _, _, _, (s0, s1) = kernel_stage_inputs(U, r, phys)
+    divu = jnp.asarray(np.random.default_rng(3).normal(0.0, 50.0, grid.cells))
+    exact, _ = cooling_source(W, divu, phys, r)
+    scale = float(jnp.max(jnp.abs(exact)))
+    if float(jnp.max(jnp.abs(r.zeta_u))) > 0.0:  # Lun et al. (1984) have no ζ_U: s1 = 0 there
+        assert float(jnp.max(jnp.abs(s1 * divu))) > 1e-3 * scale  # the ∇·u part is not negligible here
+    assert float(jnp.max(jnp.abs(s0 + s1 * divu - exact))) < 1e-13 * scale
+
+
+def test_fused_stage_is_in_the_compiled_step_only_where_it_applies() -> None:
+    grid, phys = _grid(), _physics("ret")
+    U = _state(grid, phys, jnp.float64)
+    num = Numerics(scheme="ssprk3")
+
+    def hlo(phys: Physics) -> str:
+        return jax.jit(lambda U: ssprk3_step(U, 1e-6, grid, phys, num)).lower(U).as_text()
+
+    assert flux_kernel.STAGE_TARGET in _with_kernel(True, lambda: hlo(phys))
+    assert flux_kernel.TARGET not in _with_kernel(True, lambda: hlo(phys))  # the stage does the fluxes
+    assert flux_kernel.STAGE_TARGET not in _with_kernel(True, lambda: hlo(phys), stage=False)
+    with_gravity = Physics(phys.model, 0.8, D, RHO_S, phys.phi_stop, gravity=(0.0, -9.81, 0.0))
+    text = _with_kernel(True, lambda: hlo(with_gravity))  # a body force: the flux kernel and the JAX update
+    assert flux_kernel.STAGE_TARGET not in text and flux_kernel.TARGET in text
+
+
+def test_closures_once_per_stage(monkeypatch) -> None:
+    """Tracing one SSP-RK3 step of ``advance`` evaluates the closures twice: at the step start (shared by
+    the step limits and the first stage) and in the stage loop (the two later stages) — 3 per step."""
+    grid, phys = _grid(), _physics("ret")
+    U = _state(grid, phys, jnp.float64)
+    calls = []
+    original = Physics.reduced
+    monkeypatch.setattr(Physics, "reduced", lambda self, *a, **k: calls.append(1) or original(self, *a, **k))
+    for stage in (True, False):
+        calls.clear()
+        _with_kernel(True, lambda: jax.jit(lambda U: advance.__wrapped__(
+            U, 0.0, 1e30, 1, grid, phys, Numerics(scheme="ssprk3"))).lower(U), stage=stage)
+        assert len(calls) == 2

@@ -47,3 +47,36 @@ def asarray(x: Any) -> Any:
         from .errors import InputError
 
         raise InputError(f"{x!r:.60} is not a number or an array of numbers") from None
+
+
+#: Largest |4b| for which :func:`power` multiplies instead of calling ``pow``.
+_QUARTER_POWERS = 64
+
+
+def power(x: Any, b: Any) -> Any:
+    """x**b; a concrete exponent that is a multiple of 1/4 (|b| ≤ 16) by multiplications and square roots.
+
+    Why: XLA evaluates a float64 ``pow`` on the CPU at ≈ 20 ns a value, more than all the other
+    closure arithmetic of a cell (the β = 1.75 of the viscosity-divergence RDF made the Proposed
+    model's closure pass 2× RET's, docs/solver.md, Speed).  x^(n/4) = x^⌊n/4⌋ · √x^[n mod 4 ≥ 2] ·
+    ⁴√x^[n odd] is the same function (round-off differs by a few ulp: each factor is correctly
+    rounded); NaN for x < 0 and ∞ for x = 0, b < 0, as ``pow``.  A traced exponent (a
+    calibration differentiating with respect to it) or any other value keeps ``x**b``.
+    """
+    if is_tracer(b):
+        return x**b
+    try:
+        n4 = float(b) * 4.0
+    except (TypeError, ValueError):
+        return x**b
+    if n4 != round(n4) or abs(n4) > _QUARTER_POWERS:
+        return x**b
+    n = int(round(n4))
+    whole, quarters = divmod(abs(n), 4)
+    xp = namespace(x)
+    r = x**whole  # an integer power: multiplications (jax.lax.integer_pow)
+    if quarters & 2:
+        r = r * xp.sqrt(x)
+    if quarters & 1:
+        r = r * xp.sqrt(xp.sqrt(x))
+    return 1.0 / r if n < 0 else r

@@ -21,7 +21,7 @@ from typing import Any, Callable, ClassVar
 
 import numpy as np
 
-from .._array import namespace
+from .._array import namespace, power
 from ..errors import InputError
 from .junction import DEFAULT_WIDTH, JUNCTIONS, hermite
 from .options import CLOSE_PACKING, choice_option, real_option
@@ -284,12 +284,12 @@ class JammingPowerLaw(_DivergesAtPhiC):
 
     def chi(self, phi: Any) -> Any:
         # (2 − φ)/(2(1 − φ)³) in Chialvo & Sundaresan is the Carnahan–Starling χ written differently.
-        return _cs_chi(phi) + self.a * phi**2 / (self.phi_c - phi) ** self.exponent
+        return _cs_chi(phi) + self.a * phi**2 / power(self.phi_c - phi, self.exponent)
 
     def dchi(self, phi: Any) -> Any:
         gap = self.phi_c - phi
         b = self.exponent
-        return _cs_dchi(phi) + self.a * (2.0 * phi / gap**b + b * phi**2 / gap ** (b + 1.0))
+        return _cs_dchi(phi) + self.a * (2.0 * phi / power(gap, b) + b * phi**2 / power(gap, b + 1.0))
 
 
 @dataclass(frozen=True)
@@ -327,7 +327,7 @@ class ViscosityDivergence(_CarnahanStarlingBelowFreezing):
         self._check_bridge()
 
     def _dense(self, phi: Any) -> Any:
-        return _cs_chi(self.phi_f) * ((self.phi_c - self.phi_f) / (self.phi_c - phi)) ** self.beta
+        return _cs_chi(self.phi_f) * power((self.phi_c - self.phi_f) / (self.phi_c - phi), self.beta)
 
     def _dense_slope(self, phi: Any) -> Any:
         return self.beta * self._dense(phi) / (self.phi_c - phi)

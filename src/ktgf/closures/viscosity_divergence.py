@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from .._array import namespace
+from .._array import namespace, power
 from .junction import DEFAULT_WIDTH, JUNCTIONS, hermite
 from .options import CLOSE_PACKING, choice_option, real_option
 
@@ -64,7 +64,7 @@ class ViscosityDivergenceLaw:
                     high_open=True, why="0 < width < phi_c - phi_f")
 
     def _dense(self, phi: Any) -> Any:
-        return ((self.phi_c - self.phi_f) / (self.phi_c - phi)) ** (self.beta - 1.0)
+        return power((self.phi_c - self.phi_f) / (self.phi_c - phi), self.beta - 1.0)
 
     def factor(self, phi: Any) -> Any:
         """Multiplier of η* at φ (1 for φ ≤ φ_f)."""

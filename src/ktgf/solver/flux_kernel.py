@@ -1,10 +1,12 @@
-"""CPU fast path of :func:`.fluxes.flux_divergence`: an XLA FFI custom call (``flux_kernel.cc``).
+"""CPU fast path of :func:`.fluxes.flux_divergence` and of a whole SSP-RK3 stage: XLA FFI custom calls (``flux_kernel.cc``).
 
 The kernel does the numerics of :mod:`.fluxes` only (MUSCL reconstruction with the configured
 limiter, HLL/Rusanov, central viscous stress and heat flux, face divergence, ∇·u) from the same
 cell fields the JAX path gets; every closure stays in Python.  It computes each face once
 instead of once per flux component (docs/solver.md, Speed) and agrees with the JAX path to
-round-off (tests/test_solver_flux_kernel.py).
+round-off (tests/test_solver_flux_kernel.py).  :func:`ssprk_stage` also applies the energy
+source and the stage update of :func:`.stepping.ssprk3_step` in the same sweep, so a stage of
+the explicit scheme is one closure pass (XLA) and one kernel call.
 
 It is used where it applies — CPU backend, one device, a 3D fully periodic grid, float32 or
 float64 — and when it is switched on: :data:`.fluxes.FLUX_KERNEL` (default from the environment
@@ -36,6 +38,7 @@ import numpy as np
 
 SOURCE = Path(__file__).with_name("flux_kernel.cc")
 TARGET = "ktgf_flux_divergence"
+STAGE_TARGET = "ktgf_ssprk_stage"
 FLAGS = ("-O3", "-march=native", "-fopenmp", "-ffp-contract=off", "-fno-math-errno", "-shared", "-fPIC", "-std=c++17")
 _loaded: dict[str, Any] = {}
 
@@ -75,6 +78,7 @@ def available() -> bool:
             os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
             lib = ctypes.cdll.LoadLibrary(str(build()))
             jax.ffi.register_ffi_target(TARGET, jax.ffi.pycapsule(lib.KtgfFluxDivergence), platform="cpu")
+            jax.ffi.register_ffi_target(STAGE_TARGET, jax.ffi.pycapsule(lib.KtgfSsprkStage), platform="cpu")
             _loaded["ok"] = True
         except (RuntimeError, OSError) as err:
             warnings.warn(f"ktgf flux kernel unavailable, using the JAX path: {err}", RuntimeWarning, stacklevel=2)
@@ -89,21 +93,52 @@ def applies(grid: Any, dtype: Any) -> bool:
             and jax.default_backend() == "cpu" and jax.device_count() == 1 and available())
 
 
-def flux_divergence(W: Any, eos: Any, transport: Any, grid: Any, rho_s: Any, limiter: str, riemann: str,
-                    viscous: bool) -> tuple[list[Any], Any]:
-    """−∇·F of the five conservative fields and the central ∇·u, as :func:`.fluxes.flux_divergence`."""
-    from .fluxes import GHOST, LIMITERS, RIEMANN_SOLVERS
+def _cell_fields(W: Any, eos: Any, transport: Any, grid: Any, viscous: bool) -> tuple[list[Any], Any]:
+    """The kernel's 11 cell-field inputs and its workspace (their copies with periodic ghost cells)."""
+    from .fluxes import GHOST
 
     dtype = W[0].dtype
-    cells = tuple(grid.cells)
     fields = [jnp.asarray(f, dtype) for f in (*W, *eos)]
     # Non-viscous calls pass ρ in the unused transport slots (no copy; the kernel ignores them).
     fields += [jnp.asarray(f, dtype) for f in transport] if viscous else [fields[0]] * 4
-    field = jax.ShapeDtypeStruct(cells, dtype)
     nfield = 11 if viscous else 7
-    work = jax.ShapeDtypeStruct((nfield, *(n + 2 * GHOST for n in cells)), dtype)
+    return fields, jax.ShapeDtypeStruct((nfield, *(n + 2 * GHOST for n in grid.cells)), dtype)
+
+
+def _schemes(limiter: str, riemann: str) -> dict[str, Any]:
+    from .fluxes import LIMITERS, RIEMANN_SOLVERS
+
+    return {"limiter": np.int32(LIMITERS.index(limiter)), "riemann": np.int32(RIEMANN_SOLVERS.index(riemann))}
+
+
+def flux_divergence(W: Any, eos: Any, transport: Any, grid: Any, rho_s: Any, limiter: str, riemann: str,
+                    viscous: bool) -> tuple[list[Any], Any]:
+    """−∇·F of the five conservative fields and the central ∇·u, as :func:`.fluxes.flux_divergence`."""
+    fields, work = _cell_fields(W, eos, transport, grid, viscous)
+    field = jax.ShapeDtypeStruct(tuple(grid.cells), W[0].dtype)
     call = jax.ffi.ffi_call(TARGET, (field,) * 6 + (work,))
     params = jnp.stack([jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)])
-    out = call(*fields, params, limiter=np.int32(LIMITERS.index(limiter)), riemann=np.int32(RIEMANN_SOLVERS.index(riemann)),
-               viscous=np.int32(viscous))
+    out = call(*fields, params, **_schemes(limiter, riemann), viscous=np.int32(viscous))
     return list(out[:5]), out[5]
+
+
+def ssprk_stage(U0: Any, Uk: Any, W: Any, eos: Any, transport: Any, source: tuple[Any, Any], a: Any, dt: Any,
+                grid: Any, rho_s: Any, limiter: str, riemann: str) -> tuple[Any, ...]:
+    """One SSP-RK3 stage U' = a U0 + (1 − a)(Uk + Δt L(Uk)), as in :func:`.stepping.ssprk3_step`.
+
+    L = −∇·F (convective, viscous and heat fluxes, as :func:`flux_divergence`) plus the energy
+    source s0 + s1 ∇·u with ``source`` = (s0, s1) at the cells of Uk (:func:`.sources.cooling_source`
+    is linear in ∇·u); ``W``, ``eos``, ``transport``: the primitive fields and cell coefficients of Uk.
+    """
+    dtype = Uk[0].dtype
+    fields, work = _cell_fields(W, eos, transport, grid, True)
+    state = [jnp.asarray(f, dtype) for f in (*U0, *Uk, *source)]
+    field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
+    # U' is written over Uk (each cell reads its own Uk only, after the fluxes): no new buffers, and
+    # none of the loop-carry copies XLA inserts when a stage's output cannot take its input's place.
+    call = jax.ffi.ffi_call(STAGE_TARGET, (field,) * 5 + (work,),
+                            input_output_aliases={len(fields) + 6 + v: v for v in range(5)})
+    # a and Δt as the state precision rounds them (the JAX path computes in that precision).
+    coef = [jnp.asarray(v).astype(dtype).astype(jnp.float64) for v in (a, dt)]
+    params = jnp.stack([*(jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)), *coef])
+    return tuple(call(*fields, params, *state, **_schemes(limiter, riemann))[:5])

@@ -109,6 +109,10 @@ PERIODIC_PAD = "pad"
 #: Use the C++ kernel (:mod:`.flux_kernel`) for :func:`flux_divergence` where it applies (CPU,
 #: one device, 3D fully periodic grid).  Default on; ``KTGF_FLUX_KERNEL=0`` switches it off.
 FLUX_KERNEL = os.environ.get("KTGF_FLUX_KERNEL", "1").lower() not in ("0", "off", "false", "no")
+#: Where the flux kernel applies, run each SSP-RK3 stage as one kernel call with the source and the
+#: stage update fused in (:func:`.flux_kernel.ssprk_stage`).  Default on; ``KTGF_STAGE_KERNEL=0``
+#: keeps the flux kernel for the fluxes only (the A/B reference of ``benchmarks/bench_solver.py``).
+STAGE_KERNEL = os.environ.get("KTGF_STAGE_KERNEL", "1").lower() not in ("0", "off", "false", "no")
 
 
 @functools.lru_cache(maxsize=16)

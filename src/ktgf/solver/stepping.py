@@ -200,14 +200,49 @@ def stable_dt(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None) -
     return jnp.minimum(dt, num.dt_max)
 
 
-def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> Any:
-    """One SSP-RK3 step of size dt.
+def stage_kernel_applies(grid: Grid, phys: Physics, dtype: Any) -> bool:
+    """Whether an SSP-RK3 stage runs as one C++ kernel call (:func:`.flux_kernel.ssprk_stage`): where the
+    flux kernel applies (CPU, one device, 3D periodic) and no body force adds a source of its own."""
+    from . import flux_kernel, fluxes
+
+    return fluxes.FLUX_KERNEL and fluxes.STAGE_KERNEL and phys.gravity is None and flux_kernel.applies(grid, dtype)
+
+
+def kernel_stage_inputs(Uk: Any, r: Any, phys: Physics) -> tuple:
+    """Primitive fields, (p*, g), (η, λ_b, κ, ω) and the energy source (s0, s1) of a state with cell coefficients r.
+
+    The source −(3/2)ρθζ is linear in ∇·u (ζ = ζ0 + ζ_U∇·u, :func:`.sources.cooling_source`): s0 is
+    its value at ∇·u = 0 and s1 its derivative, so the kernel adds s0 + s1∇·u with its own ∇·u.
+    """
+    W = primitive_fields(Uk)
+    zero = jnp.zeros_like(W[0])
+    source = jax.jvp(lambda divu: cooling_source(W, divu, phys, r)[0], (zero,), (jnp.ones_like(zero),))
+    return W, phys.eos(W[0], W[4], r), phys.transport(W[0], W[4], r), source
+
+
+def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0, r0: Any = None) -> Any:
+    """One SSP-RK3 step of size dt (``r0``: the cell coefficients of U, if already evaluated).
 
     Written as three stages U_{k+1} = a_k U + (1 − a_k)(U_k + Δt L(U_k)), a = (0, 3/4, 1/3),
     in a ``fori_loop`` so the right-hand side is traced (and compiled) once, not three times.
+    Where :func:`stage_kernel_applies`, each stage is the closures (XLA) and one kernel call.
     """
     coef = jnp.asarray([0.0, 0.75, 1.0 / 3.0], dtype=U[0].dtype)
     when = jnp.asarray([0.0, 1.0, 0.5], dtype=jnp.result_type(t, float))  # stage times / Δt
+
+    if stage_kernel_applies(grid, phys, U[0].dtype):
+        from .flux_kernel import ssprk_stage
+
+        def kernel_stage(k: Any, Uk: tuple, r: Any) -> tuple:
+            W, eos, transport, source = kernel_stage_inputs(Uk, r, phys)
+            return ssprk_stage(U, Uk, W, eos, transport, source, coef[k], dt, grid, phys.material_density,
+                               num.limiter, num.riemann)
+
+        if r0 is None:
+            r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
+        U1 = kernel_stage(0, tuple(U), r0)  # the closures of U are the step limits' (advance)
+        return jax.lax.fori_loop(1, 3, lambda k, Uk: kernel_stage(
+            k, Uk, cell_coefficients(primitive_fields(Uk), grid, phys, t + when[k] * dt)), U1)
 
     def stage(k: Any, Uk: tuple) -> tuple:
         a = coef[k]
@@ -217,8 +252,11 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
     return jax.lax.fori_loop(0, 3, stage, tuple(U))
 
 
-def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> tuple[Any, Any]:
+def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0,
+              r0: Any = None) -> tuple[Any, Any]:
     """One ARS(2,2,2) step (:mod:`.imex`); returns the state and the worst solve residual / tolerance.
+
+    ``r0``: the cell coefficients of U, if already evaluated (the step limits' in :func:`advance`).
 
     The two implicit stages run in a ``fori_loop`` (traced once); the closures are evaluated
     once per stage, at the stage density, and shared by the implicit solve and the next
@@ -236,7 +274,7 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
     acoustic = num.acoustics == "implicit"
     h0 = None
     if acoustic:  # the enthalpy of the linear/non-linear split, frozen at Uⁿ for the step (:mod:`.acoustics`)
-        h0 = enthalpy(Un, cell_coefficients(primitive_fields(Un), grid, phys, t), phys)
+        h0 = enthalpy(Un, r0 if r0 is not None else cell_coefficients(primitive_fields(Un), grid, phys, t), phys)
 
     def stage(k: Any, carry: tuple) -> tuple:
         Uk, rk, KE1, KI2, worst = carry
@@ -259,17 +297,22 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
             tuple(jnp.broadcast_to(f, Un[0].shape).astype(dtype) for f in fI), jnp.maximum(worst, res.astype(dtype))
 
     zeros = tuple(jnp.zeros_like(u) for u in Un)
-    r0 = jax.tree_util.tree_map(lambda x: jnp.asarray(x).astype(dtype), cell_coefficients(primitive_fields(Un), grid, phys, t))
+    if r0 is None:
+        r0 = cell_coefficients(primitive_fields(Un), grid, phys, t)
+    r0 = jax.tree_util.tree_map(lambda x: jnp.asarray(x).astype(dtype), r0)
     init = (Un, r0, zeros, zeros, jnp.zeros((), dtype))
     Ui, _, _, _, worst = jax.lax.fori_loop(0, 2, stage, init)
     return Ui, worst
 
 
-def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> tuple[Any, Any]:
-    """One step of the configured scheme from time t: (state, implicit residual / tolerance — 0 for SSP-RK3)."""
+def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0,
+                r0: Any = None) -> tuple[Any, Any]:
+    """One step of the configured scheme from time t: (state, implicit residual / tolerance — 0 for SSP-RK3).
+
+    ``r0``: the cell coefficients of U, if already evaluated."""
     if num.scheme == "imex":
-        return imex_step(U, dt, grid, phys, num, t)
-    return ssprk3_step(U, dt, grid, phys, num, t), jnp.zeros((), U[0].dtype)
+        return imex_step(U, dt, grid, phys, num, t, r0)
+    return ssprk3_step(U, dt, grid, phys, num, t, r0), jnp.zeros((), U[0].dtype)
 
 
 #: CPU time of one IMEX step over one SSP-RK3 step, measured (RET at φ = 0.5 with Δx = ℓ, 32³:
@@ -324,12 +367,14 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
 
     def body(carry: tuple) -> tuple:
         U, t, n, _, _ = carry
+        # The closures of the step start serve both the step limits and the step's first stage.
+        r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
         # Time is kept in float64 whatever the state precision, so a float32 run still lands
         # exactly on t_end.
-        dt_stable = stable_dt(U, grid, phys, num).astype(t.dtype)
+        dt_stable = stable_dt(U, grid, phys, num, r0).astype(t.dtype)
         last = dt_stable >= t_end - t
         dt = jnp.where(last, t_end - t, dt_stable)
-        U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t)
+        U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t, r0)
         bad_state = state_status(U_new, phys)
         status = jnp.where(bad_state != 0, bad_state, jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5))
         status = jnp.where((status == 0) & ~(residual <= RESIDUAL_FAIL), 6, status)
