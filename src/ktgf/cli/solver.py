@@ -13,7 +13,8 @@ from ._common import handle_errors
 def run(
     case: Path = typer.Argument(..., help="TOML run configuration (examples/: hcs_3d, uniform_shear, "
                               "uniform_shear_dense, frictional_shear, couette_2d, couette_dense, couette_dense_3d, "
-                              "couette_dense_seq32, couette_dense_seq64, couette_dense_seq128, chute_2d .toml)."),
+                              "couette_dense055, couette_dense055_3d, couette_dense_seq32, couette_dense_seq64, "
+                              "couette_dense_seq128, chute_2d .toml)."),
     resume: Path = typer.Option(None, "--resume", help="Continue from this checkpoint (same config)."),
     output_dir: Path = typer.Option(None, "--output-dir", "-o", help="Override output.directory."),
     progress: bool = typer.Option(True, "--progress/--no-progress", help="Show the progress bar."),
@@ -24,7 +25,8 @@ def run(
 
     Examples: examples/hcs_3d.toml (cooling box), uniform_shear.toml, uniform_shear_dense.toml (64³,
     φ 0.55), frictional_shear.toml (μ 0.5), couette_2d.toml, couette_dense.toml (φ 0.5, 64 cells
-    across the gap), couette_dense_3d.toml (64³, from couette_dense's result), couette_dense_seq32.toml
+    across the gap), couette_dense_3d.toml (64³, from couette_dense's result, in minutes),
+    couette_dense055.toml → couette_dense055_3d.toml (the same at φ 0.55), couette_dense_seq32.toml
     → _seq64 → _seq128 (φ 0.55, grid sequencing to 128 cells), chute_2d.toml; time.steady_tol stops a
     sheared run at its steady state; initial.from_run starts from an earlier run mapped onto the grid.
 

@@ -141,6 +141,8 @@ class NumericsSection(_Section):
     sweeps: int = Field(1, ge=1, le=5, description="IMEX: Picard passes on the implicit coefficients")
     acoustics: Literal["explicit", "implicit"] = Field(
         "explicit", description="IMEX: pressure waves explicit (step from |u| + c) or implicit (step from |u|)")
+    sink: Literal["explicit", "implicit"] = Field(
+        "explicit", description="IMEX: collisional sink explicit (step <= cfl_source/zeta0) or implicit (no such limit)")
 
     @field_validator("limiter")
     @classmethod
@@ -381,6 +383,9 @@ def check_case(cfg: Config, source: str = "config") -> None:
         raise InputError(f"{source}: field time.unit = 'strain': a chute has no imposed shear rate; valid 's'")
     if cfg.numerics.acoustics == "implicit" and cfg.time.scheme == "ssprk3":
         raise InputError(f"{source}: field numerics.acoustics = 'implicit' needs time.scheme = 'imex' or 'auto' "
+                         "(got 'ssprk3', an explicit scheme)")
+    if cfg.numerics.sink == "implicit" and cfg.time.scheme == "ssprk3":
+        raise InputError(f"{source}: field numerics.sink = 'implicit' needs time.scheme = 'imex' or 'auto' "
                          "(got 'ssprk3', an explicit scheme)")
     if cfg.numerics.acoustics == "implicit" and shear is not None:
         raise InputError(f"{source}: field numerics.acoustics = 'implicit' is not available with a 'lees-edwards' "

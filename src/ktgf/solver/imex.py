@@ -40,6 +40,14 @@ residual exceeds 10× the tolerance rejects the step (status 6).
 
 With ``numerics.acoustics = "implicit"`` f_I also holds the pressure waves (the mass, pressure and
 enthalpy fluxes of :mod:`.acoustics`), solved in the same momentum problem as a bulk viscosity.
+
+With ``numerics.sink = "implicit"`` f_I also holds the collisional sink S(θ) = (3/2)ρθζ0(φ, θ) (ζ0 of
+:meth:`~.physics.Physics.cooling_rate`, ∝ √θ), linearised about the coefficient temperature θ_k of the
+sweep: S ≈ S_k + S'_k(θ − θ_k) with S'_k = ∂S/∂θ by ``jax.jvp`` (no exponent is assumed here).  The heat
+problem becomes ((3/2)ρ + aΔt S'_k)θ − aΔt∇·(κ∇θ) = … − aΔt(S_k − S'_k θ_k): S'_k > 0 keeps it
+symmetric positive definite, and the constant part adds energy, so θ > 0 for any Δt (the step is no
+longer limited by cfl_source/ζ0).  The energy of the stage takes the linearised sink at the solved θ,
+consistent with the solve; a second sweep (``sweeps = 2``) relinearises about the first solution.
 """
 
 from __future__ import annotations
@@ -119,10 +127,10 @@ def momentum_preconditioner(grid: Grid, rho: Any, eta: Any, lam: Any, adt: Any, 
     return apply
 
 
-def heat_preconditioner(grid: Grid, rho: Any, kappa: Any, adt: Any, dtype: Any):
-    """Exact inverse of (3/2)ρ − aΔt∇·(κ∇) for constant ρ, κ."""
+def heat_preconditioner(grid: Grid, mass: Any, kappa: Any, adt: Any, dtype: Any):
+    """Exact inverse of m − aΔt∇·(κ∇) for constant m (= (3/2)ρ, plus aΔt S' with an implicit sink) and κ."""
     s2, _ = _symbols(grid, dtype)
-    D = 1.5 * rho + adt * kappa * sum(s2)
+    D = mass + adt * kappa * sum(s2)
     return lambda r: _ifft(_fft(r, grid) / D, grid, dtype)
 
 
@@ -242,10 +250,18 @@ def _unit(x: Any, acc: Any = None) -> Any:
     return jnp.where(n > 0, n, 1.0).astype(_leaves(x)[0].dtype)
 
 
+def collisional_sink(rho: Any, theta: Any, r: Reduced, phys: Physics) -> tuple[Any, Any]:
+    """S = (3/2)ρθζ0 [W/m³] of the cells at θ and ∂S/∂θ (ζ0 alone: no ζ_U∇·u, no frictional work)."""
+    r0 = r._replace(zeta_f=jnp.zeros_like(r.zeta_f)) if is_frictional(r) else r
+    return jax.jvp(lambda th: 1.5 * rho * th * phys.cooling_rate(rho, th, 0.0, r0), (theta,), (jnp.ones_like(theta),))
+
+
 def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced, tol: Any, maxiter: int,
                    sweeps: int, t: Any = 0.0, mixed: bool = False,
-                   acoustic: AcousticStage | None = None) -> tuple[tuple, list[Any], Any]:
+                   acoustic: AcousticStage | None = None, sink: bool = False) -> tuple[tuple, list[Any], Any]:
     """Solve U = Û + aΔt f_I(U) (see the module docstring) at the stage time ``t``.
+
+    ``sink``: f_I also holds the collisional sink (3/2)ρθζ0, linearised in θ about each sweep's θ_k.
 
     ``acoustic``: f_I also holds the acoustic part of the convective flux (:mod:`.acoustics`): the
     momentum problem gains the bulk viscosity aΔtρc² and the pressure of the latest iterate, and
@@ -274,13 +290,14 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     # A frictional stress's work 2μ_f S:S (docs/friction.md §7) is removed here, in the implicit part with
     # the frictional heating it cancels, frozen with μ_f at the stage start (as a rate ∝ θ, or explicitly,
     # the stage-start θ biased the steady θ by O(ζΔt), 4-7 % measured; explicitly a stiff one overshot).
-    sink = 1.5 * rho * theta * r.zeta_f if is_frictional(r) else 0.0
+    implicit_sink = sink
+    friction_sink = 1.5 * rho * theta * r.zeta_f if is_frictional(r) else 0.0
     rho_hat = rho
     if acoustic is not None:
         sweeps = max(sweeps, MIN_SWEEPS)
         p_ref, d_ref = pressure(rho, theta, r, phys), [0.0] * grid.ndim  # Û holds no compression
     fI = viscous_divergence(Wh, phys.transport(rho, theta, r), grid, phys, t)
-    fI[4] = fI[4] - sink
+    fI[4] = fI[4] - friction_sink - (collisional_sink(rho, theta, r, phys)[0] if implicit_sink else 0.0)
     heat = fI[4] - sum(x * f for x, f in zip(u, fI[1:4]))
     theta = jnp.clip(theta + adt * heat / (1.5 * rho), 0.5 * theta, 2.0 * theta)
 
@@ -369,23 +386,31 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
                 affine=False)[4], grid, a) for a in range(grid.ndim))
             return 1.5 * rho * th - adt * div
 
+        # The collisional sink linearised about θ_k: S_k + S'_k (θ − θ_k) (module docstring).
+        s_k, ds_k = collisional_sink(rho, theta, r, phys) if implicit_sink else (0.0, 0.0)
+        s_const = s_k - ds_k * theta
+        mass = 1.5 * rho + adt * ds_k
+
+        def B_sink(th: Any) -> Any:
+            return B(th) + adt * ds_k * th if implicit_sink else B(th)
+
         # Right-hand side: Ê − ρ̂|u|²/2 + aΔt∇·(τ·u + ω∇φ), i.e. the stage equation with κ = 0.
         fI0 = viscous_divergence((rho, *u, jnp.zeros_like(theta)), transport, grid, phys, t, walls)
-        rhs_E = E_base - 0.5 * rho * sum(x * x for x in u) + adt * (fI0[4] - sink)
+        rhs_E = E_base - 0.5 * rho * sum(x * x for x in u) + adt * (fI0[4] - friction_sink - s_const)
         kap_m = jnp.mean(transport[2])
-        hscale = jnp.sqrt((1.5 * rho + adt * sum(_face_sum(kap_f, grid, a) * inv_dx2[a] for a in range(grid.ndim)))
-                          / (1.5 * rho_mean + 2.0 * adt * kap_m * sum(inv_dx2)))
-        Mh = _scaled(heat_preconditioner(grid, rho_mean, kap_m, adt, dtype), hscale)
+        hscale = jnp.sqrt((mass + adt * sum(_face_sum(kap_f, grid, a) * inv_dx2[a] for a in range(grid.ndim)))
+                          / (jnp.mean(mass) + 2.0 * adt * kap_m * sum(inv_dx2)))
+        Mh = _scaled(heat_preconditioner(grid, jnp.mean(mass), kap_m, adt, dtype), hscale)
         th0 = primitive_fields((rho, *(rho * x for x in u), E_base))[4]  # θ of Û with the new u
-        bE = rhs_E - B(th0)
+        bE = rhs_E - B_sink(th0)
         atol_E = floor * _norm(E_hat, acc)
         sE = _unit(bE, acc)
-        dth, _ = solve_E(B, bE / sE, tol=tol, atol=atol_E / sE, maxiter=RESTART * maxiter, M=Mh)
+        dth, _ = solve_E(B_sink, bE / sE, tol=tol, atol=atol_E / sE, maxiter=RESTART * maxiter, M=Mh)
         theta = th0 + sE * dth
 
         # The conservative stage state and the residual of its two linear problems.
         fI = viscous_divergence((rho, *u, theta), transport, grid, phys, t, walls)
-        fI[4] = fI[4] - sink
+        fI[4] = fI[4] - friction_sink - (s_const + ds_k * theta if implicit_sink else 0.0)
         U = (rho, *(m + adt * f for m, f in zip(m_base, fI[1:4])), E_base + adt * fI[4])
         res_m = _norm(tuple(rho_op * x - m for x, m in zip(u, U[1:4])), acc)
         res_E = _norm(U[4] - rho * (0.5 * sum(x * x for x in u) + 1.5 * theta), acc)

@@ -218,12 +218,12 @@ class Simulation:
             )
         self.sharding = self._sharding(cfg.parallel.devices)
         scheme = cfg.time.scheme
-        if n.acoustics == "implicit":  # an IMEX option
+        if n.acoustics == "implicit" or n.sink == "implicit":  # IMEX options
             scheme = "imex"
         if scheme == "auto":  # from the config alone (the uniform initial state), so a resume agrees
             uniform = conservative(*uniform_fields(self.grid, self.phys, self.phi0, self.theta0))
             scheme = choose_scheme(uniform, self.grid, self.phys, self.num)
-        self.num = dataclasses.replace(self.num, scheme=scheme, acoustics=n.acoustics)
+        self.num = dataclasses.replace(self.num, scheme=scheme, acoustics=n.acoustics, sink=n.sink)
         self.wall_stepping, self.steps_timed = 0.0, 0
 
     def _sharding(self, ndev: int) -> Any:

@@ -55,6 +55,12 @@ STATUS_MESSAGES = {
     6: "implicit (IMEX) stage solve did not converge",
 }
 SCHEMES = ("imex", "ssprk3")
+SINKS = ("explicit", "implicit")
+#: Largest ζ0Δt of an implicit sink.  ARS(2,2,2) keeps a decaying θ positive only for ζΔt < 1/(1 − 2γ)
+#: = 1 + √2 ≈ 2.41: its stability function R(−x) = (1 − (1 − 2γ)x)/(1 + γx)² changes sign there, and
+#: the predictor of the last stage, θⁿ − (1 − γ)Δt ζθ₂, does too (measured: a cooling box stepped at
+#: ζ0Δt = 4 gave NaN, at 2 a positive θ).  2.0 keeps a margin (ζ0 ∝ √θ changes within a step).
+SINK_COURANT = 2.0
 #: Names of the step limits of :func:`step_limits`, in order.
 LIMIT_NAMES = ("cfl", "viscous", "conductive", "cooling")
 
@@ -91,6 +97,10 @@ class Numerics:
     acoustics : str
         ``explicit`` (the HLL convective flux, Courant limit on |u| + c) or ``implicit`` (IMEX
         only: the pressure waves in the implicit part, :mod:`.acoustics`; Courant limit on |u|).
+    sink : str
+        ``explicit`` (the collisional sink −(3/2)ρθζ0 with the convective flux; Δt ≤ cfl_source/ζ) or
+        ``implicit`` (IMEX only: ζ0 in the energy stage solve, linearised in θ, :func:`.imex.implicit_stage`;
+        the cooling limit keeps only |ζ_U∇·u|).
     mixed : bool
         IMEX with a float32 state: solve the stages with float32 vectors and float64 inner
         products and norms (:func:`~ktgf.solver.imex.implicit_stage`), instead of casting the
@@ -109,9 +119,10 @@ class Numerics:
     sweeps: int = 1
     mixed: bool = False
     acoustics: str = "explicit"
+    sink: str = "explicit"
 
     _LEAVES = ("cfl", "cfl_diffusion", "cfl_source", "dt_max", "implicit_tol")
-    _STATIC = ("limiter", "riemann", "scheme", "implicit_maxiter", "sweeps", "mixed", "acoustics")
+    _STATIC = ("limiter", "riemann", "scheme", "implicit_maxiter", "sweeps", "mixed", "acoustics", "sink")
 
     def tree_flatten(self) -> tuple[tuple, tuple]:
         return tuple(getattr(self, k) for k in self._LEAVES), tuple(getattr(self, k) for k in self._STATIC)
@@ -136,6 +147,18 @@ class Numerics:
             raise InputError(f"acoustics {self.acoustics!r} is not valid: choose one of {ACOUSTICS}")
         if self.acoustics == "implicit" and self.scheme != "imex":
             raise InputError(f"acoustics 'implicit' needs the imex scheme (got scheme {self.scheme!r})")
+        if self.sink not in SINKS:
+            raise InputError(f"sink {self.sink!r} is not valid: choose one of {SINKS}")
+        if self.sink == "implicit" and self.scheme != "imex":
+            raise InputError(f"sink 'implicit' needs the imex scheme (got scheme {self.scheme!r})")
+
+
+def explicit_coefficients(r: Any, num: Numerics) -> Any:
+    """The cell coefficients of the IMEX scheme's explicit part: without the frictional work
+    (:func:`.friction.explicit_part`) and, with ``num.sink = "implicit"``, without ζ0 (both are in
+    the implicit stage solve); ζ_U∇·u stays explicit."""
+    r = explicit_part(r)
+    return r._replace(zeta0=jnp.zeros_like(r.zeta0)) if num.sink == "implicit" else r
 
 
 def explicit_rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, viscous: bool, r: Any = None,
@@ -188,7 +211,13 @@ def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None)
     else:  # a mean shear makes max u − min u large; the central ∇·u itself (any time: only its size matters)
         divu_bound = jnp.max(jnp.abs(cell_divergence(pad_fields(u, grid, velocity=0), grid)))
     zeta = jnp.max(phys.cooling_rate(rho, theta, 0.0, r)) + jnp.max(jnp.abs(r.zeta_u)) * divu_bound
-    return jnp.stack([num.cfl / jnp.max(wave), viscous, conductive, num.cfl_source / zeta])
+    cooling = num.cfl_source / zeta
+    if num.sink == "implicit":  # ζ0 in the implicit part: SINK_COURANT/ζ0 for it, cfl_source/ζ for the rest
+        r_e = r._replace(zeta0=jnp.zeros_like(r.zeta0))
+        zeta0 = jnp.max(phys.cooling_rate(rho, theta, 0.0, r) - phys.cooling_rate(rho, theta, 0.0, r_e))
+        zeta_e = jnp.max(phys.cooling_rate(rho, theta, 0.0, r_e)) + jnp.max(jnp.abs(r.zeta_u)) * divu_bound
+        cooling = jnp.minimum(SINK_COURANT / zeta0, num.cfl_source / zeta_e)
+    return jnp.stack([num.cfl / jnp.max(wave), viscous, conductive, cooling])
 
 
 def stable_dt(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None) -> Any:
@@ -278,7 +307,7 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
 
     def stage(k: Any, carry: tuple) -> tuple:
         Uk, rk, KE1, KI2, worst = carry
-        KE = explicit_rhs(Uk, grid, phys, num, viscous=False, r=explicit_part(rk), t=t_explicit[k], h0=h0)
+        KE = explicit_rhs(Uk, grid, phys, num, viscous=False, r=explicit_coefficients(rk, num), t=t_explicit[k], h0=h0)
         KE1 = tuple(jnp.where(k == 0, a, b) for a, b in zip(KE, KE1))
         Uhat = tuple(u + dt * (wE[k, 0] * e1 + wE[k, 1] * e + wI[k] * i2)
                      for u, e1, e, i2 in zip(Un, KE1, KE, KI2))
@@ -291,7 +320,8 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
             W, grid, phys, t_implicit[k])) if acoustic else None
         Ui, fI, res = implicit_stage(Uhat64, GAMMA * jnp.asarray(dt, jnp.float64).astype(Uhat64[0].dtype), grid, phys,
                                      r, jnp.asarray(num.implicit_tol, jnp.float64), num.implicit_maxiter, num.sweeps,
-                                     t_implicit[k], mixed=num.mixed, acoustic=stage_acoustics)
+                                     t_implicit[k], mixed=num.mixed, acoustic=stage_acoustics,
+                                     sink=num.sink == "implicit")
         r = jax.tree_util.tree_map(lambda x: jnp.asarray(x).astype(dtype), r)
         return tuple(u.astype(dtype) for u in Ui), r, KE1, \
             tuple(jnp.broadcast_to(f, Un[0].shape).astype(dtype) for f in fI), jnp.maximum(worst, res.astype(dtype))
