@@ -75,6 +75,15 @@ cases = {
                              "walls": {"type": "johnson-jackson", "specularity": 0.1, "restitution": 0.9}}},
         "time": {"end": 1.0, "unit": "strain", "outputs": 2, "scheme": "imex"},
     },
+    "chute": {
+        "case": {"kind": "chute", "inclination_deg": 25.0},
+        "initial": {"solid_fraction": 0.3, "temperature": 0.03, "shear_rate": 100.0, "amplitude": 0.05, "seed": 3},
+        "grid": {"cells": [8, 8], "length_d": [8.0, 10.0]},
+        "boundaries": {"y": {"kind": "wall", "flow": "x", "wall_speed": 0.0,
+                             "walls": {"type": "johnson-jackson", "specularity": 1.0, "restitution": 0.9,
+                                       "top": {"type": "zero-flux"}}}},
+        "time": {"end": 0.05, "unit": "s", "outputs": 2, "scheme": "imex"},
+    },
 }
 out = {}
 for name, case in cases.items():
@@ -92,7 +101,8 @@ print(json.dumps(out))
 
 @pytest.mark.slow
 def test_sharded_lees_edwards_and_wall_cases_match_single_device() -> None:
-    """The sheared cases on two devices: the Lees–Edwards image shift rolls along the sharded axis."""
+    """The sheared and gravity cases on two devices: the Lees–Edwards image shift rolls along the sharded axis;
+    the chute's body force and bumpy base split along the periodic flow axis."""
     env = dict(os.environ)
     env["XLA_FLAGS"] = (env.get("XLA_FLAGS", "") + " --xla_force_host_platform_device_count=2").strip()
     env["PYTHONPATH"] = str(Path(__file__).resolve().parents[1] / "src") + os.pathsep + env.get("PYTHONPATH", "")

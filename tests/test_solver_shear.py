@@ -398,7 +398,7 @@ def test_chute_reaches_the_1d_inclined_layer() -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("case", ["uniform-shear", "couette"])
+@pytest.mark.parametrize("case", ["uniform-shear", "couette", "chute"])
 def test_sheared_case_resumes_bit_for_bit_and_writes_its_files(tmp_path: Path, case: str) -> None:
     """Ctrl-C mid-run, resume: the final state, the case columns and verification.json equal the
     uninterrupted run's; hcs.nc, VTK and checkpoint are written for the case."""
@@ -408,8 +408,9 @@ def test_sheared_case_resumes_bit_for_bit_and_writes_its_files(tmp_path: Path, c
 
     from ktgf.solver.io import read_vti
 
-    text = _case([8, 8], "y", "x", 2.0) if case == "uniform-shear" else _couette([4, 8], 4.0, lengths="[4.0, 8.0]",
-                                                                               axis="y", flow="x")
+    text = {"uniform-shear": lambda: _case([8, 8], "y", "x", 2.0),
+            "couette": lambda: _couette([4, 8], 4.0, lengths="[4.0, 8.0]", axis="y", flow="x"),
+            "chute": lambda: _chute([8, 4], 0.1, length_d=[10.0, 4.0])}[case]()
     data = tomllib.loads(text)
     data["time"]["outputs"] = 4
     data["time"]["max_steps_per_call"] = 20
