@@ -80,7 +80,7 @@ def test_dem_cell_e07_converges_and_its_continuation_passes_the_folds():
     """A case natural-parameter continuation stalled on (docs/dense.md §5.2).
 
     Which path ``solve`` takes here hangs on round-off: since the quarter-power closures (a few ulp
-    from ``pow``) Newton from the naive start converges by itself, before they it needed the
+    from ``pow``) Newton from the naive start converges by itself; before them it needed the
     arclength fallback.  So the state is checked whatever the path, and the fallback is run along
     each homotopy path on its own: each passes two folds and lands on the same state.
     """
@@ -93,7 +93,8 @@ def test_dem_cell_e07_converges_and_its_continuation_passes_the_folds():
     assert np.all(theta > 0) and phi.max() < pr.phi_max
     assert pr.V @ phi / pr.V.sum() == pytest.approx(0.5, abs=1e-10)
     for stages in homotopy_paths(pr):
-        Xc, _, _, folds, arclength_stages = _follow(pr, stages, [], 1e-10, 60, 400, "fallback")
+        Xc, _, _, folds, arclength_stages = _follow(pr, stages, [], tol=1e-10, max_iter=60, ptc_max_iter=400,
+                                                           continuation="fallback")
         assert arclength_stages >= 1 and len(folds) >= 2, folds
         assert relative_residual(pr, Xc) < 1e-8
         assert np.abs(Xc - X).max() < 1e-9 * np.abs(X).max()
