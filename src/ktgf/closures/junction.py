@@ -19,6 +19,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 JUNCTIONS: tuple[str, ...] = ("c1", "c0")
 DEFAULT_WIDTH = 0.01
 
@@ -27,7 +29,10 @@ def hermite(x: Any, x0: float, x1: float, lo: tuple[Any, Any, Any], hi: tuple[An
     """Quintic Hermite interpolant on [x0, x1] with end (value, slope, curvature) ``lo`` and ``hi``.
 
     Returns (value, slope) at ``x``; t = (x − x0)/(x1 − x0), standard quintic Hermite basis.
+    End values that are NumPy scalars are used as Python floats: JAX takes those as weakly typed, so a
+    float32 evaluation stays float32 (a NumPy float64 would promote the whole bridge to float64).
     """
+    lo, hi = (tuple(float(v) if isinstance(v, np.generic) else v for v in end) for end in (lo, hi))
     h = x1 - x0
     t = (x - x0) / h
     t2, t3, t4, t5 = t**2, t**3, t**4, t**5
