@@ -53,8 +53,8 @@ def numpy_reference(model, U: np.ndarray, rho_s: float, e: float) -> float:
 
 
 #: ``--ab``: switches of :mod:`ktgf.solver.fluxes` of main's code path and of the candidate.
-REFERENCE = {"FLUX_KERNEL": True, "STAGE_KERNEL": False}
-CANDIDATE = {"FLUX_KERNEL": True, "STAGE_KERNEL": True}
+REFERENCE = {"FLUX_KERNEL": True, "STAGE_KERNEL": True, "CELL_PROGRAM": False}
+CANDIDATE = {"FLUX_KERNEL": True, "STAGE_KERNEL": True, "CELL_PROGRAM": True}
 
 
 @contextlib.contextmanager

@@ -12,6 +12,8 @@ the JAX path with one warning.
 
 from __future__ import annotations
 
+import re
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -46,13 +48,13 @@ def _state(grid: Grid, phys: Physics, dtype, amplitude: float = 0.05, phi: float
     return tuple(jnp.asarray(random_velocity(grid, phys, phi, 1e-4, amplitude, 4), dtype=dtype))
 
 
-def _with_kernel(on: bool, fn, stage: bool = True):
-    saved = fluxes.FLUX_KERNEL, fluxes.STAGE_KERNEL
+def _with_kernel(on: bool, fn, stage: bool = True, cells: bool = True):
+    saved = fluxes.FLUX_KERNEL, fluxes.STAGE_KERNEL, fluxes.CELL_PROGRAM
     try:
-        fluxes.FLUX_KERNEL, fluxes.STAGE_KERNEL = on, stage
+        fluxes.FLUX_KERNEL, fluxes.STAGE_KERNEL, fluxes.CELL_PROGRAM = on, stage, cells
         return fn()
     finally:
-        fluxes.FLUX_KERNEL, fluxes.STAGE_KERNEL = saved
+        fluxes.FLUX_KERNEL, fluxes.STAGE_KERNEL, fluxes.CELL_PROGRAM = saved
 
 
 def _close(a, b) -> float:
@@ -147,14 +149,16 @@ def test_fused_stage_steps_match_jax(model: str, options: dict, phi: float, ampl
     if m.friction.has_stress:  # the frictional stress is present in (nearly) every cell
         assert float(jnp.mean(cell_coefficients(primitive_fields(U), grid, phys).p_f > 0.0)) > 0.9
     num = Numerics(scheme="ssprk3")
-    fused = _with_kernel(True, lambda: _steps(U, grid, phys, num))
+    cells = _with_kernel(True, lambda: _steps(U, grid, phys, num))  # closures by a cell program, where it applies
+    fused = _with_kernel(True, lambda: _steps(U, grid, phys, num), cells=False)  # closures by XLA
     kernel = _with_kernel(True, lambda: _steps(U, grid, phys, num), stage=False)  # fluxes only
     ref = _with_kernel(False, lambda: _steps(U, grid, phys, num))
-    for out in (fused, kernel, ref):
+    for out in (cells, fused, kernel, ref):
         assert int(out[2]) == 3 and int(out[3]) == 0
-    assert fused[0].dtype == dtype
+    assert fused[0].dtype == cells[0].dtype == dtype
     assert _close(fused[0], ref[0]) < RTOL[dtype]
     assert _close(fused[0], kernel[0]) < RTOL[dtype]
+    assert _close(cells[0], ref[0]) < RTOL[dtype]
     assert _close(fused[0], U) > 100 * RTOL[dtype]  # the steps changed the state
 
 
@@ -184,9 +188,18 @@ def test_fused_stage_is_in_the_compiled_step_only_where_it_applies() -> None:
     def hlo(phys: Physics) -> str:
         return jax.jit(lambda U: ssprk3_step(U, 1e-6, grid, phys, num)).lower(U).as_text()
 
-    assert flux_kernel.STAGE_TARGET in _with_kernel(True, lambda: hlo(phys))
-    assert flux_kernel.TARGET not in _with_kernel(True, lambda: hlo(phys))  # the stage does the fluxes
-    assert flux_kernel.STAGE_TARGET not in _with_kernel(True, lambda: hlo(phys), stage=False)
+    def calls(text: str, target: str) -> bool:
+        return re.search(rf"\b{target}\b", text) is not None  # ktgf_ssprk_stage is a prefix of the cells target
+
+    text = _with_kernel(True, lambda: hlo(phys))
+    assert calls(text, flux_kernel.CELLS_TARGET)  # RET: the closures by a cell program, in the stage kernel
+    assert not calls(text, flux_kernel.TARGET) and not calls(text, flux_kernel.STAGE_TARGET)
+    text = _with_kernel(True, lambda: hlo(phys), cells=False)
+    assert calls(text, flux_kernel.STAGE_TARGET) and not calls(text, flux_kernel.TARGET)  # the stage does the fluxes
+    assert not calls(_with_kernel(True, lambda: hlo(phys), stage=False), flux_kernel.STAGE_TARGET)
+    sheared = for_case(_physics("frictional"), "uniform-shear", grid)  # closures with the velocity gradient
+    text = _with_kernel(True, lambda: hlo(sheared))
+    assert calls(text, flux_kernel.STAGE_TARGET) and not calls(text, flux_kernel.CELLS_TARGET)
     with_gravity = Physics(phys.model, 0.8, D, RHO_S, phys.phi_stop, gravity=(0.0, -9.81, 0.0))
     text = _with_kernel(True, lambda: hlo(with_gravity))  # a body force: the flux kernel and the JAX update
     assert flux_kernel.STAGE_TARGET not in text and flux_kernel.TARGET in text
@@ -194,7 +207,8 @@ def test_fused_stage_is_in_the_compiled_step_only_where_it_applies() -> None:
 
 def test_closures_once_per_stage(monkeypatch) -> None:
     """Tracing one SSP-RK3 step of ``advance`` evaluates the closures twice: at the step start (shared by
-    the step limits and the first stage) and in the stage loop (the two later stages) — 3 per step."""
+    the step limits and the first stage) and in the stage loop (the two later stages) — 3 per step.
+    With a cell program, once: for the step limits (the stages evaluate them in the kernel)."""
     grid, phys = _grid(), _physics("ret")
     U = _state(grid, phys, jnp.float64)
     calls = []
@@ -203,5 +217,12 @@ def test_closures_once_per_stage(monkeypatch) -> None:
     for stage in (True, False):
         calls.clear()
         _with_kernel(True, lambda: jax.jit(lambda U: advance.__wrapped__(
-            U, 0.0, 1e30, 1, grid, phys, Numerics(scheme="ssprk3"))).lower(U), stage=stage)
+            U, 0.0, 1e30, 1, grid, phys, Numerics(scheme="ssprk3"))).lower(U), stage=stage, cells=False)
         assert len(calls) == 2
+    from ktgf.solver import cell_program
+
+    assert cell_program.for_physics(phys, jnp.float64) is not None  # generated (and traced) once, cached
+    calls.clear()
+    _with_kernel(True, lambda: jax.jit(lambda U: advance.__wrapped__(
+        U, 0.0, 1e30, 1, grid, phys, Numerics(scheme="ssprk3"))).lower(U))
+    assert len(calls) == 1  # the step limits' only: the stages evaluate the closures in the kernel

@@ -18,13 +18,21 @@
 //   U0 and Uk (5 conservative fields each), s0, s1, and float64 (dx, dy, dz, rho_s, a, dt).  The
 //   source is linear in div u by construction (the cooling rate zeta0 + zeta_U div u, model.md §1);
 //   its two coefficient fields come from the Python physics, so no closure is written here.
-// Both also output a workspace holding the fields with two periodic ghost cells per side (an
+// * KtgfSsprkStageCells: the same stage with the cell fields and the source computed here, from Uk, by a
+//   cell program (ktgf.solver.cell_program: C++ generated from the jaxpr of the Python closures, in its
+//   own library, registered by key with KtgfRegisterCells); inputs float64 (dx, dy, dz, rho_s, a, dt),
+//   the program's float64 parameters, U0 and Uk; attribute `program` the key.  The closures are
+//   evaluated in the padding pass: one pass reads Uk and writes the padded fields.
+// All output a workspace holding the fields with two periodic ghost cells per side (an
 // output so that XLA owns and reuses its memory).  Rows are swept in blocks of ROW_BLOCK along
 // the second axis so that the five planes of a block that a stencil reaches stay in the core's L2
 // cache (measured 1.3x faster at 64^3 than whole planes).  Reading the unpadded fields with
 // periodic index arithmetic instead of the padded copy was tried and measured 1.9x slower.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <mutex>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -341,20 +349,13 @@ void dispatch_riemann(int riemann, bool viscous, const T* const* P, const Consts
   else dispatch_visc<T, LIM, HLL>(viscous, P, k, o);
 }
 
-// Sweeps the cell fields with the output `o` (Rhs or Stage).
+// Sweeps the padded fields in `work` (NFIELD or GG + 1 of them, each of the padded shape of n) with the output `o`.
 template <class T, class Out>
-ffi::Error run(const ffi::AnyBuffer* in, const double* params, int limiter, int riemann, bool viscous, T* work,
-               const Out& o) {
-  auto dims = in[0].dimensions();
-  if (dims.size() != 3) return ffi::Error::InvalidArgument("flux kernel: fields must be 3D");
+ffi::Error sweep_padded(const long* n, const double* params, int limiter, int riemann, bool viscous, const T* work,
+                        const Out& o) {
   Consts<T> k;
-  for (int a = 0; a < 3; ++a) k.n[a] = long(dims[a]);
-  if (k.n[0] < GHOST || k.n[1] < GHOST || k.n[2] < GHOST)
-    return ffi::Error::InvalidArgument("flux kernel: at least 2 cells per axis");
+  for (int a = 0; a < 3; ++a) k.n[a] = n[a];
   const int nfield = viscous ? NFIELD : GG + 1;
-  std::vector<const T*> fields(NFIELD, nullptr);
-  for (int f = 0; f < nfield; ++f) fields[f] = in[f].typed_data<T>();
-  pad<T>(fields.data(), nfield, k.n, work);
   const long m[3] = {k.n[0] + 2 * GHOST, k.n[1] + 2 * GHOST, k.n[2] + 2 * GHOST};
   std::vector<const T*> P(NFIELD, nullptr);
   for (int f = 0; f < nfield; ++f) P[f] = work + f * m[0] * m[1] * m[2];
@@ -375,6 +376,83 @@ ffi::Error run(const ffi::AnyBuffer* in, const double* params, int limiter, int 
     default: return ffi::Error::InvalidArgument("flux kernel: unknown limiter");
   }
   return ffi::Error::Success();
+}
+
+// Pads the cell fields into `work` and sweeps them with the output `o` (Rhs or Stage).
+template <class T, class Out>
+ffi::Error run(const ffi::AnyBuffer* in, const double* params, int limiter, int riemann, bool viscous, T* work,
+               const Out& o) {
+  auto dims = in[0].dimensions();
+  if (dims.size() != 3) return ffi::Error::InvalidArgument("flux kernel: fields must be 3D");
+  long n[3];
+  for (int a = 0; a < 3; ++a) n[a] = long(dims[a]);
+  if (n[0] < GHOST || n[1] < GHOST || n[2] < GHOST)
+    return ffi::Error::InvalidArgument("flux kernel: at least 2 cells per axis");
+  const int nfield = viscous ? NFIELD : GG + 1;
+  std::vector<const T*> fields(NFIELD, nullptr);
+  for (int f = 0; f < nfield; ++f) fields[f] = in[f].typed_data<T>();
+  pad<T>(fields.data(), nfield, n, work);
+  return sweep_padded<T>(n, params, limiter, riemann, viscous, work, o);
+}
+
+// Cell programs (ktgf.solver.cell_program), by key: f(n, params, in[5], out[NFIELD + 2]) over n cells,
+// in = the conservative fields, out = the NFIELD cell fields then s0, s1.
+struct CellProgram {
+  void* fn;
+  int bits;  // 32 or 64: the state precision it was generated for
+};
+std::mutex programs_mutex;
+std::unordered_map<int64_t, CellProgram> programs;
+
+template <class T>
+using CellsFn = void (*)(long, const double*, const T* const*, T* const*);
+
+// The cell fields of the state U (5 conservative fields) by the program, into the padded `work` (with
+// periodic ghost cells), and the source coefficients s0, s1 (unpadded).
+template <class T>
+void cells_pad(CellsFn<T> fn, const double* leaf, const T* const* U, const long* n, T* work, T* s0, T* s1) {
+  const long m1 = n[1] + 2 * GHOST, m2 = n[2] + 2 * GHOST, plane = m1 * m2, M = (n[0] + 2 * GHOST) * plane;
+#pragma omp parallel
+  {
+#pragma omp for collapse(2) schedule(static)
+    for (long i = 0; i < n[0]; ++i) {
+      for (long j = 0; j < n[1]; ++j) {
+        const long src = (i * n[1] + j) * n[2];
+        const T* in[5];
+        for (int v = 0; v < 5; ++v) in[v] = U[v] + src;
+        T* out[NFIELD + 2];
+        for (int f = 0; f < NFIELD; ++f) out[f] = work + f * M + (i + GHOST) * plane + (j + GHOST) * m2 + GHOST;
+        out[NFIELD] = s0 + src;
+        out[NFIELD + 1] = s1 + src;
+        fn(n[2], leaf, in, out);
+        for (int f = 0; f < NFIELD; ++f) {  // the row's ghost cells along z
+          T* row = out[f] - GHOST;
+          for (long q = 0; q < GHOST; ++q) {
+            row[q] = row[n[2] + q];
+            row[GHOST + n[2] + q] = row[GHOST + q];
+          }
+        }
+      }
+    }
+#pragma omp for collapse(2) schedule(static)
+    for (int f = 0; f < NFIELD; ++f) {  // ghost rows along y of the interior planes (after all rows: barrier)
+      for (long i = GHOST; i < GHOST + n[0]; ++i) {
+        T* p = work + f * M + i * plane;
+        for (long j = 0; j < GHOST; ++j) {
+          std::copy(p + (j + n[1]) * m2, p + (j + n[1] + 1) * m2, p + j * m2);
+          std::copy(p + (GHOST + j) * m2, p + (GHOST + j + 1) * m2, p + (GHOST + n[1] + j) * m2);
+        }
+      }
+    }
+#pragma omp for collapse(2) schedule(static)
+    for (int f = 0; f < NFIELD; ++f) {  // ghost planes along x
+      for (long i = 0; i < GHOST; ++i) {
+        T* b = work + f * M;
+        std::copy(b + (i + n[0]) * plane, b + (i + n[0] + 1) * plane, b + i * plane);
+        std::copy(b + (GHOST + i) * plane, b + (GHOST + i + 1) * plane, b + (GHOST + n[0] + i) * plane);
+      }
+    }
+  }
 }
 
 template <class T>
@@ -446,7 +524,67 @@ ffi::Error ssprk_stage(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer uy,
   }
 }
 
-// The eleven cell-field arguments both entry points begin with, in the order of enum Field, and the
+template <class T>
+ffi::Error stage_cells_typed(ffi::RemainingArgs state, const double* params, const double* leaf, int limiter,
+                             int riemann, void* fn, void* const* out) {
+  auto dims = state.get<ffi::AnyBuffer>(0)->dimensions();
+  if (dims.size() != 3) return ffi::Error::InvalidArgument("stage kernel: fields must be 3D");
+  long n[3];
+  for (int a = 0; a < 3; ++a) n[a] = long(dims[a]);
+  if (n[0] < GHOST || n[1] < GHOST || n[2] < GHOST)
+    return ffi::Error::InvalidArgument("stage kernel: at least 2 cells per axis");
+  Stage<T> o;
+  for (int v = 0; v < 5; ++v) {
+    o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<T>();
+    o.Uk[v] = state.get<ffi::AnyBuffer>(5 + v)->typed_data<T>();
+    o.U[v] = static_cast<T*>(out[v]);
+  }
+  T* work = static_cast<T*>(out[5]);
+  const long M = (n[0] + 2 * GHOST) * (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST), N = n[0] * n[1] * n[2];
+  T* s0 = work + NFIELD * M;
+  T* s1 = s0 + N;
+  o.s0 = s0;
+  o.s1 = s1;
+  o.a = T(params[4]);
+  o.b = T(1) - o.a;
+  o.dt = T(params[5]);
+  // Uk is read whole here, before the sweep writes U' over it.
+  cells_pad<T>(reinterpret_cast<CellsFn<T>>(fn), leaf, o.Uk, n, work, s0, s1);
+  return sweep_padded<T>(n, params, limiter, riemann, true, work, o);
+}
+
+ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state,
+                             int32_t limiter, int32_t riemann, int64_t program, ffi::Result<ffi::AnyBuffer> u0,
+                             ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2,
+                             ffi::Result<ffi::AnyBuffer> u3, ffi::Result<ffi::AnyBuffer> u4,
+                             ffi::Result<ffi::AnyBuffer> work) {
+  void* const out[6] = {u0->untyped_data(), u1->untyped_data(), u2->untyped_data(), u3->untyped_data(),
+                        u4->untyped_data(), work->untyped_data()};
+  if (params.element_count() != 6)
+    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
+  if (state.size() != 10) return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5)");
+  auto first = state.get<ffi::AnyBuffer>(0);
+  if (!first.has_value()) return ffi::Error::InvalidArgument("stage kernel: no state");
+  const auto type = first->element_type();
+  for (size_t i = 0; i < state.size(); ++i) {
+    auto b = state.get<ffi::AnyBuffer>(i);
+    if (!b.has_value() || b->element_type() != type || b->element_count() != first->element_count())
+      return ffi::Error::InvalidArgument("stage kernel: U0, Uk must be cell fields of one precision");
+  }
+  CellProgram p{nullptr, 0};
+  {
+    std::lock_guard<std::mutex> lock(programs_mutex);
+    auto it = programs.find(program);
+    if (it != programs.end()) p = it->second;
+  }
+  const int bits = type == ffi::F64 ? 64 : type == ffi::F32 ? 32 : 0;
+  if (p.fn == nullptr) return ffi::Error::InvalidArgument("stage kernel: cell program not registered");
+  if (p.bits != bits) return ffi::Error::InvalidArgument("stage kernel: cell program of another precision");
+  if (bits == 64) return stage_cells_typed<double>(state, params.typed_data(), leaf.typed_data(), limiter, riemann, p.fn, out);
+  return stage_cells_typed<float>(state, params.typed_data(), leaf.typed_data(), limiter, riemann, p.fn, out);
+}
+
+// The eleven cell-field arguments the first two entry points begin with, in the order of enum Field, and the
 // float64 parameters after them.
 template <class Binding>
 auto cell_field_args(Binding b) {
@@ -490,3 +628,25 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStage, ssprk_stage,
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_z
                                   .Ret<ffi::AnyBuffer>()  // ... E
                                   .Ret<ffi::AnyBuffer>());  // padded fields (workspace)
+
+XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStageCells, ssprk_stage_cells,
+                              ffi::Ffi::Bind()
+                                  .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s, a, dt)
+                                  .Arg<ffi::Buffer<ffi::F64>>()  // the cell program's parameters
+                                  .RemainingArgs()               // U0 (5), Uk (5)
+                                  .Attr<int32_t>("limiter")
+                                  .Attr<int32_t>("riemann")
+                                  .Attr<int64_t>("program")
+                                  .Ret<ffi::AnyBuffer>()  // U' density
+                                  .Ret<ffi::AnyBuffer>()  // ... rho u_x
+                                  .Ret<ffi::AnyBuffer>()  // ... rho u_y
+                                  .Ret<ffi::AnyBuffer>()  // ... rho u_z
+                                  .Ret<ffi::AnyBuffer>()  // ... E
+                                  .Ret<ffi::AnyBuffer>());  // padded fields, then s0, s1 (workspace)
+
+// Registers the cell program `fn` (state precision `bits`, 32 or 64) under `key`; returns 0.
+extern "C" int KtgfRegisterCells(int64_t key, void* fn, int32_t bits) {
+  std::lock_guard<std::mutex> lock(programs_mutex);
+  programs[key] = CellProgram{fn, bits};
+  return 0;
+}

@@ -6,7 +6,8 @@ cell fields the JAX path gets; every closure stays in Python.  It computes each 
 instead of once per flux component (docs/solver.md, Speed) and agrees with the JAX path to
 round-off (tests/test_solver_flux_kernel.py).  :func:`ssprk_stage` also applies the energy
 source and the stage update of :func:`.stepping.ssprk3_step` in the same sweep, so a stage of
-the explicit scheme is one closure pass (XLA) and one kernel call.
+the explicit scheme is one closure pass (XLA) and one kernel call; :func:`ssprk_stage_cells` also
+evaluates the closures, by a generated cell program (:mod:`.cell_program`), so a stage is one call.
 
 It is used where it applies — CPU backend, one device, a 3D fully periodic grid, float32 or
 float64 — and when it is switched on: :data:`.fluxes.FLUX_KERNEL` (default from the environment
@@ -39,6 +40,7 @@ import numpy as np
 SOURCE = Path(__file__).with_name("flux_kernel.cc")
 TARGET = "ktgf_flux_divergence"
 STAGE_TARGET = "ktgf_ssprk_stage"
+CELLS_TARGET = "ktgf_ssprk_stage_cells"
 FLAGS = ("-O3", "-march=native", "-fopenmp", "-ffp-contract=off", "-fno-math-errno", "-shared", "-fPIC", "-std=c++17")
 _loaded: dict[str, Any] = {}
 
@@ -79,6 +81,8 @@ def available() -> bool:
             lib = ctypes.cdll.LoadLibrary(str(build()))
             jax.ffi.register_ffi_target(TARGET, jax.ffi.pycapsule(lib.KtgfFluxDivergence), platform="cpu")
             jax.ffi.register_ffi_target(STAGE_TARGET, jax.ffi.pycapsule(lib.KtgfSsprkStage), platform="cpu")
+            jax.ffi.register_ffi_target(CELLS_TARGET, jax.ffi.pycapsule(lib.KtgfSsprkStageCells), platform="cpu")
+            _loaded["lib"] = lib
             _loaded["ok"] = True
         except (RuntimeError, OSError) as err:
             warnings.warn(f"ktgf flux kernel unavailable, using the JAX path: {err}", RuntimeWarning, stacklevel=2)
@@ -142,3 +146,32 @@ def ssprk_stage(U0: Any, Uk: Any, W: Any, eos: Any, transport: Any, source: tupl
     coef = [jnp.asarray(v).astype(dtype).astype(jnp.float64) for v in (a, dt)]
     params = jnp.stack([*(jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)), *coef])
     return tuple(call(*fields, params, *state, **_schemes(limiter, riemann))[:5])
+
+
+def _register(program: Any) -> None:
+    """Makes a :class:`~.cell_program.CellProgram` known to the stage kernel (once per process and program)."""
+    done = _loaded.setdefault("programs", set())
+    if program.key not in done:
+        bits = 8 * program.dtype.itemsize
+        _loaded["lib"].KtgfRegisterCells(ctypes.c_int64(program.key), ctypes.c_void_p(program.address),
+                                         ctypes.c_int32(bits))
+        done.add(program.key)
+
+
+def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any,
+                      limiter: str, riemann: str) -> tuple[Any, ...]:
+    """The SSP-RK3 stage of :func:`ssprk_stage` with the cell fields and the energy source computed in
+    the kernel from Uk by a cell program (:func:`.cell_program.for_physics`) with parameters ``leaf``
+    (:func:`.cell_program.leaf_values`)."""
+    from .fluxes import GHOST
+
+    _register(program)
+    dtype = Uk[0].dtype
+    state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
+    field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
+    padded = int(np.prod([n + 2 * GHOST for n in grid.cells]))
+    work = jax.ShapeDtypeStruct((11 * padded + 2 * grid.size,), dtype)
+    call = jax.ffi.ffi_call(CELLS_TARGET, (field,) * 5 + (work,), input_output_aliases={7 + v: v for v in range(5)})
+    coef = [jnp.asarray(v).astype(dtype).astype(jnp.float64) for v in (a, dt)]
+    params = jnp.stack([*(jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)), *coef])
+    return tuple(call(params, leaf, *state, **_schemes(limiter, riemann), program=np.int64(program.key))[:5])

@@ -113,6 +113,10 @@ FLUX_KERNEL = os.environ.get("KTGF_FLUX_KERNEL", "1").lower() not in ("0", "off"
 #: stage update fused in (:func:`.flux_kernel.ssprk_stage`).  Default on; ``KTGF_STAGE_KERNEL=0``
 #: keeps the flux kernel for the fluxes only (the A/B reference of ``benchmarks/bench_solver.py``).
 STAGE_KERNEL = os.environ.get("KTGF_STAGE_KERNEL", "1").lower() not in ("0", "off", "false", "no")
+#: Where the fused stage runs, evaluate the cell closures inside it by a generated cell program
+#: (:mod:`.cell_program`, :func:`.flux_kernel.ssprk_stage_cells`) instead of an XLA closure pass.
+#: Default on; ``KTGF_CELL_PROGRAM=0`` keeps the XLA pass.
+CELL_PROGRAM = os.environ.get("KTGF_CELL_PROGRAM", "1").lower() not in ("0", "off", "false", "no")
 
 
 @functools.lru_cache(maxsize=16)

@@ -254,13 +254,22 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
 
     Written as three stages U_{k+1} = a_k U + (1 − a_k)(U_k + Δt L(U_k)), a = (0, 3/4, 1/3),
     in a ``fori_loop`` so the right-hand side is traced (and compiled) once, not three times.
-    Where :func:`stage_kernel_applies`, each stage is the closures (XLA) and one kernel call.
+    Where :func:`stage_kernel_applies`, each stage is the closures (XLA) and one kernel call, or
+    only the kernel call where the closures have a cell program (:mod:`.cell_program`).
     """
     coef = jnp.asarray([0.0, 0.75, 1.0 / 3.0], dtype=U[0].dtype)
     when = jnp.asarray([0.0, 1.0, 0.5], dtype=jnp.result_type(t, float))  # stage times / Δt
 
     if stage_kernel_applies(grid, phys, U[0].dtype):
-        from .flux_kernel import ssprk_stage
+        from . import fluxes
+        from .cell_program import for_physics, leaf_values
+        from .flux_kernel import ssprk_stage, ssprk_stage_cells
+
+        program = for_physics(phys, U[0].dtype) if fluxes.CELL_PROGRAM else None
+        if program is not None:  # the closures inside the kernel: each stage is one call
+            leaf = leaf_values(phys)
+            return jax.lax.fori_loop(0, 3, lambda k, Uk: ssprk_stage_cells(
+                U, Uk, program, leaf, coef[k], dt, grid, phys.material_density, num.limiter, num.riemann), tuple(U))
 
         def kernel_stage(k: Any, Uk: tuple, r: Any) -> tuple:
             W, eos, transport, source = kernel_stage_inputs(Uk, r, phys)

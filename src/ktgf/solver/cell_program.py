@@ -1,0 +1,312 @@
+"""The cell closures of the fused SSP-RK3 stage as compiled C++, generated from the Python physics.
+
+Why: a stage of the fused kernel (:func:`.flux_kernel.ssprk_stage`) needed an XLA pass first, to
+evaluate the closures at every cell and write 13 fields (primitive fields, (p*, g), (η, λ_b, κ, ω),
+the energy source (s0, s1)), which the kernel then read back and padded: ≈ 15 ns a cell of XLA and
+≈ 4 ns of padding per stage, a third of the stage (docs/solver.md, Speed).  Here the same function —
+:func:`.stepping.kernel_stage_inputs` of the model's :meth:`.Physics.reduced`, nothing rewritten — is
+traced once with scalar inputs, and its jaxpr (elementwise arithmetic only) is printed as a C++ loop
+over a row of cells.  The kernel calls it in its padding pass, so a stage reads the five conservative
+fields and writes the padded coefficients in one pass, with no XLA closure pass at all.
+
+Physics stays in one place: the generated code is the jaxpr of the Python closures, operation for
+operation in the same precision (each jaxpr variable keeps its dtype; ``integer_pow`` is expanded as
+XLA expands it), so it agrees with the XLA evaluation to round-off
+(tests/test_solver_cell_program.py checks every registered model, both precisions).  The parameters
+of :class:`.Physics` (e, d, ρ_s, …) are runtime inputs, not constants, so changing them does not
+recompile; a model is compiled once per precision (≈ 1 s, cached like the kernel in
+``$KTGF_CACHE_DIR``).
+
+It applies where the closures depend on the cell's own state only (no velocity gradient:
+:func:`.friction.needs_rate` false) and the jaxpr has only the primitives of :data:`_EXPRESSIONS`;
+otherwise :func:`for_physics` returns None and the stage keeps its XLA closure pass.
+``fluxes.CELL_PROGRAM`` (environment ``KTGF_CELL_PROGRAM``, ``0`` off) switches it.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import hashlib
+import os
+import platform
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass
+from typing import Any
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax.extend.core import Literal
+
+#: Outputs of a cell program, in the order the kernel stores them (its Field enum, then s0, s1).
+OUTPUTS = ("rho", "u_x", "u_y", "u_z", "theta", "p_star", "g", "eta", "lambda_b", "kappa", "omega", "s0", "s1")
+FLAGS = ("-O3", "-march=native", "-fopenmp-simd", "-ffp-contract=off", "-fno-math-errno", "-shared", "-fPIC",
+         "-std=c++17")
+SYMBOL = "ktgf_cells"
+_CTYPES = {np.dtype(np.float64): "double", np.dtype(np.float32): "float", np.dtype(np.bool_): "bool",
+           np.dtype(np.int32): "int32_t", np.dtype(np.int64): "int64_t"}
+
+
+class Unsupported(Exception):
+    """The jaxpr holds something the generator does not print (the XLA closure pass is used instead)."""
+
+
+@dataclass(frozen=True)
+class CellProgram:
+    """A compiled cell program: its source, its key in the stage kernel's registry, its state precision
+    and its C function ``(long n, const double* leaf, const T* const* in, T* const* out)`` (ctypes)."""
+
+    source: str
+    key: int
+    dtype: Any
+    function: Any
+
+    @property
+    def address(self) -> int:
+        return ctypes.cast(self.function, ctypes.c_void_p).value
+
+
+def _binary(op: str):
+    return lambda a, eqn: f"{a[0]} {op} {a[1]}"
+
+
+def _call(fn: str):
+    return lambda a, eqn: f"{fn}({', '.join(a)})"
+
+
+def _select(a: list[str], eqn: Any) -> str:
+    pred, *cases = a
+    if len(cases) == 2 and eqn.invars[0].aval.dtype == np.bool_:
+        return f"{pred} ? {cases[1]} : {cases[0]}"
+    expr = cases[-1]
+    for i in range(len(cases) - 2, -1, -1):
+        expr = f"({pred} == {i} ? {cases[i]} : {expr})"
+    return expr
+
+
+#: C++ expressions of the elementwise primitives (a: the operand names).
+_EXPRESSIONS = {
+    "add": _binary("+"), "sub": _binary("-"), "mul": _binary("*"), "div": _binary("/"),
+    "lt": _binary("<"), "le": _binary("<="), "gt": _binary(">"), "ge": _binary(">="), "eq": _binary("=="),
+    "ne": _binary("!="), "and": _binary("&"), "or": _binary("|"),
+    "neg": lambda a, eqn: f"-{a[0]}", "not": lambda a, eqn: f"!{a[0]}",
+    "max": lambda a, eqn: f"{a[0]} > {a[1]} ? {a[0]} : {a[1]}",
+    "min": lambda a, eqn: f"{a[0]} < {a[1]} ? {a[0]} : {a[1]}",
+    "sqrt": _call("std::sqrt"), "exp": _call("std::exp"), "log": _call("std::log"), "log1p": _call("std::log1p"),
+    "expm1": _call("std::expm1"), "tanh": _call("std::tanh"), "abs": _call("std::fabs"), "pow": _call("std::pow"),
+    "cbrt": _call("std::cbrt"),
+    "rsqrt": lambda a, eqn: f"1 / std::sqrt({a[0]})",
+    "square": lambda a, eqn: f"{a[0]} * {a[0]}",
+    "copy": lambda a, eqn: a[0], "copy_p": lambda a, eqn: a[0],
+    "select_n": _select,
+    "convert_element_type": lambda a, eqn: f"static_cast<{_ctype(eqn.outvars[0].aval.dtype)}>({a[0]})",
+}
+#: Primitives whose body is a sub-jaxpr, inlined.
+_CALLS = ("jit", "pjit", "custom_jvp_call", "custom_vjp_call", "custom_vjp_call_jaxpr", "closed_call")
+
+
+def _ctype(dtype: Any) -> str:
+    try:
+        return _CTYPES[np.dtype(dtype)]
+    except KeyError:
+        raise Unsupported(f"dtype {dtype}") from None
+
+
+def _literal(value: Any, dtype: Any) -> str:
+    dtype = np.dtype(dtype)
+    value = np.asarray(value)
+    if value.shape != ():
+        raise Unsupported("an array constant")
+    ctype = _ctype(dtype)
+    if dtype == np.bool_:
+        return "true" if bool(value) else "false"
+    if dtype.kind in "iu":
+        return f"{ctype}({int(value)})"
+    v = float(value)
+    if np.isnan(v):
+        return f"std::numeric_limits<{ctype}>::quiet_NaN()"
+    if np.isinf(v):
+        return f"{'-' if v < 0 else ''}std::numeric_limits<{ctype}>::infinity()"
+    return f"{ctype}({v.hex()})"  # hexadecimal: exact
+
+
+class _Printer:
+    """Prints a jaxpr as C++ statements, one ``const`` variable per jaxpr variable."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+        self.count = 0
+
+    def fresh(self, dtype: Any, expr: str) -> str:
+        name = f"v{self.count}"
+        self.count += 1
+        self.lines.append(f"const {_ctype(dtype)} {name} = {expr};")
+        return name
+
+    def jaxpr(self, jaxpr: Any, consts: list[Any], args: list[str]) -> list[str]:
+        env: dict[Any, str] = {}
+
+        def read(atom: Any) -> str:
+            if isinstance(atom, Literal):
+                return _literal(atom.val, atom.aval.dtype)
+            return env[atom]
+
+        for var, c in zip(jaxpr.constvars, consts):
+            env[var] = _literal(c, var.aval.dtype)
+        for var, name in zip(jaxpr.invars, args):
+            env[var] = name
+        for eqn in jaxpr.eqns:
+            for v in (*eqn.invars, *eqn.outvars):
+                if getattr(v.aval, "shape", None) != ():
+                    raise Unsupported(f"{eqn.primitive.name} on a non-scalar")
+            a = [read(v) for v in eqn.invars]
+            name = eqn.primitive.name
+            if name in _CALLS:
+                sub = next((eqn.params[k] for k in ("jaxpr", "call_jaxpr", "fun_jaxpr") if k in eqn.params), None)
+                if sub is None:
+                    raise Unsupported(name)
+                inner = getattr(sub, "jaxpr", sub)
+                outs = self.jaxpr(inner, list(getattr(sub, "consts", [])), a[len(a) - len(inner.invars):])
+                env.update(zip(eqn.outvars, outs))
+            elif name == "integer_pow":
+                env[eqn.outvars[0]] = self._integer_pow(a[0], eqn.params["y"], eqn.outvars[0].aval.dtype)
+            elif name in _EXPRESSIONS:
+                env[eqn.outvars[0]] = self.fresh(eqn.outvars[0].aval.dtype, _EXPRESSIONS[name](a, eqn))
+            else:
+                raise Unsupported(name)
+        return [read(v) for v in jaxpr.outvars]
+
+    def _integer_pow(self, x: str, y: int, dtype: Any) -> str:
+        """x**y by squaring, in the order of JAX's lowering of ``integer_pow`` (so the same rounding)."""
+        ctype = _ctype(dtype)
+        if y == 0:
+            return self.fresh(dtype, f"{ctype}(1)")
+        reciprocal, y = y < 0, abs(y)
+        acc = None
+        while y > 0:
+            if y & 1:
+                acc = x if acc is None else self.fresh(dtype, f"{acc} * {x}")
+            y >>= 1
+            if y > 0:
+                x = self.fresh(dtype, f"{x} * {x}")
+        return self.fresh(dtype, f"{ctype}(1) / {acc}") if reciprocal else acc
+
+
+def _avals(leaves: list[Any]) -> tuple:
+    avals = []
+    for leaf in leaves:
+        a = jax.typeof(leaf)
+        if a.shape != ():
+            raise Unsupported("a non-scalar physics parameter")
+        avals.append(jax.ShapeDtypeStruct((), a.dtype, weak_type=a.weak_type))
+    return tuple(avals)
+
+
+def source_for(treedef: Any, avals: tuple, dtype: Any) -> str:
+    """C++ source of the cell program for a state of ``dtype``, of the physics with pytree structure
+    ``treedef`` and parameter types ``avals`` (raises :class:`Unsupported`)."""
+    from .friction import cell_coefficients, needs_rate
+    from .physics import is_frictional
+    from .state import primitive_fields
+    from .stepping import kernel_stage_inputs
+
+    phys = jax.tree_util.tree_unflatten(treedef, avals)
+    if needs_rate(phys):
+        raise Unsupported("the closures need the velocity gradient")
+
+    def cells(U: tuple, leaves: list) -> tuple:
+        ph = jax.tree_util.tree_unflatten(treedef, leaves)
+        r = cell_coefficients(primitive_fields(U), None, ph)
+        if is_frictional(r):
+            raise Unsupported("a frictional stress")
+        W, eos, transport, source = kernel_stage_inputs(U, r, ph)
+        return (*W, *eos, *transport, *source)
+
+    state = tuple(jax.ShapeDtypeStruct((), dtype) for _ in range(5))
+    closed = jax.make_jaxpr(cells)(state, list(avals))
+    ctype = _ctype(dtype)
+    p = _Printer()
+    loads = [f"const {ctype} u{v} = in[{v}][i];" for v in range(5)]
+    params = [f"const {_ctype(a.dtype)} leaf{k} = static_cast<{_ctype(a.dtype)}>(leaf[{k}]);"
+              for k, a in enumerate(avals)]
+    outs = p.jaxpr(closed.jaxpr, list(closed.consts), [f"u{v}" for v in range(5)] + [f"leaf{k}" for k in range(len(avals))])
+    if len(outs) != len(OUTPUTS):
+        raise Unsupported(f"{len(outs)} outputs")
+    stores = [f"out[{k}][i] = static_cast<{ctype}>({name});" for k, name in enumerate(outs)]
+    body = "\n".join("    " + line for line in (*loads, *p.lines, *stores))
+    return (
+        f"// Cell program of {phys.model.name} ({np.dtype(dtype).name}), generated by ktgf.solver.cell_program\n"
+        "// from the jaxpr of stepping.kernel_stage_inputs: outputs " + ", ".join(OUTPUTS) + ".\n"
+        "#include <cmath>\n#include <cstdint>\n#include <limits>\n\n"
+        f'extern "C" void {SYMBOL}(long n, const double* leaf, const {ctype}* const* in, {ctype}* const* out) {{\n'
+        + "".join(f"  {line}\n" for line in params)
+        + "#pragma omp simd\n  for (long i = 0; i < n; ++i) {\n" + body + "\n  }\n}\n"
+    )
+
+
+def _build(source: str) -> str:
+    """Path of the compiled library of a program source (built now if not in the cache)."""
+    from .flux_kernel import _cache_dir
+
+    cxx = shutil.which(os.environ.get("CXX", "g++"))
+    if cxx is None:
+        raise RuntimeError("no C++ compiler")
+    key = hashlib.sha256(b"\0".join([source.encode(), " ".join(FLAGS).encode(), cxx.encode(),
+                                     platform.node().encode()])).hexdigest()[:16]
+    lib = _cache_dir() / f"cells-{key}.so"
+    if lib.exists():
+        return str(lib)
+    lib.parent.mkdir(parents=True, exist_ok=True)
+    fd, src = tempfile.mkstemp(suffix=".cc", dir=lib.parent)
+    with os.fdopen(fd, "w") as f:
+        f.write(source)
+    fd, tmp = tempfile.mkstemp(suffix=".so", dir=lib.parent)
+    os.close(fd)
+    try:
+        proc = subprocess.run([cxx, *FLAGS, src, "-o", tmp], capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"compiling a cell program failed: {(proc.stderr.strip().splitlines() or ['?'])[-1]}")
+        os.replace(tmp, lib)
+    finally:
+        for path in (src, tmp):
+            if os.path.exists(path):
+                os.unlink(path)
+    return str(lib)
+
+
+@functools.lru_cache(maxsize=None)
+def _compiled(source: str, dtype: Any) -> CellProgram:
+    function = getattr(ctypes.cdll.LoadLibrary(_build(source)), SYMBOL)
+    key = int(hashlib.sha256(source.encode()).hexdigest()[:15], 16)  # < 2^60: an int64 attribute
+    return CellProgram(source, key, np.dtype(dtype), function)
+
+
+@functools.lru_cache(maxsize=None)
+def _program(treedef: Any, avals: tuple, dtype: Any) -> CellProgram | None:
+    try:
+        return _compiled(source_for(treedef, avals, dtype), dtype)
+    except (Unsupported, RuntimeError, OSError):
+        return None
+
+
+def for_physics(phys: Any, dtype: Any) -> CellProgram | None:
+    """The compiled cell program of ``phys`` for a ``dtype`` state, or None where it does not apply
+    (see the module docstring).  The program depends on the physics' structure (model, static
+    options) and the types of its parameters only, so traced parameters are fine."""
+    leaves, treedef = jax.tree_util.tree_flatten(phys)
+    try:
+        avals = _avals(leaves)
+    except Unsupported:
+        return None
+    return _program(treedef, avals, np.dtype(dtype))
+
+
+def leaf_values(phys: Any) -> Any:
+    """The physics parameters a program takes at run time, as a float64 vector (traced or not)."""
+    leaves = jax.tree_util.tree_leaves(phys)
+    if not leaves:
+        return jnp.zeros((1,), jnp.float64)
+    return jnp.stack([jnp.asarray(v, jnp.float64) for v in leaves])
