@@ -2,7 +2,8 @@
 
 The kernel does the numerics of :mod:`.fluxes` only (MUSCL reconstruction with the configured
 limiter, HLL/Rusanov, central viscous stress and heat flux, face divergence, ∇·u) from the same
-cell fields the JAX path gets; every closure stays in Python.  It computes each face once
+cell fields the JAX path gets; every closure stays in Python (the cell programs of
+:func:`ssprk_stage_cells` are generated from it).  It computes each face once
 instead of once per flux component (docs/solver.md, Speed) and agrees with the JAX path to
 round-off (tests/test_solver_flux_kernel.py).  :func:`ssprk_stage` also applies the energy
 source and the stage update of :func:`.stepping.ssprk3_step` in the same sweep, so a stage of
