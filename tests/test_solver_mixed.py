@@ -142,13 +142,7 @@ def _float64_cell_ops(jaxpr) -> list[str]:
     return found
 
 
-#: Frictional collisions keep e static (a host quadrature, :class:`~ktgf.solver.physics.Physics`), and the
-#: closures take it as a NumPy float64 (``ktgf._array.asarray``): part of their cell arithmetic is float64.
-_E_STATIC = pytest.mark.xfail(strict=True, reason="static restitution enters the closures as a NumPy float64")
-
-
-@pytest.mark.parametrize("model", [pytest.param(m.name, marks=_E_STATIC) if m.friction.mu > 0 else m.name
-                                   for m in list_models()])
+@pytest.mark.parametrize("model", [m.name for m in list_models()])
 def test_float32_right_hand_side_computes_no_float64_cell_field(model: str) -> None:
     """A float32 state is stepped in float32: no closure promotes a cell field to float64 (a NumPy
     float64 constant in a closure would, and cost the float32 speed-up: Proposed's C¹ junction did,

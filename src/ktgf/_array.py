@@ -49,6 +49,14 @@ def asarray(x: Any) -> Any:
         raise InputError(f"{x!r:.60} is not a number or an array of numbers") from None
 
 
+def like(x: Any, ref: Any) -> Any:
+    """A host constant x (NumPy) in the precision of a JAX array ``ref``: a NumPy float64 would promote
+    float32 cell fields to float64.  JAX values and NumPy ``ref`` leave x unchanged."""
+    if is_jax(ref) and not is_jax(x):
+        return np.asarray(x, dtype=ref.dtype)
+    return x
+
+
 #: Largest |4b| for which :func:`power` multiplies instead of calling ``pow``.
 _QUARTER_POWERS = 64
 

@@ -31,7 +31,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
-from .._array import asarray
+from .._array import asarray, like
 from ..errors import InputError, UnknownModelError
 from ..validation import check_positive, check_state
 from .coefficients import Dimensional, Reduced, to_dimensional
@@ -146,12 +146,14 @@ class Model:
             self.check(phi, e)
         if hcs and shear is not None:
             raise InputError("the homogeneous cooling state has no shear: give shear = None with hcs = True")
-        phi, e = asarray(phi), asarray(e)
+        phi, e_host = asarray(phi), asarray(e)
+        e = like(e_host, phi)  # a static (host) e: in the cells' precision
         chi, dchi = self.rdf.chi(phi), self.rdf.dchi(phi)
         r = self.theory.reduced(phi, e, chi, dchi)
         zeta0 = r.zeta0 * self.dissipation.factor(phi, e, chi, shear)
         if self.friction.mu > 0.0:  # frictionless (μ = 0): ζ0 untouched, bit for bit
-            zeta0 = zeta0 * (self.friction.hcs_zeta0_factor(e) if hcs else self.friction.zeta0_factor(e))
+            factor = self.friction.hcs_zeta0_factor(e_host) if hcs else self.friction.zeta0_factor(e_host)
+            zeta0 = zeta0 * like(factor, phi)
         return r._replace(eta=r.eta * self.viscosity.factor(phi), zeta0=zeta0)
 
     def coefficients(
