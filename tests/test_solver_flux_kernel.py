@@ -29,7 +29,8 @@ from ktgf.closures.models import list_models
 from ktgf.solver.friction import cell_coefficients, for_case
 from ktgf.solver.sources import cooling_source
 from ktgf.solver.state import primitive_fields
-from ktgf.solver.stepping import Numerics, advance, explicit_rhs, kernel_stage_inputs, ssprk3_step
+from ktgf.solver.stepping import (LIMIT_TERMS, Numerics, advance, explicit_rhs, kernel_stage_inputs, kernel_step_limits,
+                                  limit_terms, ssprk3_step, start_program, step_limits)
 
 D, RHO_S = 1e-3, 2500.0
 #: float64: the kernel does the operations of the JAX path in the same order; XLA's fusion may round
@@ -208,7 +209,7 @@ def test_fused_stage_is_in_the_compiled_step_only_where_it_applies() -> None:
 def test_closures_once_per_stage(monkeypatch) -> None:
     """Tracing one SSP-RK3 step of ``advance`` evaluates the closures twice: at the step start (shared by
     the step limits and the first stage) and in the stage loop (the two later stages) — 3 per step.
-    With a cell program, once: for the step limits (the stages evaluate them in the kernel)."""
+    With a cell program, never: the kernel evaluates them, also for the step limits."""
     grid, phys = _grid(), _physics("ret")
     U = _state(grid, phys, jnp.float64)
     calls = []
@@ -222,7 +223,40 @@ def test_closures_once_per_stage(monkeypatch) -> None:
     from ktgf.solver import cell_program
 
     assert cell_program.for_physics(phys, jnp.float64) is not None  # generated (and traced) once, cached
+    assert cell_program.for_physics(phys, jnp.float64, limits="explicit") is not None  # the step-start program
     calls.clear()
     _with_kernel(True, lambda: jax.jit(lambda U: advance.__wrapped__(
         U, 0.0, 1e30, 1, grid, phys, Numerics(scheme="ssprk3"))).lower(U))
-    assert len(calls) == 1  # the step limits' only: the stages evaluate the closures in the kernel
+    assert len(calls) == 0  # the kernel evaluates the closures and reduces the step limits' terms
+
+
+@pytest.mark.parametrize("dtype", [jnp.float64, jnp.float32])
+@pytest.mark.parametrize("model", ["ret", "proposed", "frictional"])
+def test_step_limits_reduced_in_the_kernel(model: str, dtype) -> None:
+    """The step limits from the maxima the kernel reduces in its padding pass are those of the XLA
+    closures and reductions (:func:`step_limits`; float32: of the float64 state, to the float32 closures'
+    rounding); each of the four follows its own term, so a swap of terms, axes or cell sizes shows, and a
+    NaN term (θ < 0 in one cell) reaches the maxima as in ``jnp.max``."""
+    from ktgf.solver.cell_program import leaf_values
+
+    grid = _grid()
+    phys = for_case(_physics(model), "cooling", grid)
+    U = _state(grid, phys, dtype, phi=0.5)
+    num = Numerics(scheme="ssprk3")
+    program = _with_kernel(True, lambda: start_program(grid, phys, num, dtype))
+    assert program is not None and program.nlim == len(LIMIT_TERMS)
+    reduce = jax.jit(lambda U: flux_kernel.cell_fields(U, program, leaf_values(phys, grid), grid)[1])
+    got = np.asarray(kernel_step_limits(reduce(U), grid, num), np.float64)
+    want = np.asarray(jax.jit(lambda U: step_limits(U, grid, phys, num))(tuple(jnp.asarray(u, jnp.float64) for u in U)))
+    tol = 1e-13 if dtype == jnp.float64 else 1e-5  # float32: the cell program's rounding (< 128 ε₃₂)
+    np.testing.assert_allclose(got, want, rtol=tol)
+    assert len(set(np.round(want / want.min(), 6))) == 4  # four different limits: a swap would show
+    # Each maximum, from every cell (the threads' partial maxima merged), against NumPy's of the XLA terms.
+    W = primitive_fields(U)
+    terms = limit_terms(W, cell_coefficients(W, grid, phys), phys, num.acoustics, grid.spacing)
+    np.testing.assert_allclose(np.asarray(reduce(U), np.float64), [float(np.max(np.asarray(f))) for f in terms],
+                               rtol=tol)
+    cold = list(U)
+    cold[4] = cold[4].at[5, 7, 9].set(0.5 * (cold[1][5, 7, 9] ** 2 + cold[2][5, 7, 9] ** 2 + cold[3][5, 7, 9] ** 2)
+                                      / cold[0][5, 7, 9] * 0.5)  # kinetic energy > E: θ < 0 in the last cell of a thread
+    assert np.isnan(np.asarray(reduce(tuple(cold)))[0])  # c = √(θg) is NaN there

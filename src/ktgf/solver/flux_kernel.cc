@@ -9,7 +9,7 @@
 // components of an axis (docs/solver.md, Speed); here each face is computed once, from cells
 // that sit in cache, and its flux goes to the two cells it separates.
 //
-// Two entry points share the face sweep:
+// The entry points share the face sweep:
 // * KtgfFluxDivergence: inputs the cell fields (rho, u_x, u_y, u_z, theta, p*, g, eta, lambda_b,
 //   kappa, omega), each of shape (n0, n1, n2), C order, and float64 (dx, dy, dz, material density);
 //   outputs -div F of the five conservative fields and the central div u.
@@ -23,14 +23,20 @@
 //   own library, registered by key with KtgfRegisterCells); inputs float64 (dx, dy, dz, rho_s, a, dt),
 //   the program's float64 parameters, U0 and Uk; attribute `program` the key.  The closures are
 //   evaluated in the padding pass: one pass reads Uk and writes the padded fields.
+// * KtgfCellsPad and KtgfSsprkStagePadded: the first stage of a step split in two calls, so that the step size
+//   is known before the stage runs: the padding pass of a step-start cell program (the closures and the step
+//   limit terms) reduces the terms' maxima over the cells; XLA computes dt from them (a few scalars); the
+//   second call sweeps the workspace of the first.
 // All output a workspace holding the fields with two periodic ghost cells per side (an
 // output so that XLA owns and reuses its memory).  Rows are swept in blocks of ROW_BLOCK along
 // the second axis so that the five planes of a block that a stencil reaches stay in the core's L2
-// cache (measured 1.3x faster at 64^3 than whole planes).  Reading the unpadded fields with
+// cache (measured 1.3x faster at 64^3 than whole planes); each cell's MUSCL slope along an axis is kept for
+// the second face it serves (measured 1.1x faster single-threaded at 64^3, bit-identical output).  Reading the unpadded fields with
 // periodic index arithmetic instead of the padded copy was tried and measured 1.9x slower.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <mutex>
 #include <unordered_map>
 #include <utility>
@@ -88,17 +94,35 @@ struct Stencil {
   KTGF_INLINE T operator()(int f, int d0, int d1, int d2) const { return P[f][c + d0 * s0 + d1 * s1 + d2]; }
 };
 
-// Flux through the face between the cell (i, j, q) of the stencil and its neighbour along axis A: out[v * ld].
+// Half MUSCL slopes along A of the fields 0..6 at the row's cells q = from .. to - 1 (fluxes.reconstruct),
+// out[f * ld + q]: each cell's slope serves the two faces along A it touches, so it is computed once.
+template <class T, int A, int LIM>
+KTGF_INLINE void row_slopes(const T* const* P, long c0, const Consts<T>& k, T* out, long ld, long from, long to) {
+  constexpr int e0 = A == 0, e1 = A == 1, e2 = A == 2;
+  const long s0 = k.stride[0], s1 = k.stride[1];
+  #pragma GCC unroll 8
+  for (int f = 0; f < 7; ++f) {
+    T* o = out + f * ld;
+#pragma omp simd
+    for (long q = from; q < to; ++q) {
+      const Stencil<T> X{P, c0 + q, s0, s1};
+      const T fm = X(f, -e0, -e1, -e2), f0 = X(f, 0, 0, 0), f1 = X(f, e0, e1, e2);
+      o[q] = T(0.5) * slope<T, LIM>(f0 - fm, f1 - f0);
+    }
+  }
+}
+
+// Flux through the face between the cell (i, j, q) of the stencil and its neighbour along axis A: out[v * ld],
+// from the half slopes hl[f * lh] of the cell and hr[f * lh] of its neighbour.
 // The small loops are unrolled by pragma: a loop left inside stops the row loop from vectorising.
-template <class T, int A, int LIM, int RIE, bool VISC>
-KTGF_INLINE void face_flux(const Stencil<T>& X, const Consts<T>& k, T* out, long ld) {
+template <class T, int A, int RIE, bool VISC>
+KTGF_INLINE void face_flux(const Stencil<T>& X, const T* hl, const T* hr, long lh, const Consts<T>& k, T* out, long ld) {
   constexpr int e0 = A == 0, e1 = A == 1, e2 = A == 2;  // unit step along A
   T WL[7], WR[7];
   #pragma GCC unroll 8
   for (int f = 0; f < 7; ++f) {  // fluxes.reconstruct: MUSCL left/right states
-    const T fm = X(f, -e0, -e1, -e2), f0 = X(f, 0, 0, 0), f1 = X(f, e0, e1, e2), f2 = X(f, 2 * e0, 2 * e1, 2 * e2);
-    WL[f] = f0 + T(0.5) * slope<T, LIM>(f0 - fm, f1 - f0);
-    WR[f] = f1 - T(0.5) * slope<T, LIM>(f1 - f0, f2 - f1);
+    WL[f] = X(f, 0, 0, 0) + hl[f * lh];
+    WR[f] = X(f, e0, e1, e2) - hr[f * lh];
   }
   // fluxes.riemann_flux
   const T pL = WL[RHO] * WL[TH] * WL[PS], pR = WR[RHO] * WR[TH] * WR[PS];
@@ -194,12 +218,14 @@ struct Stage {
 };
 
 // Face fluxes along A of the row starting at padded cell c0: the faces between q and its
-// neighbour along A, q = -1 .. n2 - 1 for the z faces (from), 0 .. n2 - 1 else, into out[q + v * ld].
-template <class T, int A, int LIM, int RIE, bool VISC>
-KTGF_INLINE void row_faces(const T* const* P, long c0, const Consts<T>& k, T* out, long ld, long from = 0) {
+// neighbour along A, q = from .. n2 - 1, into out[q + v * ld]; hl, hr the half slopes of the two cells (index q).
+template <class T, int A, int RIE, bool VISC>
+KTGF_INLINE void row_faces(const T* const* P, long c0, const Consts<T>& k, const T* hl, const T* hr, long lh, T* out,
+                           long ld, long from = 0) {
   const long n2 = k.n[2], s0 = k.stride[0], s1 = k.stride[1];
 #pragma omp simd
-  for (long q = from; q < n2; ++q) face_flux<T, A, LIM, RIE, VISC>(Stencil<T>{P, c0 + q, s0, s1}, k, out + q, ld);
+  for (long q = from; q < n2; ++q)
+    face_flux<T, A, RIE, VISC>(Stencil<T>{P, c0 + q, s0, s1}, hl + q, hr + q, lh, k, out + q, ld);
 }
 
 // Central div u of the row's cells.
@@ -290,7 +316,9 @@ constexpr long ROW_BLOCK = 16;
 
 // Each thread owns a block of planes i and sweeps them row block by row block, rows (i, j) in
 // order, keeping the fluxes of the lower x faces (a plane block) and y faces (a row) from the
-// previous plane/row, so every face is computed once (plus one x plane and one y row per block).
+// previous plane/row, so every face is computed once (plus one x plane and one y row per block),
+// and likewise the half slopes of the cells below (x: a plane block, y: a row), so every cell's
+// slope along each axis is computed once.
 template <class T, int LIM, int RIE, bool VISC, class Out>
 void sweep(const T* const* P, const Consts<T>& k, const Out& o) {
   const long n0 = k.n[0], n1 = k.n[1], n2 = k.n[2];
@@ -299,6 +327,7 @@ void sweep(const T* const* P, const Consts<T>& k, const Out& o) {
   {
     const long B = ROW_BLOCK < n1 ? ROW_BLOCK : n1;
     std::vector<T> xlo(5 * B * n2), xhi(5 * n2), ylo(5 * n2), yhi(5 * n2), zf(5 * (n2 + 1)), divu(n2);
+    std::vector<T> hx(7 * B * n2), hxn(7 * n2), hya(7 * n2), hyb(7 * n2), hz(7 * (n2 + 2));
     int nt = 1, t = 0;
 #ifdef _OPENMP
     nt = omp_get_num_threads();
@@ -307,15 +336,27 @@ void sweep(const T* const* P, const Consts<T>& k, const Out& o) {
     const long i0 = n0 * t / nt, i1 = n0 * (t + 1) / nt;
     for (long jb = 0; jb < n1 && i0 < i1; jb += B) {
       const long je = jb + B < n1 ? jb + B : n1;
-      for (long j = jb; j < je; ++j)
-        row_faces<T, 0, LIM, RIE, VISC>(P, cell(i0 - 1, j), k, xlo.data() + (j - jb) * n2, B * n2);
+      for (long j = jb; j < je; ++j) {
+        T* h = hx.data() + (j - jb) * 7 * n2;
+        row_slopes<T, 0, LIM>(P, cell(i0 - 1, j), k, hxn.data(), n2, 0, n2);
+        row_slopes<T, 0, LIM>(P, cell(i0, j), k, h, n2, 0, n2);
+        row_faces<T, 0, RIE, VISC>(P, cell(i0 - 1, j), k, hxn.data(), h, n2, xlo.data() + (j - jb) * n2, B * n2);
+      }
       for (long i = i0; i < i1; ++i) {
-        row_faces<T, 1, LIM, RIE, VISC>(P, cell(i, jb - 1), k, ylo.data(), n2);
+        T* hy = hya.data();
+        T* hyn = hyb.data();
+        row_slopes<T, 1, LIM>(P, cell(i, jb - 1), k, hyn, n2, 0, n2);
+        row_slopes<T, 1, LIM>(P, cell(i, jb), k, hy, n2, 0, n2);
+        row_faces<T, 1, RIE, VISC>(P, cell(i, jb - 1), k, hyn, hy, n2, ylo.data(), n2);
         for (long j = jb; j < je; ++j) {
           const long c0 = cell(i, j);
-          row_faces<T, 0, LIM, RIE, VISC>(P, c0, k, xhi.data(), n2);
-          row_faces<T, 1, LIM, RIE, VISC>(P, c0, k, yhi.data(), n2);
-          row_faces<T, 2, LIM, RIE, VISC>(P, c0, k, zf.data() + 1, n2 + 1, -1);  // face q + 1/2 at q + 1
+          T* hxj = hx.data() + (j - jb) * 7 * n2;
+          row_slopes<T, 0, LIM>(P, cell(i + 1, j), k, hxn.data(), n2, 0, n2);
+          row_faces<T, 0, RIE, VISC>(P, c0, k, hxj, hxn.data(), n2, xhi.data(), n2);
+          row_slopes<T, 1, LIM>(P, cell(i, j + 1), k, hyn, n2, 0, n2);
+          row_faces<T, 1, RIE, VISC>(P, c0, k, hy, hyn, n2, yhi.data(), n2);
+          row_slopes<T, 2, LIM>(P, c0, k, hz.data() + 1, n2 + 2, -1, n2 + 1);
+          row_faces<T, 2, RIE, VISC>(P, c0, k, hz.data() + 1, hz.data() + 2, n2 + 2, zf.data() + 1, n2 + 1, -1);
           T* lo[10];
           const T* hi[10];
           for (int v = 0; v < 5; ++v) {
@@ -327,10 +368,12 @@ void sweep(const T* const* P, const Consts<T>& k, const Out& o) {
           write_row(o, P, c0, (i * n1 + j) * n2, k, lo, hi, zf.data(), n2 + 1, divu.data());
           for (int v = 0; v < 10; ++v) {  // the upper faces become the next plane's/row's lower ones
             T* l = lo[v];
-            const T* h = hi[v];
+            const T* hh = hi[v];
 #pragma omp simd
-            for (long q = 0; q < n2; ++q) l[q] = h[q];
+            for (long q = 0; q < n2; ++q) l[q] = hh[q];
           }
+          std::copy(hxn.begin(), hxn.end(), hxj);  // plane i + 1's slopes, for the next plane
+          std::swap(hy, hyn);
         }
       }
     }
@@ -395,8 +438,9 @@ ffi::Error run(const ffi::AnyBuffer* in, const double* params, int limiter, int 
   return sweep_padded<T>(n, params, limiter, riemann, viscous, work, o);
 }
 
-// Cell programs (ktgf.solver.cell_program), by key: f(n, params, in[5], out[NFIELD + 2]) over n cells,
-// in = the conservative fields, out = the NFIELD cell fields then s0, s1.
+// Cell programs (ktgf.solver.cell_program), by key: f(n, params, in[5], out[NFIELD + 2 + nlim]) over n cells,
+// in = the conservative fields, out = the NFIELD cell fields, then s0, s1, then (a step-start program) the
+// nlim cell terms whose maxima give the step limits.
 struct CellProgram {
   void* fn;
   int bits;  // 32 or 64: the state precision it was generated for
@@ -407,24 +451,44 @@ std::unordered_map<int64_t, CellProgram> programs;
 template <class T>
 using CellsFn = void (*)(long, const double*, const T* const*, T* const*);
 
-// The cell fields of the state U (5 conservative fields) by the program, into the padded `work` (with
-// periodic ghost cells), and the source coefficients s0, s1 (unpadded).
+// max as jnp.max: a NaN wins (so a NaN step limit reaches the step's status check).
 template <class T>
-void cells_pad(CellsFn<T> fn, const double* leaf, const T* const* U, const long* n, T* work, T* s0, T* s1) {
+KTGF_INLINE T max_nan(T m, T x) { return (x > m || x != x) ? x : m; }
+
+// The cell fields of the state U (5 conservative fields) by the program, into the padded `work` (with
+// periodic ghost cells), and the source coefficients s0, s1 (unpadded); with nlim > 0 also the maxima over
+// the cells of the program's nlim limit terms, into `maxima` (reduced here, in the same pass).
+template <class T>
+void cells_pad(CellsFn<T> fn, const double* leaf, const T* const* U, const long* n, T* work, T* s0, T* s1,
+               int nlim = 0, T* maxima = nullptr) {
   const long m1 = n[1] + 2 * GHOST, m2 = n[2] + 2 * GHOST, plane = m1 * m2, M = (n[0] + 2 * GHOST) * plane;
+  for (int k = 0; k < nlim; ++k) maxima[k] = -std::numeric_limits<T>::infinity();
 #pragma omp parallel
   {
+    std::vector<T> terms(size_t(nlim) * n[2]), local(nlim, -std::numeric_limits<T>::infinity());
+    std::vector<T*> out(NFIELD + 2 + nlim);
 #pragma omp for collapse(2) schedule(static)
     for (long i = 0; i < n[0]; ++i) {
       for (long j = 0; j < n[1]; ++j) {
         const long src = (i * n[1] + j) * n[2];
         const T* in[5];
         for (int v = 0; v < 5; ++v) in[v] = U[v] + src;
-        T* out[NFIELD + 2];
         for (int f = 0; f < NFIELD; ++f) out[f] = work + f * M + (i + GHOST) * plane + (j + GHOST) * m2 + GHOST;
         out[NFIELD] = s0 + src;
         out[NFIELD + 1] = s1 + src;
-        fn(n[2], leaf, in, out);
+        for (int k = 0; k < nlim; ++k) out[NFIELD + 2 + k] = terms.data() + k * n[2];
+        fn(n[2], leaf, in, out.data());
+        for (int k = 0; k < nlim; ++k) {  // eight partial maxima: a vector, not one serial chain
+          const T* t = terms.data() + k * n[2];
+          T acc[8];
+          for (int l = 0; l < 8; ++l) acc[l] = local[k];
+          long q = 0;
+          for (; q + 8 <= n[2]; q += 8)
+            for (int l = 0; l < 8; ++l) acc[l] = max_nan(acc[l], t[q + l]);
+          for (; q < n[2]; ++q) acc[0] = max_nan(acc[0], t[q]);
+          for (int l = 1; l < 8; ++l) acc[0] = max_nan(acc[0], acc[l]);
+          local[k] = acc[0];
+        }
         for (int f = 0; f < NFIELD; ++f) {  // the row's ghost cells along z
           T* row = out[f] - GHOST;
           for (long q = 0; q < GHOST; ++q) {
@@ -433,6 +497,10 @@ void cells_pad(CellsFn<T> fn, const double* leaf, const T* const* U, const long*
           }
         }
       }
+    }
+    if (nlim > 0) {
+#pragma omp critical(ktgf_cells_maxima)
+      for (int k = 0; k < nlim; ++k) maxima[k] = max_nan(maxima[k], local[k]);
     }
 #pragma omp for collapse(2) schedule(static)
     for (int f = 0; f < NFIELD; ++f) {  // ghost rows along y of the interior planes (after all rows: barrier)
@@ -524,33 +592,134 @@ ffi::Error ssprk_stage(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer uy,
   }
 }
 
-template <class T>
-ffi::Error stage_cells_typed(ffi::RemainingArgs state, const double* params, const double* leaf, int limiter,
-                             int riemann, void* fn, void* const* out) {
-  auto dims = state.get<ffi::AnyBuffer>(0)->dimensions();
+// The grid shape of a 3D cell field, or an error.
+ffi::Error grid_shape(const ffi::AnyBuffer& field, long* n) {
+  auto dims = field.dimensions();
   if (dims.size() != 3) return ffi::Error::InvalidArgument("stage kernel: fields must be 3D");
-  long n[3];
   for (int a = 0; a < 3; ++a) n[a] = long(dims[a]);
   if (n[0] < GHOST || n[1] < GHOST || n[2] < GHOST)
     return ffi::Error::InvalidArgument("stage kernel: at least 2 cells per axis");
+  return ffi::Error::Success();
+}
+
+// The stage output of the state (U0, Uk = the RemainingArgs 0..9) whose padded cell fields and source
+// coefficients s0, s1 are in `work` (NFIELD padded fields, then s0 and s1).
+template <class T>
+Stage<T> stage_of(ffi::RemainingArgs state, const long* n, const double* params, const T* work, void* const* out) {
   Stage<T> o;
   for (int v = 0; v < 5; ++v) {
     o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<T>();
     o.Uk[v] = state.get<ffi::AnyBuffer>(5 + v)->typed_data<T>();
     o.U[v] = static_cast<T*>(out[v]);
   }
-  T* work = static_cast<T*>(out[5]);
   const long M = (n[0] + 2 * GHOST) * (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST), N = n[0] * n[1] * n[2];
-  T* s0 = work + NFIELD * M;
-  T* s1 = s0 + N;
-  o.s0 = s0;
-  o.s1 = s1;
+  o.s0 = work + NFIELD * M;
+  o.s1 = o.s0 + N;
   o.a = T(params[4]);
   o.b = T(1) - o.a;
   o.dt = T(params[5]);
+  return o;
+}
+
+template <class T>
+ffi::Error stage_cells_typed(ffi::RemainingArgs state, const double* params, const double* leaf, int limiter,
+                             int riemann, void* fn, void* const* out) {
+  long n[3];
+  if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
+  T* work = static_cast<T*>(out[5]);
+  const Stage<T> o = stage_of<T>(state, n, params, work, out);
   // Uk is read whole here, before the sweep writes U' over it.
-  cells_pad<T>(reinterpret_cast<CellsFn<T>>(fn), leaf, o.Uk, n, work, s0, s1);
+  cells_pad<T>(reinterpret_cast<CellsFn<T>>(fn), leaf, o.Uk, n, work, const_cast<T*>(o.s0), const_cast<T*>(o.s1));
   return sweep_padded<T>(n, params, limiter, riemann, true, work, o);
+}
+
+// The cell program registered under `program`, checked against the precision of `type`.
+ffi::Error find_program(int64_t program, ffi::DataType type, CellProgram& p) {
+  {
+    std::lock_guard<std::mutex> lock(programs_mutex);
+    auto it = programs.find(program);
+    if (it != programs.end()) p = it->second;
+  }
+  const int bits = type == ffi::F64 ? 64 : type == ffi::F32 ? 32 : 0;
+  if (p.fn == nullptr) return ffi::Error::InvalidArgument("stage kernel: cell program not registered");
+  if (p.bits != bits) return ffi::Error::InvalidArgument("stage kernel: cell program of another precision");
+  return ffi::Error::Success();
+}
+
+// Checks that the first `count` RemainingArgs are cell fields of one precision; their type in `type`.
+ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& type) {
+  if (state.size() < count) return ffi::Error::InvalidArgument("stage kernel: too few state fields");
+  auto first = state.get<ffi::AnyBuffer>(0);
+  if (!first.has_value()) return ffi::Error::InvalidArgument("stage kernel: no state");
+  type = first->element_type();
+  for (size_t i = 0; i < count; ++i) {
+    auto b = state.get<ffi::AnyBuffer>(i);
+    if (!b.has_value() || b->element_type() != type || b->element_count() != first->element_count())
+      return ffi::Error::InvalidArgument("stage kernel: the state must be cell fields of one precision");
+  }
+  return ffi::Error::Success();
+}
+
+// KtgfCellsPad: the cell fields and source coefficients of Uk by a step-start cell program, into the
+// workspace layout of KtgfSsprkStageCells, and the maxima of the program's `nlim` limit terms (from which
+// the step size is computed before KtgfSsprkStagePadded runs the first stage on this workspace).
+template <class T>
+ffi::Error cells_typed(ffi::RemainingArgs state, const double* leaf, void* fn, int nlim, void* out, void* maxima) {
+  long n[3];
+  if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
+  const T* U[5];
+  for (int v = 0; v < 5; ++v) U[v] = state.get<ffi::AnyBuffer>(v)->typed_data<T>();
+  T* work = static_cast<T*>(out);
+  const long M = (n[0] + 2 * GHOST) * (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST), N = n[0] * n[1] * n[2];
+  cells_pad<T>(reinterpret_cast<CellsFn<T>>(fn), leaf, U, n, work, work + NFIELD * M, work + NFIELD * M + N, nlim,
+               static_cast<T*>(maxima));
+  return ffi::Error::Success();
+}
+
+ffi::Error cells(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state, int64_t program, int32_t nlim,
+                 ffi::Result<ffi::AnyBuffer> work, ffi::Result<ffi::AnyBuffer> maxima) {
+  if (state.size() != 5) return ffi::Error::InvalidArgument("cells kernel: state = Uk x5");
+  ffi::DataType type;
+  if (auto err = same_fields(state, 5, type); err.failure()) return err;
+  if (nlim < 0 || long(maxima->element_count()) != nlim || maxima->element_type() != type)
+    return ffi::Error::InvalidArgument("cells kernel: maxima must be nlim values of the state precision");
+  CellProgram p{nullptr, 0};
+  if (auto err = find_program(program, type, p); err.failure()) return err;
+  if (type == ffi::F64)
+    return cells_typed<double>(state, leaf.typed_data(), p.fn, nlim, work->untyped_data(), maxima->untyped_data());
+  return cells_typed<float>(state, leaf.typed_data(), p.fn, nlim, work->untyped_data(), maxima->untyped_data());
+}
+
+// KtgfSsprkStagePadded: the stage of KtgfSsprkStageCells from a workspace that KtgfCellsPad wrote.
+template <class T>
+ffi::Error stage_padded_typed(ffi::RemainingArgs state, const double* params, int limiter, int riemann,
+                              void* const* out) {
+  long n[3];
+  if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
+  const T* work = state.get<ffi::AnyBuffer>(10)->typed_data<T>();
+  return sweep_padded<T>(n, params, limiter, riemann, true, work, stage_of<T>(state, n, params, work, out));
+}
+
+ffi::Error ssprk_stage_padded(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs state, int32_t limiter,
+                              int32_t riemann, ffi::Result<ffi::AnyBuffer> u0, ffi::Result<ffi::AnyBuffer> u1,
+                              ffi::Result<ffi::AnyBuffer> u2, ffi::Result<ffi::AnyBuffer> u3,
+                              ffi::Result<ffi::AnyBuffer> u4) {
+  void* const out[5] = {u0->untyped_data(), u1->untyped_data(), u2->untyped_data(), u3->untyped_data(),
+                        u4->untyped_data()};
+  if (params.element_count() != 6)
+    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
+  if (state.size() != 11) return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5, workspace)");
+  ffi::DataType type;
+  if (auto err = same_fields(state, 10, type); err.failure()) return err;
+  auto work = state.get<ffi::AnyBuffer>(10);
+  long n[3];
+  if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
+  const long M = (n[0] + 2 * GHOST) * (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST), N = n[0] * n[1] * n[2];
+  if (!work.has_value() || work->element_type() != type || long(work->element_count()) != NFIELD * M + 2 * N)
+    return ffi::Error::InvalidArgument("stage kernel: workspace is not that of KtgfCellsPad for this state");
+  if (type == ffi::F64) return stage_padded_typed<double>(state, params.typed_data(), limiter, riemann, out);
+  if (type == ffi::F32) return stage_padded_typed<float>(state, params.typed_data(), limiter, riemann, out);
+  return ffi::Error::InvalidArgument("stage kernel: fields must be float32 or float64");
 }
 
 ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state,
@@ -563,24 +732,11 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
   if (params.element_count() != 6)
     return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
   if (state.size() != 10) return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5)");
-  auto first = state.get<ffi::AnyBuffer>(0);
-  if (!first.has_value()) return ffi::Error::InvalidArgument("stage kernel: no state");
-  const auto type = first->element_type();
-  for (size_t i = 0; i < state.size(); ++i) {
-    auto b = state.get<ffi::AnyBuffer>(i);
-    if (!b.has_value() || b->element_type() != type || b->element_count() != first->element_count())
-      return ffi::Error::InvalidArgument("stage kernel: U0, Uk must be cell fields of one precision");
-  }
+  ffi::DataType type;
+  if (auto err = same_fields(state, 10, type); err.failure()) return err;
   CellProgram p{nullptr, 0};
-  {
-    std::lock_guard<std::mutex> lock(programs_mutex);
-    auto it = programs.find(program);
-    if (it != programs.end()) p = it->second;
-  }
-  const int bits = type == ffi::F64 ? 64 : type == ffi::F32 ? 32 : 0;
-  if (p.fn == nullptr) return ffi::Error::InvalidArgument("stage kernel: cell program not registered");
-  if (p.bits != bits) return ffi::Error::InvalidArgument("stage kernel: cell program of another precision");
-  if (bits == 64) return stage_cells_typed<double>(state, params.typed_data(), leaf.typed_data(), limiter, riemann, p.fn, out);
+  if (auto err = find_program(program, type, p); err.failure()) return err;
+  if (type == ffi::F64) return stage_cells_typed<double>(state, params.typed_data(), leaf.typed_data(), limiter, riemann, p.fn, out);
   return stage_cells_typed<float>(state, params.typed_data(), leaf.typed_data(), limiter, riemann, p.fn, out);
 }
 
@@ -643,6 +799,27 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStageCells, ssprk_stage_cells,
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_z
                                   .Ret<ffi::AnyBuffer>()  // ... E
                                   .Ret<ffi::AnyBuffer>());  // padded fields, then s0, s1 (workspace)
+
+XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfCellsPad, cells,
+                              ffi::Ffi::Bind()
+                                  .Arg<ffi::Buffer<ffi::F64>>()  // the cell program's parameters
+                                  .RemainingArgs()               // Uk (5)
+                                  .Attr<int64_t>("program")
+                                  .Attr<int32_t>("nlim")
+                                  .Ret<ffi::AnyBuffer>()    // padded fields, then s0, s1 (workspace)
+                                  .Ret<ffi::AnyBuffer>());  // maxima of the nlim limit terms
+
+XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStagePadded, ssprk_stage_padded,
+                              ffi::Ffi::Bind()
+                                  .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s, a, dt)
+                                  .RemainingArgs()               // U0 (5), Uk (5), workspace of KtgfCellsPad
+                                  .Attr<int32_t>("limiter")
+                                  .Attr<int32_t>("riemann")
+                                  .Ret<ffi::AnyBuffer>()  // U' density
+                                  .Ret<ffi::AnyBuffer>()  // ... rho u_x
+                                  .Ret<ffi::AnyBuffer>()  // ... rho u_y
+                                  .Ret<ffi::AnyBuffer>()  // ... rho u_z
+                                  .Ret<ffi::AnyBuffer>());  // ... E
 
 // Registers the cell program `fn` (state precision `bits`, 32 or 64) under `key`; returns 0.
 extern "C" int KtgfRegisterCells(int64_t key, void* fn, int32_t bits) {

@@ -8,7 +8,9 @@ instead of once per flux component (docs/solver.md, Speed) and agrees with the J
 round-off (tests/test_solver_flux_kernel.py).  :func:`ssprk_stage` also applies the energy
 source and the stage update of :func:`.stepping.ssprk3_step` in the same sweep, so a stage of
 the explicit scheme is one closure pass (XLA) and one kernel call; :func:`ssprk_stage_cells` also
-evaluates the closures, by a generated cell program (:mod:`.cell_program`), so a stage is one call.
+evaluates the closures, by a generated cell program (:mod:`.cell_program`), so a stage is one call;
+a step's first stage is :func:`cell_fields` (closures and the maxima of the step-limit terms, in the
+padding pass) and :func:`ssprk_stage_padded`, with the step size computed from the maxima between them.
 
 It is used where it applies — CPU backend, one device, a 3D fully periodic grid, float32 or
 float64 — and when it is switched on: :data:`.fluxes.FLUX_KERNEL` (default from the environment
@@ -42,6 +44,8 @@ SOURCE = Path(__file__).with_name("flux_kernel.cc")
 TARGET = "ktgf_flux_divergence"
 STAGE_TARGET = "ktgf_ssprk_stage"
 CELLS_TARGET = "ktgf_ssprk_stage_cells"
+CELLS_PAD_TARGET = "ktgf_cells_pad"
+STAGE_PADDED_TARGET = "ktgf_ssprk_stage_padded"
 FLAGS = ("-O3", "-march=native", "-fopenmp", "-ffp-contract=off", "-fno-math-errno", "-shared", "-fPIC", "-std=c++17")
 _loaded: dict[str, Any] = {}
 
@@ -83,6 +87,9 @@ def available() -> bool:
             jax.ffi.register_ffi_target(TARGET, jax.ffi.pycapsule(lib.KtgfFluxDivergence), platform="cpu")
             jax.ffi.register_ffi_target(STAGE_TARGET, jax.ffi.pycapsule(lib.KtgfSsprkStage), platform="cpu")
             jax.ffi.register_ffi_target(CELLS_TARGET, jax.ffi.pycapsule(lib.KtgfSsprkStageCells), platform="cpu")
+            jax.ffi.register_ffi_target(CELLS_PAD_TARGET, jax.ffi.pycapsule(lib.KtgfCellsPad), platform="cpu")
+            jax.ffi.register_ffi_target(STAGE_PADDED_TARGET, jax.ffi.pycapsule(lib.KtgfSsprkStagePadded),
+                                        platform="cpu")
             _loaded["lib"] = lib
             _loaded["ok"] = True
         except (RuntimeError, OSError) as err:
@@ -143,9 +150,7 @@ def ssprk_stage(U0: Any, Uk: Any, W: Any, eos: Any, transport: Any, source: tupl
     # none of the loop-carry copies XLA inserts when a stage's output cannot take its input's place.
     call = jax.ffi.ffi_call(STAGE_TARGET, (field,) * 5 + (work,),
                             input_output_aliases={len(fields) + 6 + v: v for v in range(5)})
-    # a and Δt as the state precision rounds them (the JAX path computes in that precision).
-    coef = [jnp.asarray(v).astype(dtype).astype(jnp.float64) for v in (a, dt)]
-    params = jnp.stack([*(jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)), *coef])
+    params = _stage_params(a, dt, grid, rho_s, dtype)
     return tuple(call(*fields, params, *state, **_schemes(limiter, riemann))[:5])
 
 
@@ -159,20 +164,53 @@ def _register(program: Any) -> None:
         done.add(program.key)
 
 
+def _workspace(grid: Any, dtype: Any) -> Any:
+    """The cell-program workspace: the 11 kernel cell fields with periodic ghost cells, then s0 and s1."""
+    from .fluxes import GHOST
+
+    padded = int(np.prod([n + 2 * GHOST for n in grid.cells]))
+    return jax.ShapeDtypeStruct((11 * padded + 2 * grid.size,), dtype)
+
+
+def cell_fields(Uk: Any, program: Any, leaf: Any, grid: Any) -> tuple[Any, Any]:
+    """The workspace of the step-start cell program ``program`` (:func:`.cell_program.for_physics` with
+    ``limits``) at the state Uk, and the maxima over the cells of its limit terms
+    (:data:`.stepping.LIMIT_TERMS`), reduced in the same pass: the closures and step-limit reductions of a
+    step's start in one call, so that the step size is known before :func:`ssprk_stage_padded` runs the
+    first stage on this workspace."""
+    _register(program)
+    dtype = Uk[0].dtype
+    call = jax.ffi.ffi_call(CELLS_PAD_TARGET, (_workspace(grid, dtype), jax.ShapeDtypeStruct((program.nlim,), dtype)))
+    return call(leaf, *(jnp.asarray(f, dtype) for f in Uk), program=np.int64(program.key), nlim=np.int32(program.nlim))
+
+
+def _stage_params(a: Any, dt: Any, grid: Any, rho_s: Any, dtype: Any) -> Any:
+    # a and Δt as the state precision rounds them (the JAX path computes in that precision).
+    coef = [jnp.asarray(v).astype(dtype).astype(jnp.float64) for v in (a, dt)]
+    return jnp.stack([*(jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)), *coef])
+
+
 def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any,
                       limiter: str, riemann: str) -> tuple[Any, ...]:
     """The SSP-RK3 stage of :func:`ssprk_stage` with the cell fields and the energy source computed in
     the kernel from Uk by a cell program (:func:`.cell_program.for_physics`) with parameters ``leaf``
     (:func:`.cell_program.leaf_values`)."""
-    from .fluxes import GHOST
-
     _register(program)
     dtype = Uk[0].dtype
     state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
     field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
-    padded = int(np.prod([n + 2 * GHOST for n in grid.cells]))
-    work = jax.ShapeDtypeStruct((11 * padded + 2 * grid.size,), dtype)
-    call = jax.ffi.ffi_call(CELLS_TARGET, (field,) * 5 + (work,), input_output_aliases={7 + v: v for v in range(5)})
-    coef = [jnp.asarray(v).astype(dtype).astype(jnp.float64) for v in (a, dt)]
-    params = jnp.stack([*(jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)), *coef])
+    call = jax.ffi.ffi_call(CELLS_TARGET, (field,) * 5 + (_workspace(grid, dtype),),
+                            input_output_aliases={7 + v: v for v in range(5)})
+    params = _stage_params(a, dt, grid, rho_s, dtype)
     return tuple(call(params, leaf, *state, **_schemes(limiter, riemann), program=np.int64(program.key))[:5])
+
+
+def ssprk_stage_padded(U0: Any, Uk: Any, work: Any, a: Any, dt: Any, grid: Any, rho_s: Any, limiter: str,
+                       riemann: str) -> tuple[Any, ...]:
+    """The stage of :func:`ssprk_stage_cells` from the workspace ``work`` = :func:`cell_fields` of Uk."""
+    dtype = Uk[0].dtype
+    state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
+    field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
+    call = jax.ffi.ffi_call(STAGE_PADDED_TARGET, (field,) * 5, input_output_aliases={6 + v: v for v in range(5)})
+    params = _stage_params(a, dt, grid, rho_s, dtype)
+    return tuple(call(params, *state, work, **_schemes(limiter, riemann)))

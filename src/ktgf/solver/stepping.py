@@ -191,38 +191,85 @@ def rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> Any:
     return tuple(explicit_rhs(U, grid, phys, num, viscous=True, t=t))
 
 
+#: The cell fields whose maxima give the step limits (:func:`limit_terms`, :func:`limits_of_maxima`).
+LIMIT_TERMS = ("wave", "viscous", "conductive", "zeta", "abs_zeta_u", "u_x", "u_y", "u_z", "-u_x", "-u_y", "-u_z")
+
+
+def limit_terms(W: Any, r: Any, phys: Physics, acoustics: str, spacing: Any) -> tuple:
+    """The cell fields of :data:`LIMIT_TERMS`, whose maxima give the step limits (:func:`limits_of_maxima`).
+
+    The wave rate Σ_a (|u_a| + c)/Δx_a (``acoustics`` implicit: c = 0, the flow speed only), the
+    kinematic viscosity (4/3 η + λ_b)/ρ and thermal diffusivity κ/(3ρ/2), the cooling rate ζ at ∇·u = 0
+    and |ζ_U| (ζ = ζ0 + ζ_U ∇·u), and ±u_a (their maxima bound the central ∇·u on a periodic grid).
+    Elementwise in the cell's own state, so a step-start cell program (:mod:`.cell_program`) evaluates
+    them in the stage kernel's padding pass and the kernel reduces them there.
+    """
+    rho, u, theta = W[0], W[1:4], W[4]
+    c = phys.sound_speed(theta, r) if acoustics == "explicit" else 0.0
+    eta, lam, kap, _ = phys.transport(rho, theta, r)
+    wave = sum((jnp.abs(u[a]) + c) / spacing[a] for a in range(len(spacing)))
+    return (wave, (4.0 / 3.0 * eta + lam) / rho, kap / (1.5 * rho), phys.cooling_rate(rho, theta, 0.0, r),
+            jnp.abs(r.zeta_u), *u, *(-v for v in u))
+
+
+def divu_bound(maxima: Any, grid: Grid) -> Any:
+    """A bound of the central ∇·u on a periodic grid from the maxima of :data:`LIMIT_TERMS`:
+    |∇·u| ≤ Σ_a (max u_a − min u_a)/(2Δx_a), with −min u_a = max(−u_a).
+
+    Plain reductions only, since a stencil inside XLA's CPU reduction loop makes it an order of
+    magnitude slower."""
+    return sum((maxima[5 + a] + maxima[8 + a]) * (0.5 / grid.spacing[a]) for a in range(grid.ndim))
+
+
+def limits_of_maxima(maxima: Any, grid: Grid, num: Numerics, divu_max: Any) -> Any:
+    """The four step limits (acoustic CFL, viscous, conductive, cooling) [s] from the maxima of
+    :data:`LIMIT_TERMS` over the cells and a bound ``divu_max`` of |∇·u|: max |ζ| ≤ max ζ0 + max |ζ_U| max |∇·u|."""
+    inv_dx2 = sum(1.0 / h**2 for h in grid.spacing)
+    viscous = num.cfl_diffusion / (2.0 * inv_dx2 * maxima[1])
+    conductive = num.cfl_diffusion / (2.0 * inv_dx2 * maxima[2])
+    cooling = num.cfl_source / (maxima[3] + maxima[4] * divu_max)
+    return jnp.stack([num.cfl / maxima[0], viscous, conductive, cooling])
+
+
+def kernel_limits_apply(grid: Grid, num: Numerics) -> bool:
+    """Whether the step-start maxima may come from the stage kernel (:func:`.flux_kernel.cell_fields`):
+    SSP-RK3 with the explicit sink (whose cooling limit is :func:`limits_of_maxima`'s) on a periodic grid."""
+    return num.scheme == "ssprk3" and num.sink == "explicit" and (grid.boundaries is None or grid.boundaries.all_periodic)
+
+
 def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None) -> Any:
     """The four step limits (acoustic CFL, viscous, conductive, cooling) of :class:`Numerics` [s]."""
     W = primitive_fields(U)
     rho, u, theta = W[0], W[1:4], W[4]
     if r is None:
         r = cell_coefficients(W, grid, phys)
-    c = phys.sound_speed(theta, r) if num.acoustics == "explicit" else 0.0  # implicit: the flow speed only
-    wave = sum((jnp.abs(u[a]) + c) / grid.spacing[a] for a in range(grid.ndim))
-    eta, lam, kap, _ = phys.transport(rho, theta, r)
-    inv_dx2 = sum(1.0 / h**2 for h in grid.spacing)
-    viscous = num.cfl_diffusion / (2.0 * inv_dx2 * jnp.max((4.0 / 3.0 * eta + lam) / rho))
-    conductive = num.cfl_diffusion / (2.0 * inv_dx2 * jnp.max(kap / (1.5 * rho)))
-    # max|ζ| ≤ max ζ0 + max|ζ_U| max|∇·u|, and the central ∇·u obeys
-    # |∇·u| ≤ Σ_a (max u_a − min u_a)/(2Δx_a): plain reductions only, since a stencil inside
-    # XLA's CPU reduction loop makes it an order of magnitude slower.
+    maxima = [jnp.max(f) for f in limit_terms(W, r, phys, num.acoustics, grid.spacing)]
     if grid.boundaries is None or grid.boundaries.all_periodic:
-        divu_bound = sum((jnp.max(u[a]) - jnp.min(u[a])) * (0.5 / grid.spacing[a]) for a in range(grid.ndim))
+        divu_max = divu_bound(maxima, grid)
     else:  # a mean shear makes max u − min u large; the central ∇·u itself (any time: only its size matters)
-        divu_bound = jnp.max(jnp.abs(cell_divergence(pad_fields(u, grid, velocity=0), grid)))
-    zeta = jnp.max(phys.cooling_rate(rho, theta, 0.0, r)) + jnp.max(jnp.abs(r.zeta_u)) * divu_bound
-    cooling = num.cfl_source / zeta
+        divu_max = jnp.max(jnp.abs(cell_divergence(pad_fields(u, grid, velocity=0), grid)))
+    lim = limits_of_maxima(maxima, grid, num, divu_max)
     if num.sink == "implicit":  # ζ0 in the implicit part: SINK_COURANT/ζ0 for it, cfl_source/ζ for the rest
         r_e = r._replace(zeta0=jnp.zeros_like(r.zeta0))
         zeta0 = jnp.max(phys.cooling_rate(rho, theta, 0.0, r) - phys.cooling_rate(rho, theta, 0.0, r_e))
-        zeta_e = jnp.max(phys.cooling_rate(rho, theta, 0.0, r_e)) + jnp.max(jnp.abs(r.zeta_u)) * divu_bound
-        cooling = jnp.minimum(SINK_COURANT / zeta0, num.cfl_source / zeta_e)
-    return jnp.stack([num.cfl / jnp.max(wave), viscous, conductive, cooling])
+        zeta_e = jnp.max(phys.cooling_rate(rho, theta, 0.0, r_e)) + maxima[4] * divu_max
+        lim = lim.at[3].set(jnp.minimum(SINK_COURANT / zeta0, num.cfl_source / zeta_e))
+    return lim
+
+
+def kernel_step_limits(maxima: Any, grid: Grid, num: Numerics) -> Any:
+    """:func:`step_limits` from the maxima the stage kernel reduced (:func:`.flux_kernel.cell_fields`;
+    where :func:`kernel_limits_apply`)."""
+    return limits_of_maxima(maxima, grid, num, divu_bound(maxima, grid))
 
 
 def stable_dt(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None) -> Any:
     """Largest step of the scheme: the minimum of its limits (the IMEX scheme has no diffusive ones)."""
-    lim = step_limits(U, grid, phys, num, r)
+    return dt_of_limits(step_limits(U, grid, phys, num, r), num)
+
+
+def dt_of_limits(lim: Any, num: Numerics) -> Any:
+    """The step of the scheme from the limits of :func:`step_limits`."""
     dt = jnp.minimum(lim[0], lim[3])
     if num.scheme == "ssprk3":
         dt = jnp.minimum(dt, jnp.minimum(lim[1], lim[2]))
@@ -249,8 +296,24 @@ def kernel_stage_inputs(Uk: Any, r: Any, phys: Physics) -> tuple:
     return W, phys.eos(W[0], W[4], r), phys.transport(W[0], W[4], r), source
 
 
-def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0, r0: Any = None) -> Any:
-    """One SSP-RK3 step of size dt (``r0``: the cell coefficients of U, if already evaluated).
+def start_program(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> Any:
+    """The step-start cell program of the SSP-RK3 stage kernel — the stage closures and the
+    :data:`LIMIT_TERMS`, :func:`.flux_kernel.cell_fields` — or None where a step does not start with it
+    (no stage kernel or stage program, another scheme, the implicit sink, walls: :func:`kernel_limits_apply`)."""
+    from . import fluxes
+    from .cell_program import for_physics
+
+    if not (fluxes.CELL_PROGRAM and kernel_limits_apply(grid, num) and stage_kernel_applies(grid, phys, dtype)):
+        return None
+    if for_physics(phys, dtype) is None:  # the later stages need the stage program
+        return None
+    return for_physics(phys, dtype, limits=num.acoustics)
+
+
+def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0, r0: Any = None,
+                work: Any = None) -> Any:
+    """One SSP-RK3 step of size dt (``r0``: the cell coefficients of U, if already evaluated; ``work``:
+    the cell-program workspace of U, :func:`.flux_kernel.cell_fields`, if already evaluated).
 
     Written as three stages U_{k+1} = a_k U + (1 − a_k)(U_k + Δt L(U_k)), a = (0, 3/4, 1/3),
     in a ``fori_loop`` so the right-hand side is traced (and compiled) once, not three times.
@@ -263,13 +326,19 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
     if stage_kernel_applies(grid, phys, U[0].dtype):
         from . import fluxes
         from .cell_program import for_physics, leaf_values
-        from .flux_kernel import ssprk_stage, ssprk_stage_cells
+        from .flux_kernel import ssprk_stage, ssprk_stage_cells, ssprk_stage_padded
 
         program = for_physics(phys, U[0].dtype) if fluxes.CELL_PROGRAM else None
         if program is not None:  # the closures inside the kernel: each stage is one call
             leaf = leaf_values(phys)
-            return jax.lax.fori_loop(0, 3, lambda k, Uk: ssprk_stage_cells(
-                U, Uk, program, leaf, coef[k], dt, grid, phys.material_density, num.limiter, num.riemann), tuple(U))
+            first = 0
+            if work is not None:  # the first stage's closures are the step limits' (advance)
+                U = tuple(U)
+                first, U1 = 1, ssprk_stage_padded(U, U, work, coef[0], dt, grid, phys.material_density,
+                                                  num.limiter, num.riemann)
+            return jax.lax.fori_loop(first, 3, lambda k, Uk: ssprk_stage_cells(
+                U, Uk, program, leaf, coef[k], dt, grid, phys.material_density, num.limiter, num.riemann),
+                tuple(U) if work is None else U1)
 
         def kernel_stage(k: Any, Uk: tuple, r: Any) -> tuple:
             W, eos, transport, source = kernel_stage_inputs(Uk, r, phys)
@@ -406,14 +475,27 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
 
     def body(carry: tuple) -> tuple:
         U, t, n, _, _ = carry
-        # The closures of the step start serve both the step limits and the step's first stage.
-        r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
+        # The closures of the step start serve both the step limits and the step's first stage:
+        # evaluated by XLA, or by the stage kernel's cell program into its workspace.
+        if program is None:
+            r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
+            lim = step_limits(U, grid, phys, num, r0)
+        else:
+            from .cell_program import leaf_values
+            from .flux_kernel import cell_fields
+
+            work, maxima = cell_fields(U, program, leaf_values(phys, grid), grid)
+            lim = kernel_step_limits(maxima, grid, num)
         # Time is kept in float64 whatever the state precision, so a float32 run still lands
         # exactly on t_end.
-        dt_stable = stable_dt(U, grid, phys, num, r0).astype(t.dtype)
+        dt_stable = dt_of_limits(lim, num).astype(t.dtype)
         last = dt_stable >= t_end - t
         dt = jnp.where(last, t_end - t, dt_stable)
-        U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t, r0)
+        if program is None:
+            U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t, r0)
+        else:
+            U_new = ssprk3_step(U, dt.astype(U[0].dtype), grid, phys, num, t, work=work)
+            residual = jnp.zeros((), U[0].dtype)
         bad_state = state_status(U_new, phys)
         status = jnp.where(bad_state != 0, bad_state, jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5))
         status = jnp.where((status == 0) & ~(residual <= RESIDUAL_FAIL), 6, status)
@@ -423,6 +505,7 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         return U, t, n + good.astype(n.dtype), status, dt
 
     U = tuple(U)
+    program = start_program(grid, phys, num, U[0].dtype)
     t = jnp.asarray(t, jnp.float64)
     t_end = jnp.asarray(t_end, jnp.float64)
     init = (U, t, jnp.zeros((), jnp.int32), jnp.zeros((), jnp.int32), jnp.zeros((), jnp.float64))
