@@ -231,10 +231,11 @@ def limits_of_maxima(maxima: Any, grid: Grid, num: Numerics, divu_max: Any) -> A
     return jnp.stack([num.cfl / maxima[0], viscous, conductive, cooling])
 
 
-def kernel_limits_apply(grid: Grid, num: Numerics) -> bool:
-    """Whether the step-start maxima may come from the stage kernel (:func:`.flux_kernel.cell_fields`):
-    SSP-RK3 with the explicit sink (whose cooling limit is :func:`limits_of_maxima`'s) on a periodic grid."""
-    return num.scheme == "ssprk3" and num.sink == "explicit" and (grid.boundaries is None or grid.boundaries.all_periodic)
+def kernel_limits_apply(num: Numerics) -> bool:
+    """Whether the step-start maxima may come from the stage kernel (:func:`.flux_kernel.cell_fields`, which
+    runs on periodic grids only: :func:`stage_kernel_applies`): SSP-RK3 with the explicit sink, whose
+    cooling limit is :func:`limits_of_maxima`'s."""
+    return num.scheme == "ssprk3" and num.sink == "explicit"
 
 
 def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None) -> Any:
@@ -299,11 +300,11 @@ def kernel_stage_inputs(Uk: Any, r: Any, phys: Physics) -> tuple:
 def start_program(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> Any:
     """The step-start cell program of the SSP-RK3 stage kernel — the stage closures and the
     :data:`LIMIT_TERMS`, :func:`.flux_kernel.cell_fields` — or None where a step does not start with it
-    (no stage kernel or stage program, another scheme, the implicit sink, walls: :func:`kernel_limits_apply`)."""
+    (no stage kernel or stage program, e.g. walls; another scheme or the implicit sink: :func:`kernel_limits_apply`)."""
     from . import fluxes
     from .cell_program import for_physics
 
-    if not (fluxes.CELL_PROGRAM and kernel_limits_apply(grid, num) and stage_kernel_applies(grid, phys, dtype)):
+    if not (fluxes.CELL_PROGRAM and kernel_limits_apply(num) and stage_kernel_applies(grid, phys, dtype)):
         return None
     if for_physics(phys, dtype) is None:  # the later stages need the stage program
         return None
