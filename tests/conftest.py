@@ -28,13 +28,23 @@ def data_dir() -> Path:
 
 
 @pytest.fixture(scope="session", autouse=True)
-def _jax_x64() -> None:
-    """Closures are checked against 6-digit oracles, so JAX runs in float64 in the tests."""
+def _jax_x64(tmp_path_factory) -> None:
+    """Closures are checked against 6-digit oracles, so JAX runs in float64 in the tests.
+
+    The test processes of one run share a JAX compilation cache (in the run's temporary folder,
+    so every run starts empty): many tests compile the same step functions on the same grids.
+    Subprocesses started by tests do not use it, so they compile as a user's first run does.
+    """
     try:
         import jax
     except ImportError:  # pragma: no cover
         return
     jax.config.update("jax_enable_x64", True)
+    cache = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        cache = cache.parent
+    jax.config.update("jax_compilation_cache_dir", str(cache / "jax_cache"))
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.2)
 
 
 @pytest.fixture(scope="session")
