@@ -27,23 +27,34 @@ def data_dir() -> Path:
     return DATA
 
 
-@pytest.fixture(scope="session", autouse=True)
-def _jax_x64(tmp_path_factory) -> None:
-    """Closures are checked against 6-digit oracles, so JAX runs in float64 in the tests.
+def run_temp(tmp_path_factory) -> Path:
+    """The temporary folder of the whole test run: shared by the pytest-xdist workers, else this process's."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
 
-    The test processes of one run share a JAX compilation cache (in the run's temporary folder,
-    so every run starts empty): many tests compile the same step functions on the same grids.
-    Subprocesses started by tests do not use it, so they compile as a user's first run does.
-    """
+
+@pytest.fixture(scope="session", autouse=True)
+def _jax_x64() -> None:
+    """Closures are checked against 6-digit oracles, so JAX runs in float64 in the tests."""
     try:
         import jax
     except ImportError:  # pragma: no cover
         return
     jax.config.update("jax_enable_x64", True)
-    cache = tmp_path_factory.getbasetemp()
-    if os.environ.get("PYTEST_XDIST_WORKER"):
-        cache = cache.parent
-    jax.config.update("jax_compilation_cache_dir", str(cache / "jax_cache"))
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _jax_compilation_cache(tmp_path_factory) -> None:
+    """The test processes of one run share a JAX compilation cache in the run's temporary folder.
+
+    Many tests compile the same step functions on the same grids; every run starts with the cache
+    empty.  Subprocesses started by tests do not use it, so they compile as a user's first run does.
+    """
+    try:
+        import jax
+    except ImportError:  # pragma: no cover
+        return
+    jax.config.update("jax_compilation_cache_dir", str(run_temp(tmp_path_factory) / "jax_cache"))
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.2)
 
 
@@ -68,7 +79,7 @@ def quick_report(tmp_path_factory):
         fcntl = None
     if fcntl is None or not os.environ.get("PYTEST_XDIST_WORKER"):
         return build(own)
-    shared = tmp_path_factory.getbasetemp().parent / "quick_report"
+    shared = run_temp(tmp_path_factory) / "quick_report"
     shared.mkdir(exist_ok=True)
     record = shared / "statuses.json"
     with open(shared / "lock", "w") as lock:
