@@ -15,7 +15,7 @@ XLA expands it), so it agrees with the XLA evaluation to round-off
 (tests/test_solver_cell_program.py checks every registered model, both precisions).  The parameters
 of :class:`.Physics` (e, d, ρ_s, …) are runtime inputs, not constants, so changing them does not
 recompile; a model is compiled once per precision (≈ 1 s, cached like the kernel in
-``$KTGF_CACHE_DIR``).
+``$KTGF_CACHE_DIR`` by :mod:`.cxx`).
 
 It applies where the closures depend on the cell's own state only (no velocity gradient:
 :func:`.friction.needs_rate` false) and the jaxpr has only the primitives of :data:`_EXPRESSIONS`;
@@ -28,11 +28,6 @@ from __future__ import annotations
 import ctypes
 import functools
 import hashlib
-import os
-import platform
-import shutil
-import subprocess
-import tempfile
 from dataclasses import dataclass
 from typing import Any
 
@@ -40,6 +35,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 from jax.extend.core import Literal
+
+from .cxx import shared_library
 
 #: Outputs of a cell program, in the order the kernel stores them (its Field enum, then s0, s1); a
 #: step-start program (``limits``) adds :data:`.stepping.LIMIT_TERMS`, which the kernel reduces to maxima.
@@ -261,39 +258,9 @@ def source_for(treedef: Any, avals: tuple, dtype: Any, limits: str | None = None
     )
 
 
-def _build(source: str) -> str:
-    """Path of the compiled library of a program source (built now if not in the cache)."""
-    from .flux_kernel import _cache_dir
-
-    cxx = shutil.which(os.environ.get("CXX", "g++"))
-    if cxx is None:
-        raise RuntimeError("no C++ compiler")
-    key = hashlib.sha256(b"\0".join([source.encode(), " ".join(FLAGS).encode(), cxx.encode(),
-                                     platform.node().encode()])).hexdigest()[:16]
-    lib = _cache_dir() / f"cells-{key}.so"
-    if lib.exists():
-        return str(lib)
-    lib.parent.mkdir(parents=True, exist_ok=True)
-    fd, src = tempfile.mkstemp(suffix=".cc", dir=lib.parent)
-    with os.fdopen(fd, "w") as f:
-        f.write(source)
-    fd, tmp = tempfile.mkstemp(suffix=".so", dir=lib.parent)
-    os.close(fd)
-    try:
-        proc = subprocess.run([cxx, *FLAGS, src, "-o", tmp], capture_output=True, text=True)
-        if proc.returncode != 0:
-            raise RuntimeError(f"compiling a cell program failed: {(proc.stderr.strip().splitlines() or ['?'])[-1]}")
-        os.replace(tmp, lib)
-    finally:
-        for path in (src, tmp):
-            if os.path.exists(path):
-                os.unlink(path)
-    return str(lib)
-
-
 @functools.lru_cache(maxsize=None)
-def _compiled(source: str, dtype: Any, nlim: int) -> CellProgram:
-    function = getattr(ctypes.cdll.LoadLibrary(_build(source)), SYMBOL)
+def _compiled(source: str, dtype: Any, nlim: int, what: str) -> CellProgram:
+    function = getattr(ctypes.cdll.LoadLibrary(str(shared_library("cells", source, FLAGS, what, "1 s"))), SYMBOL)
     key = int(hashlib.sha256(source.encode()).hexdigest()[:15], 16)  # < 2^60: an int64 attribute
     return CellProgram(source, key, np.dtype(dtype), function, nlim)
 
@@ -302,8 +269,11 @@ def _compiled(source: str, dtype: Any, nlim: int) -> CellProgram:
 def _program(treedef: Any, avals: tuple, dtype: Any, limits: str | None) -> CellProgram | None:
     from .stepping import LIMIT_TERMS
 
+    model = jax.tree_util.tree_unflatten(treedef, avals).model.name
+    what = f"the {'step-start ' if limits else ''}cell program of {model} ({np.dtype(dtype).name})"
     try:
-        return _compiled(source_for(treedef, avals, dtype, limits), dtype, 0 if limits is None else len(LIMIT_TERMS))
+        return _compiled(source_for(treedef, avals, dtype, limits), dtype, 0 if limits is None else len(LIMIT_TERMS),
+                         what)
     except (Unsupported, RuntimeError, OSError):
         return None
 
