@@ -7,6 +7,8 @@ Each topic lives in its own module exposing ``register(app, plot_app)``; the mod
 from __future__ import annotations
 
 import importlib
+import logging
+import sys
 
 import typer
 
@@ -51,6 +53,22 @@ for _name in COMMAND_MODULES:
     _mod.register(app, plot_app)
 
 
+def show_info() -> None:
+    """Shows the INFO records of the ``ktgf`` logger (e.g. that the C++ flux kernel is being compiled, which
+    takes seconds the first time) on stderr, unless the ``ktgf`` logger already has a handler.
+
+    Library use stays silent: without a handler only warnings and errors reach stderr (Python's last resort).
+    """
+    logger = logging.getLogger("ktgf")
+    if not logger.handlers:
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("ktgf: %(message)s"))
+        logger.addHandler(handler)
+        if logger.level == logging.NOTSET:
+            logger.setLevel(logging.INFO)
+
+
 def main() -> None:
     """Entry point of the ``ktgf`` console script."""
+    show_info()
     app()
