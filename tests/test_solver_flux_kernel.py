@@ -7,12 +7,19 @@ both time schemes and two closure models.  The fused SSP-RK3 stage (:func:`.flux
 is checked the same way, in both precisions and with a frictional model, and its energy source
 s0 + s1∇·u against :func:`~ktgf.solver.sources.cooling_source` for every registered model.  Also:
 where the kernel does not apply it is not used, and without a compiler the solver falls back to
-the JAX path with one warning.
+the JAX path with one warning.  The build: one library per variant instantiates the face sweep once,
+refuses calls of another variant, is built once by two processes that need it at the same time, and
+is announced (INFO on the ``ktgf`` logger, which the command line shows).
 """
 
 from __future__ import annotations
 
+import logging
+import os
 import re
+import shutil
+import subprocess
+import sys
 
 import jax
 import jax.numpy as jnp
@@ -125,9 +132,21 @@ def test_without_a_compiler_the_jax_path_runs_with_one_warning(monkeypatch, tmp_
     monkeypatch.setenv("CXX", "no-such-compiler-ktgf")
     monkeypatch.setenv("KTGF_CACHE_DIR", str(tmp_path))
     monkeypatch.setattr(flux_kernel, "_loaded", {})
+    builds = []
+    build = flux_kernel.build
+    monkeypatch.setattr(flux_kernel, "build", lambda v: builds.append(v) or build(v))
     with pytest.warns(RuntimeWarning, match="flux kernel unavailable.*no-such-compiler-ktgf"):
-        assert not flux_kernel.applies(_grid(), jnp.float64)
-    assert not flux_kernel.applies(_grid(), jnp.float64)  # decided once: no second warning, no retry
+        assert not flux_kernel.applies(_grid(), jnp.float64, "rhs", "vanleer", "hll")
+    # Decided once: no second warning (an error here, pyproject's filterwarnings), no retry of any variant.
+    assert not flux_kernel.applies(_grid(), jnp.float64, "rhs", "vanleer", "hll")
+    assert not flux_kernel.applies(_grid(), jnp.float32, "stage", "minmod", "rusanov")
+    assert not flux_kernel.available()
+    assert len(builds) == 1
+    U = _state(_grid(), _physics("ret"), jnp.float64)
+    text = _with_kernel(True, lambda: jax.jit(lambda U: ssprk3_step(U, 1e-6, _grid(), _physics("ret"), Numerics(
+        scheme="ssprk3"))).lower(U).as_text())
+    assert not any(base in text for base in (flux_kernel.TARGET, flux_kernel.STAGE_TARGET,
+                                             flux_kernel.CELLS_PAD_TARGET))
 
 
 def _steps(U, grid, phys, num, steps: int = 3):
@@ -189,11 +208,14 @@ def test_fused_stage_is_in_the_compiled_step_only_where_it_applies() -> None:
     def hlo(phys: Physics) -> str:
         return jax.jit(lambda U: ssprk3_step(U, 1e-6, grid, phys, num)).lower(U).as_text()
 
-    def calls(text: str, target: str) -> bool:
-        return re.search(rf"\b{target}\b", text) is not None  # ktgf_ssprk_stage is a prefix of the cells target
+    def calls(text: str, base: str) -> bool:
+        # A variant's target is the base name, "__", the variant (ktgf_ssprk_stage is a prefix of the cells target).
+        return re.search(rf"\b{base}__", text) is not None
 
     text = _with_kernel(True, lambda: hlo(phys))
     assert calls(text, flux_kernel.CELLS_TARGET)  # RET: the closures by a cell program, in the stage kernel
+    stage = flux_kernel.variant(jnp.float64, num.limiter, num.riemann, "stage")
+    assert f"@{flux_kernel.target(flux_kernel.CELLS_TARGET, stage)}(" in text  # the variant of the step's numerics
     assert not calls(text, flux_kernel.TARGET) and not calls(text, flux_kernel.STAGE_TARGET)
     text = _with_kernel(True, lambda: hlo(phys), cells=False)
     assert calls(text, flux_kernel.STAGE_TARGET) and not calls(text, flux_kernel.TARGET)  # the stage does the fluxes
@@ -245,7 +267,8 @@ def test_step_limits_reduced_in_the_kernel(model: str, dtype) -> None:
     num = Numerics(scheme="ssprk3")
     program = _with_kernel(True, lambda: start_program(grid, phys, num, dtype))
     assert program is not None and program.nlim == len(LIMIT_TERMS)
-    reduce = jax.jit(lambda U: flux_kernel.cell_fields(U, program, leaf_values(phys, grid), grid)[1])
+    reduce = jax.jit(lambda U: flux_kernel.cell_fields(U, program, leaf_values(phys, grid), grid, num.limiter,
+                                                       num.riemann)[1])
     got = np.asarray(kernel_step_limits(reduce(U), grid, num), np.float64)
     want = np.asarray(jax.jit(lambda U: step_limits(U, grid, phys, num))(tuple(jnp.asarray(u, jnp.float64) for u in U)))
     tol = 1e-13 if dtype == jnp.float64 else 1e-5  # float32: the cell program's rounding (< 128 ε₃₂)
@@ -260,3 +283,105 @@ def test_step_limits_reduced_in_the_kernel(model: str, dtype) -> None:
     cold[4] = cold[4].at[5, 7, 9].set(0.5 * (cold[1][5, 7, 9] ** 2 + cold[2][5, 7, 9] ** 2 + cold[3][5, 7, 9] ** 2)
                                       / cold[0][5, 7, 9] * 0.5)  # kinetic energy > E: θ < 0 in the last cell of a thread
     assert np.isnan(np.asarray(reduce(tuple(cold)))[0])  # c = √(θg) is NaN there
+
+
+def _sweeps(library) -> set[tuple[str, ...]]:
+    """The template arguments (type, limiter, Riemann solver, viscous, output) of the sweeps in a library."""
+    symbols = subprocess.run(["nm", "-C", str(library)], capture_output=True, text=True, check=True).stdout
+    return set(re.findall(r"sweep<(\w+), (\d), (\d), (true|false), \(anonymous namespace\)::(\w+)<", symbols))
+
+
+@pytest.mark.skipif(shutil.which("nm") is None, reason="needs nm (binutils)")
+def test_a_variant_library_compiles_the_sweep_once() -> None:
+    """Each library holds the one face sweep of its variant (a build compiles one, not 64) and the entries of
+    its kind."""
+    cases = [(flux_kernel.DEFAULT, ("double", "1", "0", "true", "Stage")),  # the variants the tests above use
+             (flux_kernel.variant(jnp.float64, "minmod", "rusanov", "rhs"), ("double", "0", "1", "true", "Rhs")),
+             (flux_kernel.variant(jnp.float64, "mc", "hll", "euler"), ("double", "2", "0", "false", "Rhs"))]
+    for v, sweep in cases:
+        library = flux_kernel.build(v)
+        assert _sweeps(library) == {sweep}, v
+        exported = subprocess.run(["nm", "-D", "--defined-only", str(library)], capture_output=True, text=True,
+                                  check=True).stdout
+        entries = set(re.findall(r"\b(Ktgf\w+)", exported))
+        assert entries == set(flux_kernel.ENTRIES[v.kind]) | ({"KtgfRegisterCells"} if v.kind == "stage" else set())
+
+
+def test_a_library_refuses_a_call_of_another_variant(monkeypatch) -> None:
+    """Every call goes to the float64 vanleer/hll viscous library here: a call that asks for another
+    precision, limiter, Riemann solver or viscous flag is an error, never that library's result."""
+    grid, phys = _grid(), _physics("ret")
+
+    def divergence(dtype, limiter: str, riemann: str, viscous: bool):
+        U = _state(grid, phys, dtype)
+        W, eos, transport, _ = kernel_stage_inputs(U, cell_coefficients(primitive_fields(U), grid, phys), phys)
+        return jax.jit(lambda: flux_kernel.flux_divergence(W, eos, transport, grid, RHO_S, limiter, riemann,
+                                                           viscous))()
+
+    want = divergence(jnp.float64, "vanleer", "hll", True)
+    target = flux_kernel._target
+    monkeypatch.setattr(flux_kernel, "_target", lambda base, *args: target(base, jnp.float64, "vanleer", "hll", "rhs"))
+    got = divergence(jnp.float64, "vanleer", "hll", True)
+    assert _close(got[0], want[0]) == 0.0 and float(jnp.max(jnp.abs(got[1] - want[1]))) == 0.0
+    others = [(jnp.float64, "minmod", "hll", True, "float64 minmod/hll viscous"),
+              (jnp.float64, "vanleer", "rusanov", True, "float64 vanleer/rusanov viscous"),
+              (jnp.float64, "vanleer", "hll", False, "float64 vanleer/hll inviscid"),
+              (jnp.float32, "vanleer", "hll", True, "float32 vanleer/hll viscous")]
+    for dtype, limiter, riemann, viscous, asked in others:
+        with pytest.raises(jax.errors.JaxRuntimeError,
+                           match=f"built for float64 vanleer/hll viscous, the call asks for {asked}"):
+            jax.block_until_ready(divergence(dtype, limiter, riemann, viscous))
+
+
+def test_two_processes_build_a_variant_once(tmp_path) -> None:
+    """Two processes that need the same variant at the same time: one compiles, the other waits and loads it."""
+    script = ("import logging; logging.basicConfig(level=logging.INFO, format='%(message)s')\n"
+              "from ktgf.solver import flux_kernel as k\n"
+              "print(k.build(k.Variant('float32', 'none', 'rusanov', 'euler')))")
+    env = {**os.environ, "KTGF_CACHE_DIR": str(tmp_path)}
+    procs = [subprocess.Popen([sys.executable, "-c", script], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True) for _ in range(2)]
+    outs = [proc.communicate(timeout=600) for proc in procs]
+    assert [proc.returncode for proc in procs] == [0, 0], outs
+    libraries = {out.strip() for out, _ in outs}
+    assert len(libraries) == 1
+    assert sorted(f.name for f in tmp_path.iterdir() if f.suffix != ".lock") == [os.path.basename(libraries.pop())]
+    logs = "".join(err for _, err in outs)  # one build; the other process may say it waits for it
+    assert len(re.findall(r"^compiling the CPU flux kernel for float32 none/rusanov euler ", logs, re.M)) == 1, logs
+    assert len(re.findall(r"^compiled ", logs, re.M)) == 1, logs
+
+
+def test_a_build_is_announced_once(monkeypatch, tmp_path, caplog) -> None:
+    """A build logs that it starts (what, and that it is once per machine) and its time; the cache hit after it,
+    nothing."""
+    compiler = tmp_path / "fake-cxx"  # writes an empty "library": only the announcement is checked here
+    compiler.write_text('#!/bin/sh\nfor last; do :; done\n: > "$last"\n')
+    compiler.chmod(0o755)
+    monkeypatch.setenv("CXX", str(compiler))
+    monkeypatch.setenv("KTGF_CACHE_DIR", str(tmp_path / "cache"))
+    v = flux_kernel.variant(jnp.float32, "mc", "rusanov", "stage")
+    with caplog.at_level(logging.INFO, logger="ktgf"):
+        assert flux_kernel.build(v) == flux_kernel.build(v)
+    messages = [r.getMessage() for r in caplog.records if r.name.startswith("ktgf")]
+    assert len(messages) == 2, messages
+    assert messages[0] == "compiling the CPU flux kernel for float32 mc/rusanov stage (once per machine, about 10-15 s)"
+    assert re.fullmatch(r"compiled the CPU flux kernel for float32 mc/rusanov stage in \d+\.\d s", messages[1])
+
+
+def test_the_command_line_shows_the_build_messages(capsys) -> None:
+    """Library use is silent at INFO; the ``ktgf`` command's entry shows the ``ktgf`` INFO records on stderr."""
+    from ktgf.cli import show_info
+
+    logger, record = logging.getLogger("ktgf"), logging.getLogger("ktgf.solver.cxx")
+    saved = list(logger.handlers), logger.level
+    try:
+        logger.handlers.clear()
+        logger.setLevel(logging.NOTSET)
+        record.info("compiling something")
+        assert "compiling something" not in capsys.readouterr().err
+        show_info()
+        record.info("compiling something")
+        assert capsys.readouterr().err == "ktgf: compiling something\n"
+    finally:
+        logger.handlers[:] = saved[0]
+        logger.setLevel(saved[1])

@@ -33,11 +33,21 @@
 // cache (measured 1.3x faster at 64^3 than whole planes); each cell's MUSCL slope along an axis is kept for
 // the second face it serves (measured 1.1x faster single-threaded at 64^3, bit-identical output).  Reading the unpadded fields with
 // periodic index arithmetic instead of the padded copy was tried and measured 1.9x slower.
+//
+// Build: one library per variant (flux_kernel.py, Variant), selected by macros: the precision
+// (-DKTGF_REAL=double|float), the limiter and the Riemann solver (-DKTGF_LIMITER, -DKTGF_RIEMANN: indices of
+// fluxes.LIMITERS and fluxes.RIEMANN_SOLVERS) and the kind (-DKTGF_KIND): KTGF_RHS and KTGF_EULER hold
+// KtgfFluxDivergence with and without the viscous fluxes, KTGF_STAGE the four stage entries and
+// KtgfRegisterCells (its own registry of cell programs).  Each library instantiates the sweep once, so a
+// build takes seconds, not the minutes of all variants at once; its handlers refuse (InvalidArgument) a call
+// that asks for another precision, limiter, Riemann solver or viscous flag than the library's.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <mutex>
+#include <string>
+#include <type_traits>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -380,64 +390,102 @@ void sweep(const T* const* P, const Consts<T>& k, const Out& o) {
   }
 }
 
-template <class T, int LIM, int RIE, class Out>
-void dispatch_visc(bool viscous, const T* const* P, const Consts<T>& k, const Out& o) {
-  if (viscous) sweep<T, LIM, RIE, true>(P, k, o);
-  else sweep<T, LIM, RIE, false>(P, k, o);
+// The variant this library is built for, from the -D macros of flux_kernel.py (one library per variant, built
+// when first needed): it instantiates `sweep` once, which is most of what a build costs (7-15 s here; the
+// 64 instantiations of the library of all variants took 6 minutes).
+#define KTGF_RHS 0    // KtgfFluxDivergence with the viscous fluxes
+#define KTGF_EULER 1  // KtgfFluxDivergence without them
+#define KTGF_STAGE 2  // KtgfSsprkStage, KtgfSsprkStageCells, KtgfCellsPad, KtgfSsprkStagePadded, KtgfRegisterCells
+#if !defined(KTGF_REAL) || !defined(KTGF_LIMITER) || !defined(KTGF_RIEMANN) || !defined(KTGF_KIND)
+#error "build with -DKTGF_REAL=double|float -DKTGF_LIMITER=0..3 -DKTGF_RIEMANN=0..1 -DKTGF_KIND=0..2 (flux_kernel.py)"
+#endif
+#if KTGF_KIND != KTGF_RHS && KTGF_KIND != KTGF_EULER && KTGF_KIND != KTGF_STAGE
+#error "KTGF_KIND must be KTGF_RHS, KTGF_EULER or KTGF_STAGE"
+#endif
+using Real = KTGF_REAL;
+static_assert(std::is_same<Real, double>::value || std::is_same<Real, float>::value, "KTGF_REAL: double or float");
+static_assert(KTGF_LIMITER >= MINMOD && KTGF_LIMITER <= NONE, "KTGF_LIMITER: an index of fluxes.LIMITERS");
+static_assert(KTGF_RIEMANN == HLL || KTGF_RIEMANN == RUSANOV, "KTGF_RIEMANN: an index of fluxes.RIEMANN_SOLVERS");
+constexpr ffi::DataType BUILT_TYPE = std::is_same<Real, double>::value ? ffi::F64 : ffi::F32;
+constexpr bool BUILT_VISCOUS = KTGF_KIND != KTGF_EULER;
+
+std::string variant_name(ffi::DataType type, int limiter, int riemann, bool viscous) {
+  static const char* const limiters[] = {"minmod", "vanleer", "mc", "none"};  // fluxes.LIMITERS
+  static const char* const riemanns[] = {"hll", "rusanov"};                   // fluxes.RIEMANN_SOLVERS
+  const std::string lim = limiter >= 0 && limiter <= NONE ? limiters[limiter] : "limiter " + std::to_string(limiter);
+  const std::string rie = riemann >= 0 && riemann <= RUSANOV ? riemanns[riemann] : "riemann " + std::to_string(riemann);
+  const char* precision = type == ffi::F64 ? "float64" : type == ffi::F32 ? "float32" : "a non-float type";
+  return std::string(precision) + " " + lim + "/" + rie + (viscous ? " viscous" : " inviscid");
 }
 
-template <class T, int LIM, class Out>
-void dispatch_riemann(int riemann, bool viscous, const T* const* P, const Consts<T>& k, const Out& o) {
-  if (riemann == RUSANOV) dispatch_visc<T, LIM, RUSANOV>(viscous, P, k, o);
-  else dispatch_visc<T, LIM, HLL>(viscous, P, k, o);
+// Success if a call of `entry` asks for the variant this library computes, else the error that says both: a
+// library never computes another variant than the one it was built for.
+ffi::Error check_variant(const char* entry, ffi::DataType type, int limiter, int riemann, bool viscous) {
+  if (type == BUILT_TYPE && limiter == KTGF_LIMITER && riemann == KTGF_RIEMANN && viscous == BUILT_VISCOUS)
+    return ffi::Error::Success();
+  return ffi::Error::InvalidArgument(std::string(entry) + ": this library is built for " +
+                                     variant_name(BUILT_TYPE, KTGF_LIMITER, KTGF_RIEMANN, BUILT_VISCOUS) +
+                                     ", the call asks for " + variant_name(type, limiter, riemann, viscous));
 }
 
 // Sweeps the padded fields in `work` (NFIELD or GG + 1 of them, each of the padded shape of n) with the output `o`.
-template <class T, class Out>
-ffi::Error sweep_padded(const long* n, const double* params, int limiter, int riemann, bool viscous, const T* work,
-                        const Out& o) {
-  Consts<T> k;
+template <class Out>
+void sweep_padded(const long* n, const double* params, const Real* work, const Out& o) {
+  Consts<Real> k;
   for (int a = 0; a < 3; ++a) k.n[a] = n[a];
-  const int nfield = viscous ? NFIELD : GG + 1;
+  const int nfield = BUILT_VISCOUS ? NFIELD : GG + 1;
   const long m[3] = {k.n[0] + 2 * GHOST, k.n[1] + 2 * GHOST, k.n[2] + 2 * GHOST};
-  std::vector<const T*> P(NFIELD, nullptr);
+  std::vector<const Real*> P(NFIELD, nullptr);
   for (int f = 0; f < nfield; ++f) P[f] = work + f * m[0] * m[1] * m[2];
   k.stride[0] = m[1] * m[2];
   k.stride[1] = m[2];
   k.stride[2] = 1;
   const double rho_s = params[3];
   for (int a = 0; a < 3; ++a) {
-    k.inv_dx[a] = T(1.0 / params[a]);
-    k.half_inv_dx[a] = T(0.5 / params[a]);
-    k.omega_factor[a] = T((1.0 / params[a]) / rho_s);
+    k.inv_dx[a] = Real(1.0 / params[a]);
+    k.half_inv_dx[a] = Real(0.5 / params[a]);
+    k.omega_factor[a] = Real((1.0 / params[a]) / rho_s);
   }
-  switch (limiter) {
-    case MINMOD: dispatch_riemann<T, MINMOD>(riemann, viscous, P.data(), k, o); break;
-    case VANLEER: dispatch_riemann<T, VANLEER>(riemann, viscous, P.data(), k, o); break;
-    case MC: dispatch_riemann<T, MC>(riemann, viscous, P.data(), k, o); break;
-    case NONE: dispatch_riemann<T, NONE>(riemann, viscous, P.data(), k, o); break;
-    default: return ffi::Error::InvalidArgument("flux kernel: unknown limiter");
-  }
-  return ffi::Error::Success();
+  sweep<Real, KTGF_LIMITER, KTGF_RIEMANN, BUILT_VISCOUS>(P.data(), k, o);
 }
 
 // Pads the cell fields into `work` and sweeps them with the output `o` (Rhs or Stage).
-template <class T, class Out>
-ffi::Error run(const ffi::AnyBuffer* in, const double* params, int limiter, int riemann, bool viscous, T* work,
-               const Out& o) {
+template <class Out>
+ffi::Error run(const ffi::AnyBuffer* in, const double* params, Real* work, const Out& o) {
   auto dims = in[0].dimensions();
   if (dims.size() != 3) return ffi::Error::InvalidArgument("flux kernel: fields must be 3D");
   long n[3];
   for (int a = 0; a < 3; ++a) n[a] = long(dims[a]);
   if (n[0] < GHOST || n[1] < GHOST || n[2] < GHOST)
     return ffi::Error::InvalidArgument("flux kernel: at least 2 cells per axis");
-  const int nfield = viscous ? NFIELD : GG + 1;
-  std::vector<const T*> fields(NFIELD, nullptr);
-  for (int f = 0; f < nfield; ++f) fields[f] = in[f].typed_data<T>();
-  pad<T>(fields.data(), nfield, n, work);
-  return sweep_padded<T>(n, params, limiter, riemann, viscous, work, o);
+  const int nfield = BUILT_VISCOUS ? NFIELD : GG + 1;
+  std::vector<const Real*> fields(NFIELD, nullptr);
+  for (int f = 0; f < nfield; ++f) fields[f] = in[f].typed_data<Real>();
+  pad<Real>(fields.data(), nfield, n, work);
+  sweep_padded(n, params, work, o);
+  return ffi::Error::Success();
 }
 
+#if KTGF_KIND != KTGF_STAGE
+ffi::Error flux_divergence(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer uy, ffi::AnyBuffer uz,
+                           ffi::AnyBuffer theta, ffi::AnyBuffer pstar, ffi::AnyBuffer g, ffi::AnyBuffer eta,
+                           ffi::AnyBuffer lam, ffi::AnyBuffer kap, ffi::AnyBuffer omega,
+                           ffi::Buffer<ffi::F64> params, int32_t limiter,
+                           int32_t riemann, int32_t viscous, ffi::Result<ffi::AnyBuffer> d0,
+                           ffi::Result<ffi::AnyBuffer> d1, ffi::Result<ffi::AnyBuffer> d2,
+                           ffi::Result<ffi::AnyBuffer> d3, ffi::Result<ffi::AnyBuffer> d4,
+                           ffi::Result<ffi::AnyBuffer> divu, ffi::Result<ffi::AnyBuffer> work) {
+  const ffi::AnyBuffer in[NFIELD] = {rho, ux, uy, uz, theta, pstar, g, eta, lam, kap, omega};
+  if (params.element_count() != 4) return ffi::Error::InvalidArgument("flux kernel: params = (dx, dy, dz, rho_s)");
+  if (auto err = check_variant("KtgfFluxDivergence", rho.element_type(), limiter, riemann, viscous != 0);
+      err.failure())
+    return err;
+  const Rhs<Real> o{{d0->typed_data<Real>(), d1->typed_data<Real>(), d2->typed_data<Real>(), d3->typed_data<Real>(),
+                     d4->typed_data<Real>()},
+                    divu->typed_data<Real>()};
+  return run(in, params.typed_data(), work->typed_data<Real>(), o);
+}
+#else
 // Cell programs (ktgf.solver.cell_program), by key: f(n, params, in[5], out[NFIELD + 2 + nlim]) over n cells,
 // in = the conservative fields, out = the NFIELD cell fields, then s0, s1, then (a step-start program) the
 // nlim cell terms whose maxima give the step limits.
@@ -523,51 +571,6 @@ void cells_pad(CellsFn<T> fn, const double* leaf, const T* const* U, const long*
   }
 }
 
-template <class T>
-ffi::Error rhs_typed(const ffi::AnyBuffer* in, const double* params, int limiter, int riemann, bool viscous,
-                     void* const* out) {
-  Rhs<T> o;
-  for (int v = 0; v < 5; ++v) o.dU[v] = static_cast<T*>(out[v]);
-  o.divu = static_cast<T*>(out[5]);
-  return run<T>(in, params, limiter, riemann, viscous, static_cast<T*>(out[6]), o);
-}
-
-ffi::Error flux_divergence(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer uy, ffi::AnyBuffer uz,
-                           ffi::AnyBuffer theta, ffi::AnyBuffer pstar, ffi::AnyBuffer g, ffi::AnyBuffer eta,
-                           ffi::AnyBuffer lam, ffi::AnyBuffer kap, ffi::AnyBuffer omega,
-                           ffi::Buffer<ffi::F64> params, int32_t limiter,
-                           int32_t riemann, int32_t viscous, ffi::Result<ffi::AnyBuffer> d0,
-                           ffi::Result<ffi::AnyBuffer> d1, ffi::Result<ffi::AnyBuffer> d2,
-                           ffi::Result<ffi::AnyBuffer> d3, ffi::Result<ffi::AnyBuffer> d4,
-                           ffi::Result<ffi::AnyBuffer> divu, ffi::Result<ffi::AnyBuffer> work) {
-  const ffi::AnyBuffer in[NFIELD] = {rho, ux, uy, uz, theta, pstar, g, eta, lam, kap, omega};
-  void* const out[7] = {d0->untyped_data(), d1->untyped_data(), d2->untyped_data(), d3->untyped_data(),
-                        d4->untyped_data(), divu->untyped_data(), work->untyped_data()};
-  if (params.element_count() != 4) return ffi::Error::InvalidArgument("flux kernel: params = (dx, dy, dz, rho_s)");
-  switch (rho.element_type()) {
-    case ffi::F64: return rhs_typed<double>(in, params.typed_data(), limiter, riemann, viscous != 0, out);
-    case ffi::F32: return rhs_typed<float>(in, params.typed_data(), limiter, riemann, viscous != 0, out);
-    default: return ffi::Error::InvalidArgument("flux kernel: fields must be float32 or float64");
-  }
-}
-
-template <class T>
-ffi::Error stage_typed(const ffi::AnyBuffer* in, ffi::RemainingArgs state, const double* params, int limiter,
-                       int riemann, void* const* out) {
-  Stage<T> o;
-  for (int v = 0; v < 5; ++v) {
-    o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<T>();
-    o.Uk[v] = state.get<ffi::AnyBuffer>(5 + v)->typed_data<T>();
-    o.U[v] = static_cast<T*>(out[v]);
-  }
-  o.s0 = state.get<ffi::AnyBuffer>(10)->typed_data<T>();
-  o.s1 = state.get<ffi::AnyBuffer>(11)->typed_data<T>();
-  o.a = T(params[4]);
-  o.b = T(1) - o.a;  // as the JAX path: 1 - a in the state precision
-  o.dt = T(params[5]);
-  return run<T>(in, params, limiter, riemann, true, static_cast<T*>(out[5]), o);
-}
-
 ffi::Error ssprk_stage(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer uy, ffi::AnyBuffer uz,
                        ffi::AnyBuffer theta, ffi::AnyBuffer pstar, ffi::AnyBuffer g, ffi::AnyBuffer eta,
                        ffi::AnyBuffer lam, ffi::AnyBuffer kap, ffi::AnyBuffer omega, ffi::Buffer<ffi::F64> params,
@@ -575,8 +578,8 @@ ffi::Error ssprk_stage(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer uy,
                        ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2, ffi::Result<ffi::AnyBuffer> u3,
                        ffi::Result<ffi::AnyBuffer> u4, ffi::Result<ffi::AnyBuffer> work) {
   const ffi::AnyBuffer in[NFIELD] = {rho, ux, uy, uz, theta, pstar, g, eta, lam, kap, omega};
-  void* const out[6] = {u0->untyped_data(), u1->untyped_data(), u2->untyped_data(), u3->untyped_data(),
-                        u4->untyped_data(), work->untyped_data()};
+  void* const out[5] = {u0->untyped_data(), u1->untyped_data(), u2->untyped_data(), u3->untyped_data(),
+                        u4->untyped_data()};
   if (params.element_count() != 6)
     return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
   if (state.size() != 12) return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5, s0, s1)");
@@ -585,11 +588,20 @@ ffi::Error ssprk_stage(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer uy,
     if (!b.has_value() || b->element_type() != rho.element_type() || b->element_count() != rho.element_count())
       return ffi::Error::InvalidArgument("stage kernel: U0, Uk, s0, s1 must be cell fields of the state precision");
   }
-  switch (rho.element_type()) {
-    case ffi::F64: return stage_typed<double>(in, state, params.typed_data(), limiter, riemann, out);
-    case ffi::F32: return stage_typed<float>(in, state, params.typed_data(), limiter, riemann, out);
-    default: return ffi::Error::InvalidArgument("stage kernel: fields must be float32 or float64");
+  if (auto err = check_variant("KtgfSsprkStage", rho.element_type(), limiter, riemann, true); err.failure()) return err;
+  Stage<Real> o;
+  for (int v = 0; v < 5; ++v) {
+    o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<Real>();
+    o.Uk[v] = state.get<ffi::AnyBuffer>(5 + v)->typed_data<Real>();
+    o.U[v] = static_cast<Real*>(out[v]);
   }
+  const double* p = params.typed_data();
+  o.s0 = state.get<ffi::AnyBuffer>(10)->typed_data<Real>();
+  o.s1 = state.get<ffi::AnyBuffer>(11)->typed_data<Real>();
+  o.a = Real(p[4]);
+  o.b = Real(1) - o.a;  // as the JAX path: 1 - a in the state precision
+  o.dt = Real(p[5]);
+  return run(in, p, work->typed_data<Real>(), o);
 }
 
 // The grid shape of a 3D cell field, or an error.
@@ -604,33 +616,21 @@ ffi::Error grid_shape(const ffi::AnyBuffer& field, long* n) {
 
 // The stage output of the state (U0, Uk = the RemainingArgs 0..9) whose padded cell fields and source
 // coefficients s0, s1 are in `work` (NFIELD padded fields, then s0 and s1).
-template <class T>
-Stage<T> stage_of(ffi::RemainingArgs state, const long* n, const double* params, const T* work, void* const* out) {
-  Stage<T> o;
+Stage<Real> stage_of(ffi::RemainingArgs state, const long* n, const double* params, const Real* work,
+                     void* const* out) {
+  Stage<Real> o;
   for (int v = 0; v < 5; ++v) {
-    o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<T>();
-    o.Uk[v] = state.get<ffi::AnyBuffer>(5 + v)->typed_data<T>();
-    o.U[v] = static_cast<T*>(out[v]);
+    o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<Real>();
+    o.Uk[v] = state.get<ffi::AnyBuffer>(5 + v)->typed_data<Real>();
+    o.U[v] = static_cast<Real*>(out[v]);
   }
   const long M = (n[0] + 2 * GHOST) * (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST), N = n[0] * n[1] * n[2];
   o.s0 = work + NFIELD * M;
   o.s1 = o.s0 + N;
-  o.a = T(params[4]);
-  o.b = T(1) - o.a;
-  o.dt = T(params[5]);
+  o.a = Real(params[4]);
+  o.b = Real(1) - o.a;
+  o.dt = Real(params[5]);
   return o;
-}
-
-template <class T>
-ffi::Error stage_cells_typed(ffi::RemainingArgs state, const double* params, const double* leaf, int limiter,
-                             int riemann, void* fn, void* const* out) {
-  long n[3];
-  if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
-  T* work = static_cast<T*>(out[5]);
-  const Stage<T> o = stage_of<T>(state, n, params, work, out);
-  // Uk is read whole here, before the sweep writes U' over it.
-  cells_pad<T>(reinterpret_cast<CellsFn<T>>(fn), leaf, o.Uk, n, work, const_cast<T*>(o.s0), const_cast<T*>(o.s1));
-  return sweep_padded<T>(n, params, limiter, riemann, true, work, o);
 }
 
 // The cell program registered under `program`, checked against the precision of `type`.
@@ -662,44 +662,30 @@ ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& ty
 
 // KtgfCellsPad: the cell fields and source coefficients of Uk by a step-start cell program, into the
 // workspace layout of KtgfSsprkStageCells, and the maxima of the program's `nlim` limit terms (from which
-// the step size is computed before KtgfSsprkStagePadded runs the first stage on this workspace).
-template <class T>
-ffi::Error cells_typed(ffi::RemainingArgs state, const double* leaf, void* fn, int nlim, void* out, void* maxima) {
-  long n[3];
-  if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
-  const T* U[5];
-  for (int v = 0; v < 5; ++v) U[v] = state.get<ffi::AnyBuffer>(v)->typed_data<T>();
-  T* work = static_cast<T*>(out);
-  const long M = (n[0] + 2 * GHOST) * (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST), N = n[0] * n[1] * n[2];
-  cells_pad<T>(reinterpret_cast<CellsFn<T>>(fn), leaf, U, n, work, work + NFIELD * M, work + NFIELD * M + N, nlim,
-               static_cast<T*>(maxima));
-  return ffi::Error::Success();
-}
-
+// the step size is computed before KtgfSsprkStagePadded runs the first stage on this workspace).  It does not
+// depend on the limiter or the Riemann solver; Python calls the one of the stage library of the step.
 ffi::Error cells(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state, int64_t program, int32_t nlim,
                  ffi::Result<ffi::AnyBuffer> work, ffi::Result<ffi::AnyBuffer> maxima) {
   if (state.size() != 5) return ffi::Error::InvalidArgument("cells kernel: state = Uk x5");
   ffi::DataType type;
   if (auto err = same_fields(state, 5, type); err.failure()) return err;
+  if (auto err = check_variant("KtgfCellsPad", type, KTGF_LIMITER, KTGF_RIEMANN, true); err.failure()) return err;
   if (nlim < 0 || long(maxima->element_count()) != nlim || maxima->element_type() != type)
     return ffi::Error::InvalidArgument("cells kernel: maxima must be nlim values of the state precision");
   CellProgram p{nullptr, 0};
   if (auto err = find_program(program, type, p); err.failure()) return err;
-  if (type == ffi::F64)
-    return cells_typed<double>(state, leaf.typed_data(), p.fn, nlim, work->untyped_data(), maxima->untyped_data());
-  return cells_typed<float>(state, leaf.typed_data(), p.fn, nlim, work->untyped_data(), maxima->untyped_data());
+  long n[3];
+  if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
+  const Real* U[5];
+  for (int v = 0; v < 5; ++v) U[v] = state.get<ffi::AnyBuffer>(v)->typed_data<Real>();
+  Real* w = work->typed_data<Real>();
+  const long M = (n[0] + 2 * GHOST) * (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST), N = n[0] * n[1] * n[2];
+  cells_pad<Real>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(), U, n, w, w + NFIELD * M,
+                  w + NFIELD * M + N, nlim, maxima->typed_data<Real>());
+  return ffi::Error::Success();
 }
 
 // KtgfSsprkStagePadded: the stage of KtgfSsprkStageCells from a workspace that KtgfCellsPad wrote.
-template <class T>
-ffi::Error stage_padded_typed(ffi::RemainingArgs state, const double* params, int limiter, int riemann,
-                              void* const* out) {
-  long n[3];
-  if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
-  const T* work = state.get<ffi::AnyBuffer>(10)->typed_data<T>();
-  return sweep_padded<T>(n, params, limiter, riemann, true, work, stage_of<T>(state, n, params, work, out));
-}
-
 ffi::Error ssprk_stage_padded(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs state, int32_t limiter,
                               int32_t riemann, ffi::Result<ffi::AnyBuffer> u0, ffi::Result<ffi::AnyBuffer> u1,
                               ffi::Result<ffi::AnyBuffer> u2, ffi::Result<ffi::AnyBuffer> u3,
@@ -711,15 +697,16 @@ ffi::Error ssprk_stage_padded(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs s
   if (state.size() != 11) return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5, workspace)");
   ffi::DataType type;
   if (auto err = same_fields(state, 10, type); err.failure()) return err;
+  if (auto err = check_variant("KtgfSsprkStagePadded", type, limiter, riemann, true); err.failure()) return err;
   auto work = state.get<ffi::AnyBuffer>(10);
   long n[3];
   if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
   const long M = (n[0] + 2 * GHOST) * (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST), N = n[0] * n[1] * n[2];
   if (!work.has_value() || work->element_type() != type || long(work->element_count()) != NFIELD * M + 2 * N)
     return ffi::Error::InvalidArgument("stage kernel: workspace is not that of KtgfCellsPad for this state");
-  if (type == ffi::F64) return stage_padded_typed<double>(state, params.typed_data(), limiter, riemann, out);
-  if (type == ffi::F32) return stage_padded_typed<float>(state, params.typed_data(), limiter, riemann, out);
-  return ffi::Error::InvalidArgument("stage kernel: fields must be float32 or float64");
+  const Real* w = work->typed_data<Real>();
+  sweep_padded(n, params.typed_data(), w, stage_of(state, n, params.typed_data(), w, out));
+  return ffi::Error::Success();
 }
 
 ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state,
@@ -727,18 +714,27 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
                              ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2,
                              ffi::Result<ffi::AnyBuffer> u3, ffi::Result<ffi::AnyBuffer> u4,
                              ffi::Result<ffi::AnyBuffer> work) {
-  void* const out[6] = {u0->untyped_data(), u1->untyped_data(), u2->untyped_data(), u3->untyped_data(),
-                        u4->untyped_data(), work->untyped_data()};
+  void* const out[5] = {u0->untyped_data(), u1->untyped_data(), u2->untyped_data(), u3->untyped_data(),
+                        u4->untyped_data()};
   if (params.element_count() != 6)
     return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
   if (state.size() != 10) return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5)");
   ffi::DataType type;
   if (auto err = same_fields(state, 10, type); err.failure()) return err;
+  if (auto err = check_variant("KtgfSsprkStageCells", type, limiter, riemann, true); err.failure()) return err;
   CellProgram p{nullptr, 0};
   if (auto err = find_program(program, type, p); err.failure()) return err;
-  if (type == ffi::F64) return stage_cells_typed<double>(state, params.typed_data(), leaf.typed_data(), limiter, riemann, p.fn, out);
-  return stage_cells_typed<float>(state, params.typed_data(), leaf.typed_data(), limiter, riemann, p.fn, out);
+  long n[3];
+  if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
+  Real* w = work->typed_data<Real>();
+  const Stage<Real> o = stage_of(state, n, params.typed_data(), w, out);
+  // Uk is read whole here, before the sweep writes U' over it.
+  cells_pad<Real>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(), o.Uk, n, w, const_cast<Real*>(o.s0),
+                  const_cast<Real*>(o.s1));
+  sweep_padded(n, params.typed_data(), w, o);
+  return ffi::Error::Success();
 }
+#endif
 
 // The eleven cell-field arguments the first two entry points begin with, in the order of enum Field, and the
 // float64 parameters after them.
@@ -760,6 +756,7 @@ auto cell_field_args(Binding b) {
 
 }  // namespace
 
+#if KTGF_KIND != KTGF_STAGE
 XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfFluxDivergence, flux_divergence,
                               cell_field_args(ffi::Ffi::Bind())
                                   .Attr<int32_t>("limiter")
@@ -773,6 +770,7 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfFluxDivergence, flux_divergence,
                                   .Ret<ffi::AnyBuffer>()  // div u
                                   .Ret<ffi::AnyBuffer>());  // padded fields (workspace)
 
+#else
 XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStage, ssprk_stage,
                               cell_field_args(ffi::Ffi::Bind())  // at Uk
                                   .RemainingArgs()               // U0 (5), Uk (5), s0, s1
@@ -821,9 +819,12 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStagePadded, ssprk_stage_padded,
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_z
                                   .Ret<ffi::AnyBuffer>());  // ... E
 
-// Registers the cell program `fn` (state precision `bits`, 32 or 64) under `key`; returns 0.
+// Registers the cell program `fn` (state precision `bits`, 32 or 64) under `key` in this library; returns 0, or
+// 1 (nothing registered) if this library is built for the other precision.
 extern "C" int KtgfRegisterCells(int64_t key, void* fn, int32_t bits) {
+  if (bits != 8 * int(sizeof(Real))) return 1;
   std::lock_guard<std::mutex> lock(programs_mutex);
   programs[key] = CellProgram{fn, bits};
   return 0;
 }
+#endif

@@ -17,22 +17,23 @@ float64 — and when it is switched on: :data:`.fluxes.FLUX_KERNEL` (default fro
 variable ``KTGF_FLUX_KERNEL``; ``0`` switches it off).  The JAX path remains the reference and
 the path for GPUs, sharding, walls and Lees–Edwards boundaries.
 
-Build: compiled on first use with the C++ compiler ``$CXX`` (default ``g++``; OpenMP, ``-O3
--march=native``) into ``$KTGF_CACHE_DIR`` (default ``~/.cache/ktgf``), keyed by the source, the
-flags, jaxlib's version and the host; without a compiler (or if the build fails) the JAX path
-runs and one warning says why.
+Build: one shared library per *variant* (:class:`Variant`: precision × limiter × Riemann solver × kind,
+the kind one of :data:`KINDS` — the viscous flux divergence, the inviscid one of the IMEX scheme, or the
+SSP-RK3 stage entries), compiled when a solver first needs it (:func:`applies`) with the C++ compiler
+``$CXX`` (default ``g++``; OpenMP, ``-O3 -march=native``) into ``$KTGF_CACHE_DIR`` (default
+``~/.cache/ktgf``) by :mod:`.cxx`, and kept there; a variant is chosen by ``-D`` macros, so each build
+compiles the face sweep once (≈ 7–11 s; all 64 instantiations in one library took 6 minutes).  Each
+variant registers its FFI targets under the base names below plus :attr:`Variant.suffix`
+(:func:`target`); its handlers refuse a call that asks for another variant.  Without a compiler (or if a
+build fails) the JAX path runs and one warning says why; no further build is tried in that process.
 """
 
 from __future__ import annotations
 
 import ctypes
-import hashlib
 import os
-import platform
-import shutil
-import subprocess
-import tempfile
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -40,69 +41,137 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .cxx import shared_library
+
 SOURCE = Path(__file__).with_name("flux_kernel.cc")
+#: Base names of the FFI targets; a variant's are these plus its :attr:`Variant.suffix`.
 TARGET = "ktgf_flux_divergence"
 STAGE_TARGET = "ktgf_ssprk_stage"
 CELLS_TARGET = "ktgf_ssprk_stage_cells"
 CELLS_PAD_TARGET = "ktgf_cells_pad"
 STAGE_PADDED_TARGET = "ktgf_ssprk_stage_padded"
 FLAGS = ("-O3", "-march=native", "-fopenmp", "-ffp-contract=off", "-fno-math-errno", "-shared", "-fPIC", "-std=c++17")
-_loaded: dict[str, Any] = {}
+#: What a library computes, in the order of the KTGF_KIND values of flux_kernel.cc: the viscous flux
+#: divergence (:func:`flux_divergence` with ``viscous``), the inviscid one (the explicit part of the IMEX
+#: scheme), and the SSP-RK3 stage (:func:`ssprk_stage`, :func:`ssprk_stage_cells`, :func:`cell_fields`,
+#: :func:`ssprk_stage_padded` and the cell-program registry).
+KINDS = ("rhs", "euler", "stage")
+#: The FFI entries (C symbol: base target name) in a library of each kind.
+ENTRIES = {
+    "rhs": {"KtgfFluxDivergence": TARGET},
+    "euler": {"KtgfFluxDivergence": TARGET},
+    "stage": {"KtgfSsprkStage": STAGE_TARGET, "KtgfSsprkStageCells": CELLS_TARGET, "KtgfCellsPad": CELLS_PAD_TARGET,
+              "KtgfSsprkStagePadded": STAGE_PADDED_TARGET},
+}
+#: Loaded libraries by :class:`Variant`; ``"failed"``: why a build failed (none is tried after it);
+#: ``"programs"``: the (variant, key) of the cell programs registered with a stage library.
+_loaded: dict[Any, Any] = {}
 
 
-def _cache_dir() -> Path:
-    return Path(os.environ.get("KTGF_CACHE_DIR", Path.home() / ".cache" / "ktgf"))
+@dataclass(frozen=True)
+class Variant:
+    """One build of the kernel: the state precision (``"float64"`` or ``"float32"``), the limiter (one of
+    :data:`.fluxes.LIMITERS`), the Riemann solver (:data:`.fluxes.RIEMANN_SOLVERS`) and the kind (:data:`KINDS`)."""
+
+    dtype: str
+    limiter: str
+    riemann: str
+    kind: str
+
+    def __post_init__(self) -> None:
+        from .fluxes import LIMITERS, RIEMANN_SOLVERS
+
+        for value, valid in ((self.dtype, ("float64", "float32")), (self.limiter, LIMITERS),
+                             (self.riemann, RIEMANN_SOLVERS), (self.kind, KINDS)):
+            if value not in valid:
+                raise ValueError(f"no flux kernel variant for {value!r}; valid: {valid}")
+
+    def __str__(self) -> str:
+        return f"{self.dtype} {self.limiter}/{self.riemann} {self.kind}"
+
+    @property
+    def suffix(self) -> str:
+        """What this variant's FFI target names add to the base names, e.g. ``__f64_vanleer_hll_stage``."""
+        return f"__f{self.dtype[5:]}_{self.limiter}_{self.riemann}_{self.kind}"
+
+    @property
+    def macros(self) -> tuple[str, ...]:
+        """The ``-D`` flags that select the variant in flux_kernel.cc."""
+        from .fluxes import LIMITERS, RIEMANN_SOLVERS
+
+        return (f"-DKTGF_REAL={'double' if self.dtype == 'float64' else 'float'}",
+                f"-DKTGF_LIMITER={LIMITERS.index(self.limiter)}",
+                f"-DKTGF_RIEMANN={RIEMANN_SOLVERS.index(self.riemann)}", f"-DKTGF_KIND={KINDS.index(self.kind)}")
 
 
-def build() -> Path:
-    """The compiled library (built now if not in the cache); raises RuntimeError if it cannot be."""
-    cxx = shutil.which(os.environ.get("CXX", "g++"))
-    if cxx is None:
-        raise RuntimeError(f"no C++ compiler ({os.environ.get('CXX', 'g++')!r} not found)")
-    key = hashlib.sha256(b"\0".join([SOURCE.read_bytes(), " ".join(FLAGS).encode(), cxx.encode(),
-                                     jax.__version__.encode(), platform.node().encode()])).hexdigest()[:16]
-    lib = _cache_dir() / f"flux_kernel-{key}.so"
-    if lib.exists():
-        return lib
-    lib.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".so", dir=lib.parent)
-    os.close(fd)
-    cmd = [cxx, *FLAGS, f"-I{jax.ffi.include_dir()}", str(SOURCE), "-o", tmp]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    if proc.returncode != 0:
-        os.unlink(tmp)
-        last = (proc.stderr.strip().splitlines() or ["?"])[-1]
-        raise RuntimeError(f"compiling {SOURCE.name} failed: {last}")
-    os.replace(tmp, lib)  # atomic: parallel test workers may build at the same time
+#: The variant :func:`available` builds: the SSP-RK3 stage of the default numerics in float64.
+DEFAULT = Variant("float64", "vanleer", "hll", "stage")
+
+
+def variant(dtype: Any, limiter: str, riemann: str, kind: str) -> Variant:
+    """The :class:`Variant` of a state of ``dtype`` (any form :func:`jax.numpy.dtype` takes)."""
+    return Variant(jnp.dtype(dtype).name, limiter, riemann, kind)
+
+
+def target(base: str, v: Variant) -> str:
+    """The FFI target name of the entry ``base`` (e.g. :data:`STAGE_TARGET`) in the library of ``v``."""
+    return base + v.suffix
+
+
+def build(v: Variant = DEFAULT) -> Path:
+    """The compiled library of the variant ``v`` (built now if not in the cache); raises RuntimeError if it cannot
+    be."""
+    return shared_library("flux_kernel", SOURCE, (*FLAGS, *v.macros, f"-I{jax.ffi.include_dir()}"),
+                          f"the CPU flux kernel for {v}", "10-15 s")
+
+
+def _library(v: Variant) -> Any:
+    """The library of ``v`` (ctypes), loaded and its FFI targets registered on first need; raises
+    RuntimeError or OSError if it cannot be built or loaded."""
+    lib = _loaded.get(v)
+    if lib is None:
+        # Idle OpenMP threads must sleep, not spin: between calls XLA's own threads need the cores.
+        os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+        lib = ctypes.cdll.LoadLibrary(str(build(v)))
+        for entry, base in ENTRIES[v.kind].items():
+            jax.ffi.register_ffi_target(target(base, v), jax.ffi.pycapsule(getattr(lib, entry)), platform="cpu")
+        _loaded[v] = lib
     return lib
 
 
+def _usable(v: Variant) -> bool:
+    """Whether the library of ``v`` is loaded, or can be now.  The first failure warns and switches the
+    kernel off for the process: a compiler that fails once would fail (slowly) for every variant."""
+    if "failed" in _loaded:
+        return False
+    try:
+        _library(v)
+    except (RuntimeError, OSError) as err:
+        warnings.warn(f"ktgf flux kernel unavailable, using the JAX path: {err}", RuntimeWarning, stacklevel=2)
+        _loaded["failed"] = str(err)
+        return False
+    return True
+
+
 def available() -> bool:
-    """Whether the kernel is built and registered with XLA (tried once per process)."""
-    if "ok" not in _loaded:
-        try:
-            # Idle OpenMP threads must sleep, not spin: between calls XLA's own threads need the cores.
-            os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
-            lib = ctypes.cdll.LoadLibrary(str(build()))
-            jax.ffi.register_ffi_target(TARGET, jax.ffi.pycapsule(lib.KtgfFluxDivergence), platform="cpu")
-            jax.ffi.register_ffi_target(STAGE_TARGET, jax.ffi.pycapsule(lib.KtgfSsprkStage), platform="cpu")
-            jax.ffi.register_ffi_target(CELLS_TARGET, jax.ffi.pycapsule(lib.KtgfSsprkStageCells), platform="cpu")
-            jax.ffi.register_ffi_target(CELLS_PAD_TARGET, jax.ffi.pycapsule(lib.KtgfCellsPad), platform="cpu")
-            jax.ffi.register_ffi_target(STAGE_PADDED_TARGET, jax.ffi.pycapsule(lib.KtgfSsprkStagePadded),
-                                        platform="cpu")
-            _loaded["lib"] = lib
-            _loaded["ok"] = True
-        except (RuntimeError, OSError) as err:
-            warnings.warn(f"ktgf flux kernel unavailable, using the JAX path: {err}", RuntimeWarning, stacklevel=2)
-            _loaded["ok"] = False
-    return _loaded["ok"]
+    """Whether the kernel can be used: :data:`DEFAULT` is built (once per machine) and registered."""
+    return _usable(DEFAULT)
 
 
-def applies(grid: Any, dtype: Any) -> bool:
-    """Whether the kernel can replace the JAX flux divergence here (see the module docstring)."""
+def applies(grid: Any, dtype: Any, kind: str, limiter: str, riemann: str) -> bool:
+    """Whether the variant (``dtype``, ``limiter``, ``riemann``, ``kind``) of the kernel can replace the JAX path
+    on ``grid`` (see the module docstring); builds it if needed."""
     periodic = grid.boundaries is None or grid.boundaries.all_periodic
     return (grid.ndim == 3 and periodic and jnp.dtype(dtype) in (jnp.float32, jnp.float64)
-            and jax.default_backend() == "cpu" and jax.device_count() == 1 and available())
+            and jax.default_backend() == "cpu" and jax.device_count() == 1
+            and _usable(variant(dtype, limiter, riemann, kind)))
+
+
+def _target(base: str, dtype: Any, limiter: str, riemann: str, kind: str) -> str:
+    """The FFI target of the entry ``base`` in the library of that variant, loaded if it is not yet."""
+    v = variant(dtype, limiter, riemann, kind)
+    _library(v)
+    return target(base, v)
 
 
 def _cell_fields(W: Any, eos: Any, transport: Any, grid: Any, viscous: bool) -> tuple[list[Any], Any]:
@@ -128,7 +197,8 @@ def flux_divergence(W: Any, eos: Any, transport: Any, grid: Any, rho_s: Any, lim
     """−∇·F of the five conservative fields and the central ∇·u, as :func:`.fluxes.flux_divergence`."""
     fields, work = _cell_fields(W, eos, transport, grid, viscous)
     field = jax.ShapeDtypeStruct(tuple(grid.cells), W[0].dtype)
-    call = jax.ffi.ffi_call(TARGET, (field,) * 6 + (work,))
+    kind = "rhs" if viscous else "euler"
+    call = jax.ffi.ffi_call(_target(TARGET, W[0].dtype, limiter, riemann, kind), (field,) * 6 + (work,))
     params = jnp.stack([jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)])
     out = call(*fields, params, **_schemes(limiter, riemann), viscous=np.int32(viscous))
     return list(out[:5]), out[5]
@@ -148,20 +218,23 @@ def ssprk_stage(U0: Any, Uk: Any, W: Any, eos: Any, transport: Any, source: tupl
     field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
     # U' is written over Uk (each cell reads its own Uk only, after the fluxes): no new buffers, and
     # none of the loop-carry copies XLA inserts when a stage's output cannot take its input's place.
-    call = jax.ffi.ffi_call(STAGE_TARGET, (field,) * 5 + (work,),
+    call = jax.ffi.ffi_call(_target(STAGE_TARGET, dtype, limiter, riemann, "stage"), (field,) * 5 + (work,),
                             input_output_aliases={len(fields) + 6 + v: v for v in range(5)})
     params = _stage_params(a, dt, grid, rho_s, dtype)
     return tuple(call(*fields, params, *state, **_schemes(limiter, riemann))[:5])
 
 
-def _register(program: Any) -> None:
-    """Makes a :class:`~.cell_program.CellProgram` known to the stage kernel (once per process and program)."""
+def _register(program: Any, limiter: str, riemann: str) -> None:
+    """Makes a :class:`~.cell_program.CellProgram` known to the stage library of its precision with ``limiter`` and
+    ``riemann``, whose calls use it (each library has its own registry; once per process, library and program)."""
+    v = variant(program.dtype, limiter, riemann, "stage")
     done = _loaded.setdefault("programs", set())
-    if program.key not in done:
+    if (v, program.key) not in done:
         bits = 8 * program.dtype.itemsize
-        _loaded["lib"].KtgfRegisterCells(ctypes.c_int64(program.key), ctypes.c_void_p(program.address),
-                                         ctypes.c_int32(bits))
-        done.add(program.key)
+        if _library(v).KtgfRegisterCells(ctypes.c_int64(program.key), ctypes.c_void_p(program.address),
+                                         ctypes.c_int32(bits)) != 0:
+            raise RuntimeError(f"a {program.dtype} cell program cannot be registered with the {v} kernel")
+        done.add((v, program.key))
 
 
 def _workspace(grid: Any, dtype: Any) -> Any:
@@ -172,15 +245,17 @@ def _workspace(grid: Any, dtype: Any) -> Any:
     return jax.ShapeDtypeStruct((11 * padded + 2 * grid.size,), dtype)
 
 
-def cell_fields(Uk: Any, program: Any, leaf: Any, grid: Any) -> tuple[Any, Any]:
+def cell_fields(Uk: Any, program: Any, leaf: Any, grid: Any, limiter: str, riemann: str) -> tuple[Any, Any]:
     """The workspace of the step-start cell program ``program`` (:func:`.cell_program.for_physics` with
     ``limits``) at the state Uk, and the maxima over the cells of its limit terms
     (:data:`.stepping.LIMIT_TERMS`), reduced in the same pass: the closures and step-limit reductions of a
     step's start in one call, so that the step size is known before :func:`ssprk_stage_padded` runs the
-    first stage on this workspace."""
-    _register(program)
+    first stage on this workspace.  ``limiter``, ``riemann``: those of the stage that follows, whose library
+    this call uses (the padding pass does not depend on them)."""
+    _register(program, limiter, riemann)
     dtype = Uk[0].dtype
-    call = jax.ffi.ffi_call(CELLS_PAD_TARGET, (_workspace(grid, dtype), jax.ShapeDtypeStruct((program.nlim,), dtype)))
+    call = jax.ffi.ffi_call(_target(CELLS_PAD_TARGET, dtype, limiter, riemann, "stage"),
+                            (_workspace(grid, dtype), jax.ShapeDtypeStruct((program.nlim,), dtype)))
     return call(leaf, *(jnp.asarray(f, dtype) for f in Uk), program=np.int64(program.key), nlim=np.int32(program.nlim))
 
 
@@ -195,11 +270,12 @@ def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any
     """The SSP-RK3 stage of :func:`ssprk_stage` with the cell fields and the energy source computed in
     the kernel from Uk by a cell program (:func:`.cell_program.for_physics`) with parameters ``leaf``
     (:func:`.cell_program.leaf_values`)."""
-    _register(program)
+    _register(program, limiter, riemann)
     dtype = Uk[0].dtype
     state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
     field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
-    call = jax.ffi.ffi_call(CELLS_TARGET, (field,) * 5 + (_workspace(grid, dtype),),
+    call = jax.ffi.ffi_call(_target(CELLS_TARGET, dtype, limiter, riemann, "stage"),
+                            (field,) * 5 + (_workspace(grid, dtype),),
                             input_output_aliases={7 + v: v for v in range(5)})
     params = _stage_params(a, dt, grid, rho_s, dtype)
     return tuple(call(params, leaf, *state, **_schemes(limiter, riemann), program=np.int64(program.key))[:5])
@@ -211,6 +287,7 @@ def ssprk_stage_padded(U0: Any, Uk: Any, work: Any, a: Any, dt: Any, grid: Any, 
     dtype = Uk[0].dtype
     state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
     field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
-    call = jax.ffi.ffi_call(STAGE_PADDED_TARGET, (field,) * 5, input_output_aliases={6 + v: v for v in range(5)})
+    call = jax.ffi.ffi_call(_target(STAGE_PADDED_TARGET, dtype, limiter, riemann, "stage"), (field,) * 5,
+                            input_output_aliases={6 + v: v for v in range(5)})
     params = _stage_params(a, dt, grid, rho_s, dtype)
     return tuple(call(params, *state, work, **_schemes(limiter, riemann)))

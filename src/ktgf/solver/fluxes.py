@@ -328,7 +328,7 @@ def flux_divergence(W: Sequence[Any], coefficients: tuple[tuple[Any, ...], tuple
     if FLUX_KERNEL:
         from . import flux_kernel
 
-        if flux_kernel.applies(grid, W[0].dtype):
+        if flux_kernel.applies(grid, W[0].dtype, "rhs" if viscous else "euler", limiter, riemann):
             return flux_kernel.flux_divergence(W, eos, transport, grid, phys.material_density, limiter, riemann,
                                                viscous)
     P = pad_fields((*W, *eos), grid, t, velocity=1)

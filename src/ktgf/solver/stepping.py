@@ -277,12 +277,14 @@ def dt_of_limits(lim: Any, num: Numerics) -> Any:
     return jnp.minimum(dt, num.dt_max)
 
 
-def stage_kernel_applies(grid: Grid, phys: Physics, dtype: Any) -> bool:
+def stage_kernel_applies(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> bool:
     """Whether an SSP-RK3 stage runs as one C++ kernel call (:func:`.flux_kernel.ssprk_stage`): where the
-    flux kernel applies (CPU, one device, 3D periodic) and no body force adds a source of its own."""
+    flux kernel's stage variant of ``num``'s limiter and Riemann solver applies (CPU, one device, 3D
+    periodic; built now if needed) and no body force adds a source of its own."""
     from . import flux_kernel, fluxes
 
-    return fluxes.FLUX_KERNEL and fluxes.STAGE_KERNEL and phys.gravity is None and flux_kernel.applies(grid, dtype)
+    return (fluxes.FLUX_KERNEL and fluxes.STAGE_KERNEL and phys.gravity is None
+            and flux_kernel.applies(grid, dtype, "stage", num.limiter, num.riemann))
 
 
 def kernel_stage_inputs(Uk: Any, r: Any, phys: Physics) -> tuple:
@@ -304,7 +306,7 @@ def start_program(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> Any:
     from . import fluxes
     from .cell_program import for_physics
 
-    if not (fluxes.CELL_PROGRAM and kernel_limits_apply(num) and stage_kernel_applies(grid, phys, dtype)):
+    if not (fluxes.CELL_PROGRAM and kernel_limits_apply(num) and stage_kernel_applies(grid, phys, num, dtype)):
         return None
     if for_physics(phys, dtype) is None:  # the later stages need the stage program
         return None
@@ -324,7 +326,7 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
     coef = jnp.asarray([0.0, 0.75, 1.0 / 3.0], dtype=U[0].dtype)
     when = jnp.asarray([0.0, 1.0, 0.5], dtype=jnp.result_type(t, float))  # stage times / Δt
 
-    if stage_kernel_applies(grid, phys, U[0].dtype):
+    if stage_kernel_applies(grid, phys, num, U[0].dtype):
         from . import fluxes
         from .cell_program import for_physics, leaf_values
         from .flux_kernel import ssprk_stage, ssprk_stage_cells, ssprk_stage_padded
@@ -485,7 +487,7 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
             from .cell_program import leaf_values
             from .flux_kernel import cell_fields
 
-            work, maxima = cell_fields(U, program, leaf_values(phys, grid), grid)
+            work, maxima = cell_fields(U, program, leaf_values(phys, grid), grid, num.limiter, num.riemann)
             lim = kernel_step_limits(maxima, grid, num)
         # Time is kept in float64 whatever the state precision, so a float32 run still lands
         # exactly on t_end.
