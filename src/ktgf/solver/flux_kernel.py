@@ -22,8 +22,8 @@ the kind one of :data:`KINDS` — the viscous flux divergence, the inviscid one 
 SSP-RK3 stage entries), compiled when a solver first needs it (:func:`applies`) with the C++ compiler
 ``$CXX`` (default ``g++``; OpenMP, ``-O3 -march=native``) into ``$KTGF_CACHE_DIR`` (default
 ``~/.cache/ktgf``) by :mod:`.cxx`, and kept there; a variant is chosen by ``-D`` macros, so each build
-compiles the face sweep once (≈ 7–11 s; all 64 instantiations in one library took 6 minutes).  Each
-variant registers its FFI targets under the base names below plus :attr:`Variant.suffix`
+compiles the face sweep once (7–15 s here; one library of all 64 instantiations took 6 minutes).  Each
+variant registers its FFI targets under the base names (:data:`TARGET`, ...) plus :attr:`Variant.suffix`
 (:func:`target`); its handlers refuse a call that asks for another variant.  Without a compiler (or if a
 build fails) the JAX path runs and one warning says why; no further build is tried in that process.
 """
