@@ -485,7 +485,7 @@ ffi::Error flux_divergence(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer
                     divu->typed_data<Real>()};
   return run(in, params.typed_data(), work->typed_data<Real>(), o);
 }
-#else
+#else  // the stage kind
 // Cell programs (ktgf.solver.cell_program), by key: f(n, params, in[5], out[NFIELD + 2 + nlim]) over n cells,
 // in = the conservative fields, out = the NFIELD cell fields, then s0, s1, then (a step-start program) the
 // nlim cell terms whose maxima give the step limits.
@@ -734,7 +734,7 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
   sweep_padded(n, params.typed_data(), w, o);
   return ffi::Error::Success();
 }
-#endif
+#endif  // KTGF_KIND
 
 // The eleven cell-field arguments the first two entry points begin with, in the order of enum Field, and the
 // float64 parameters after them.
@@ -770,7 +770,7 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfFluxDivergence, flux_divergence,
                                   .Ret<ffi::AnyBuffer>()  // div u
                                   .Ret<ffi::AnyBuffer>());  // padded fields (workspace)
 
-#else
+#else  // the stage kind
 XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStage, ssprk_stage,
                               cell_field_args(ffi::Ffi::Bind())  // at Uk
                                   .RemainingArgs()               // U0 (5), Uk (5), s0, s1
@@ -827,4 +827,4 @@ extern "C" int KtgfRegisterCells(int64_t key, void* fn, int32_t bits) {
   programs[key] = CellProgram{fn, bits};
   return 0;
 }
-#endif
+#endif  // KTGF_KIND
