@@ -270,7 +270,7 @@ def _program(treedef: Any, avals: tuple, dtype: Any, limits: str | None) -> Cell
     from .stepping import LIMIT_TERMS
 
     model = jax.tree_util.tree_unflatten(treedef, avals).model.name
-    what = f"the {'step-start ' if limits else ''}cell program of {model} ({np.dtype(dtype).name})"
+    what = f"the {np.dtype(dtype).name} {'step-start ' if limits else ''}cell program of {model}"
     try:
         return _compiled(source_for(treedef, avals, dtype, limits), dtype, 0 if limits is None else len(LIMIT_TERMS),
                          what)
