@@ -146,7 +146,7 @@ def test_without_a_compiler_the_jax_path_runs_with_one_warning(monkeypatch, tmp_
     text = _with_kernel(True, lambda: jax.jit(lambda U: ssprk3_step(U, 1e-6, _grid(), _physics("ret"), Numerics(
         scheme="ssprk3"))).lower(U).as_text())
     assert not any(base in text for base in (flux_kernel.TARGET, flux_kernel.STAGE_TARGET,
-                                             flux_kernel.CELLS_PAD_TARGET))
+                                             flux_kernel.LIMITS_TARGET))
 
 
 def _steps(U, grid, phys, num, steps: int = 3):
@@ -180,6 +180,71 @@ def test_fused_stage_steps_match_jax(model: str, options: dict, phi: float, ampl
     assert _close(fused[0], kernel[0]) < RTOL[dtype]
     assert _close(cells[0], ref[0]) < RTOL[dtype]
     assert _close(fused[0], U) > 100 * RTOL[dtype]  # the steps changed the state
+
+
+def test_fused_stage_on_few_planes_matches_jax() -> None:
+    """The fused sweep's ring of planes on a grid of the fewest planes (4: planes -2, -1 are planes 2, 3, and
+    the periodic images n0, n0 + 1 the kept planes 0, 1) and rows split unevenly over the threads (13 rows)."""
+    grid = Grid((4, 13, 5), (4 * D, 13 * 0.9 * D, 5 * 1.2 * D))
+    phys = for_case(_physics("ret"), "cooling", grid)
+    U = _state(grid, phys, jnp.float64, amplitude=0.2)
+    num = Numerics(scheme="ssprk3")
+    cells = _with_kernel(True, lambda: _steps(U, grid, phys, num))
+    ref = _with_kernel(False, lambda: _steps(U, grid, phys, num))
+    assert int(cells[2]) == 3 and int(cells[3]) == 0
+    assert _close(cells[0], ref[0]) < RTOL[jnp.float64]
+    assert _close(cells[0], U) > 100 * RTOL[jnp.float64]
+
+
+_THREADS_SCRIPT = """
+import hashlib, sys
+import jax, jax.numpy as jnp, numpy as np
+jax.config.update("jax_enable_x64", True)
+from ktgf.closures import get_model
+from ktgf.solver.friction import for_case
+from ktgf.solver.grid import Grid
+from ktgf.solver.initial import random_velocity
+from ktgf.solver.physics import Physics
+from ktgf.solver.stepping import Numerics, advance
+m = get_model("proposed")
+grid = Grid((5, 13, 6), (5e-3, 13e-3, 6e-3))
+phys = for_case(Physics(m, 0.8, 1e-3, 2500.0, 0.99 * m.phi_max), "cooling", grid)
+U = tuple(jnp.asarray(random_velocity(grid, phys, 0.3, 1e-4, 0.05, 4)))
+out = advance(U, 0.0, 1e30, 2, grid, phys, Numerics(scheme="ssprk3"))
+assert int(out[2]) == 2 and int(out[3]) == 0
+print(hashlib.sha256(np.asarray(out[0]).tobytes()).hexdigest())
+"""
+
+
+def test_fused_stage_does_not_depend_on_the_threads(tmp_path) -> None:
+    """Every cell does the same operations whatever the threads' split of the rows (and which thread computes
+    a ghost row): two steps with 1, 2 and 3 OpenMP threads are bit for bit the same.  13 rows: 6/7 and 4/4/5
+    rows a thread, so ghost rows and the neighbours' waits (each thread writes U' over Uk, which its
+    neighbours read for their ghost rows) cross thread boundaries."""
+    import os
+    import subprocess
+    import sys
+
+    script = tmp_path / "threads.py"
+    script.write_text(_THREADS_SCRIPT)
+    digests = set()
+    for threads in (1, 2, 3):
+        env = {**os.environ, "OMP_NUM_THREADS": str(threads)}
+        run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env, timeout=300)
+        assert run.returncode == 0, run.stderr[-2000:]
+        digests.add(run.stdout.strip().splitlines()[-1])
+    assert len(digests) == 1
+
+
+def test_fused_stage_refuses_a_small_ring(monkeypatch) -> None:
+    """The fused stage's workspace (its threads' rings) is sized by the kernel (KtgfRingElements): one element
+    short, the call is an error, not a write past the buffer."""
+    grid, phys = _grid(), _physics("ret")
+    U = _state(grid, phys, jnp.float64)
+    ring = flux_kernel._ring
+    monkeypatch.setattr(flux_kernel, "_ring", lambda *a: jax.ShapeDtypeStruct((ring(*a).shape[0] - 1,), ring(*a).dtype))
+    with pytest.raises(Exception, match="ring workspace"):
+        _with_kernel(True, lambda: np.asarray(_steps(U, grid, phys, Numerics(scheme="ssprk3"))[0]))
 
 
 @pytest.mark.parametrize("model", [m.name for m in list_models()])
@@ -267,8 +332,8 @@ def test_step_limits_reduced_in_the_kernel(model: str, dtype) -> None:
     num = Numerics(scheme="ssprk3")
     program = _with_kernel(True, lambda: start_program(grid, phys, num, dtype))
     assert program is not None and program.nlim == len(LIMIT_TERMS)
-    reduce = jax.jit(lambda U: flux_kernel.cell_fields(U, program, leaf_values(phys, grid), grid, num.limiter,
-                                                       num.riemann)[1])
+    reduce = jax.jit(lambda U: flux_kernel.cell_limits(U, program, leaf_values(phys, grid), grid, num.limiter,
+                                                       num.riemann))
     got = np.asarray(kernel_step_limits(reduce(U), grid, num), np.float64)
     want = np.asarray(jax.jit(lambda U: step_limits(U, grid, phys, num))(tuple(jnp.asarray(u, jnp.float64) for u in U)))
     tol = 1e-13 if dtype == jnp.float64 else 1e-5  # float32: the cell program's rounding (< 128 ε₃₂)
@@ -304,7 +369,11 @@ def test_a_variant_library_compiles_the_sweep_once() -> None:
         exported = subprocess.run(["nm", "-D", "--defined-only", str(library)], capture_output=True, text=True,
                                   check=True).stdout
         entries = set(re.findall(r"\b(Ktgf\w+)", exported))
-        assert entries == set(flux_kernel.ENTRIES[v.kind]) | ({"KtgfRegisterCells"} if v.kind == "stage" else set())
+        stage = v.kind == "stage"
+        assert entries == set(flux_kernel.ENTRIES[v.kind]) | ({"KtgfRegisterCells", "KtgfRingElements"} if stage else set())
+        symbols = subprocess.run(["nm", "-C", str(library)], capture_output=True, text=True, check=True).stdout
+        fused = set(re.findall(r"sweep_fused<(\w+), (\d), (\d)>", symbols))  # the cell-program stage's sweep
+        assert fused == ({sweep[:3]} if stage else set()), v
 
 
 def test_a_library_refuses_a_call_of_another_variant(monkeypatch) -> None:

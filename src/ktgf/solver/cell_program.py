@@ -6,8 +6,9 @@ the energy source (s0, s1)), which the kernel then read back and padded: ≈ 15 
 ≈ 4 ns of padding per stage, a third of the stage (docs/solver.md, Speed).  Here the same function —
 :func:`.stepping.kernel_stage_inputs` of the model's :meth:`.Physics.reduced`, nothing rewritten — is
 traced once with scalar inputs, and its jaxpr (elementwise arithmetic only) is printed as a C++ loop
-over a row of cells.  The kernel calls it in its padding pass, so a stage reads the five conservative
-fields and writes the padded coefficients in one pass, with no XLA closure pass at all.
+over a row of cells.  The kernel calls it row by row as its sweep goes (each thread keeps the few planes
+the stencil reaches), so a stage reads the five conservative fields and never writes the coefficients
+to memory, with no XLA closure pass at all.
 
 Physics stays in one place: the generated code is the jaxpr of the Python closures, operation for
 operation in the same precision (each jaxpr variable keeps its dtype; ``integer_pow`` is expanded as

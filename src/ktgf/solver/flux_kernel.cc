@@ -22,17 +22,18 @@
 //   cell program (ktgf.solver.cell_program: C++ generated from the jaxpr of the Python closures, in its
 //   own library, registered by key with KtgfRegisterCells); inputs float64 (dx, dy, dz, rho_s, a, dt),
 //   the program's float64 parameters, U0 and Uk; attribute `program` the key.  The closures are
-//   evaluated in the padding pass: one pass reads Uk and writes the padded fields.
-// * KtgfCellsPad and KtgfSsprkStagePadded: the first stage of a step split in two calls, so that the step size
-//   is known before the stage runs: the padding pass of a step-start cell program (the closures and the step
-//   limit terms) reduces the terms' maxima over the cells; XLA computes dt from them (a few scalars); the
-//   second call sweeps the workspace of the first.
-// All output a workspace holding the fields with two periodic ghost cells per side (an
-// output so that XLA owns and reuses its memory).  Rows are swept in blocks of ROW_BLOCK along
-// the second axis so that the five planes of a block that a stencil reaches stay in the core's L2
-// cache (measured 1.3x faster at 64^3 than whole planes); each cell's MUSCL slope along an axis is kept for
-// the second face it serves (measured 1.1x faster single-threaded at 64^3, bit-identical output).  Reading the unpadded fields with
-// periodic index arithmetic instead of the padded copy was tried and measured 1.9x slower.
+//   evaluated plane by plane as the sweep goes (sweep_fused), into a small ring of planes per thread, so
+//   the cell fields never go to memory (measured 1.3x faster per stage at 64^3 than a padding pass that
+//   wrote them all, then a sweep that read them back; bit-identical output).
+// * KtgfCellLimits: the maxima over the cells of the step-limit terms of a step-start cell program (the
+//   closures and the terms), from which XLA computes dt (a few scalars) before the step's first stage.
+// KtgfFluxDivergence and KtgfSsprkStage output a workspace holding their input fields with two periodic
+// ghost cells per side, KtgfSsprkStageCells its ring (outputs, so that XLA owns and reuses the memory).
+// The padded fields are swept in blocks of ROW_BLOCK rows along the second axis so that the five planes
+// of a block that a stencil reaches stay in the core's L2 cache (measured 1.3x faster at 64^3 than whole
+// planes); each cell's MUSCL slope along an axis is kept for the second face it serves (measured 1.1x
+// faster single-threaded at 64^3, bit-identical output).  Reading the unpadded fields with periodic index
+// arithmetic instead of the padded copy was tried and measured 1.9x slower.
 //
 // Build: one library per variant (flux_kernel.py, Variant), selected by macros: the precision
 // (-DKTGF_REAL=double|float), the limiter and the Riemann solver (-DKTGF_LIMITER, -DKTGF_RIEMANN: indices of
@@ -42,11 +43,13 @@
 // build takes seconds, not the minutes of all variants at once; its handlers refuse (InvalidArgument) a call
 // that asks for another precision, limiter, Riemann solver or viscous flag than the library's.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <unordered_map>
 #include <utility>
@@ -96,12 +99,15 @@ struct Consts {
   T omega_factor[3];  // (1/dx_a)/rho_s
 };
 
-// The value of field f at the cell (i + d0, j + d1, q + d2) of the padded fields, the cell (i, j, q) at c.
+// Planes: the sweeps read the cell fields plane by plane, through a table of three planes around the row's
+// plane i: P[(d0 + 1) * NFIELD + f] is field f of plane i + d0 (d0 = -1, 0, 1), a padded plane with row stride
+// s1, so that the planes can sit in one padded array (sweep) or in a ring of planes (sweep_fused).
+// The value of field f at the cell (i + d0, j + d1, q + d2), the cell (i, j, q) at offset c of its plane.
 template <class T>
 struct Stencil {
   const T* const* P;
-  long c, s0, s1;
-  KTGF_INLINE T operator()(int f, int d0, int d1, int d2) const { return P[f][c + d0 * s0 + d1 * s1 + d2]; }
+  long c, s1;
+  KTGF_INLINE T operator()(int f, int d0, int d1, int d2) const { return P[(d0 + 1) * NFIELD + f][c + d1 * s1 + d2]; }
 };
 
 // Half MUSCL slopes along A of the fields 0..6 at the row's cells q = from .. to - 1 (fluxes.reconstruct),
@@ -109,13 +115,13 @@ struct Stencil {
 template <class T, int A, int LIM>
 KTGF_INLINE void row_slopes(const T* const* P, long c0, const Consts<T>& k, T* out, long ld, long from, long to) {
   constexpr int e0 = A == 0, e1 = A == 1, e2 = A == 2;
-  const long s0 = k.stride[0], s1 = k.stride[1];
+  const long s1 = k.stride[1];
   #pragma GCC unroll 8
   for (int f = 0; f < 7; ++f) {
     T* o = out + f * ld;
 #pragma omp simd
     for (long q = from; q < to; ++q) {
-      const Stencil<T> X{P, c0 + q, s0, s1};
+      const Stencil<T> X{P, c0 + q, s1};
       const T fm = X(f, -e0, -e1, -e2), f0 = X(f, 0, 0, 0), f1 = X(f, e0, e1, e2);
       o[q] = T(0.5) * slope<T, LIM>(f0 - fm, f1 - f0);
     }
@@ -232,19 +238,19 @@ struct Stage {
 template <class T, int A, int RIE, bool VISC>
 KTGF_INLINE void row_faces(const T* const* P, long c0, const Consts<T>& k, const T* hl, const T* hr, long lh, T* out,
                            long ld, long from = 0) {
-  const long n2 = k.n[2], s0 = k.stride[0], s1 = k.stride[1];
+  const long n2 = k.n[2], s1 = k.stride[1];
 #pragma omp simd
   for (long q = from; q < n2; ++q)
-    face_flux<T, A, RIE, VISC>(Stencil<T>{P, c0 + q, s0, s1}, hl + q, hr + q, lh, k, out + q, ld);
+    face_flux<T, A, RIE, VISC>(Stencil<T>{P, c0 + q, s1}, hl + q, hr + q, lh, k, out + q, ld);
 }
 
 // Central div u of the row's cells.
 template <class T>
 KTGF_INLINE void row_divu(const T* const* P, long c0, const Consts<T>& k, T* dv) {
-  const long n2 = k.n[2], s0 = k.stride[0], s1 = k.stride[1];
+  const long n2 = k.n[2], s1 = k.stride[1];
 #pragma omp simd
   for (long q = 0; q < n2; ++q) {
-    const Stencil<T> X{P, c0 + q, s0, s1};
+    const Stencil<T> X{P, c0 + q, s1};
     dv[q] = (X(UX, 1, 0, 0) - X(UX, -1, 0, 0)) * k.half_inv_dx[0] +
             (X(UY, 0, 1, 0) - X(UY, 0, -1, 0)) * k.half_inv_dx[1] +
             (X(UZ, 0, 0, 1) - X(UZ, 0, 0, -1)) * k.half_inv_dx[2];
@@ -283,7 +289,8 @@ KTGF_INLINE T cell_div(const T* xl, const T* xh, const T* yl, const T* yh, const
 
 template <class T>
 KTGF_INLINE void write_row(const Rhs<T>& o, const T* const* P, long c0, long out, const Consts<T>& k,
-                           T* const* lo, const T* const* hi, const T* z, long zld, T* /*scratch*/) {
+                           const T* const* lo, const T* const* hi, const T* z, long zld, T* /*scratch*/,
+                           const T* /*s0*/, const T* /*s1*/) {
   const long n2 = k.n[2];
   for (int v = 0; v < 5; ++v) {
     T* d = o.dU[v] + out;
@@ -296,7 +303,8 @@ KTGF_INLINE void write_row(const Rhs<T>& o, const T* const* P, long c0, long out
 
 template <class T>
 KTGF_INLINE void write_row(const Stage<T>& o, const T* const* P, long c0, long out, const Consts<T>& k,
-                           T* const* lo, const T* const* hi, const T* z, long zld, T* divu) {
+                           const T* const* lo, const T* const* hi, const T* z, long zld, T* divu, const T* s0,
+                           const T* s1) {
   const long n2 = k.n[2];
   row_divu(P, c0, k, divu);
   for (int v = 0; v < 5; ++v) {
@@ -305,8 +313,6 @@ KTGF_INLINE void write_row(const Stage<T>& o, const T* const* P, long c0, long o
     T* d = o.U[v] + out;
     const T* zv = z + v * zld;
     if (v == 4) {
-      const T* s0 = o.s0 + out;
-      const T* s1 = o.s1 + out;
 #pragma omp simd
       for (long q = 0; q < n2; ++q) {
         const T L = cell_div(lo[v], hi[v], lo[5 + v], hi[5 + v], zv, q, k) + (s0[q] + s1[q] * divu[q]);
@@ -322,8 +328,95 @@ KTGF_INLINE void write_row(const Stage<T>& o, const T* const* P, long c0, long o
   }
 }
 
+// The energy source rows of the output at offset `out` (a stage's s0, s1; none for Rhs).
+template <class T>
+KTGF_INLINE void source_rows(const Rhs<T>&, long, const T** s) { s[0] = s[1] = nullptr; }
+template <class T>
+KTGF_INLINE void source_rows(const Stage<T>& o, long out, const T** s) {
+  s[0] = o.s0 + out;
+  s[1] = o.s1 + out;
+}
+
 constexpr long ROW_BLOCK = 16;
 
+// The per-thread buffers of a sweep over rows of n2 cells with B rows in flight: the lower x faces and
+// the x half slopes of B rows (kept from the previous plane), the y ones of one row (kept from the
+// previous row), the z ones of a row, and the row's div u.
+template <class T>
+struct RowBuffers {
+  long B, n2;
+  // x: the faces and half slopes of B rows on the plane being swept (lo, hx) and on the next one (hi, hxn),
+  // which trade places after each plane; y: those of a row, which trade places after each row.
+  std::vector<T> xlo, xhi, ylo, yhi, zf, divu, hx, hxn, hya, hyb, hz;
+  RowBuffers(long B_, long n2_)
+      : B(B_), n2(n2_), xlo(5 * B_ * n2_), xhi(5 * B_ * n2_), ylo(5 * n2_), yhi(5 * n2_), zf(5 * (n2_ + 1)),
+        divu(n2_), hx(7 * B_ * n2_), hxn(7 * B_ * n2_), hya(7 * n2_), hyb(7 * n2_), hz(7 * (n2_ + 2)) {}
+};
+
+// The lower x faces of rows b = 0 .. nb - 1 of a block: the half x slopes of the plane below (table Pm) and of
+// the block's plane (table P0), and the faces between them; rows at in-plane offsets row(b).
+template <class T, int LIM, int RIE, bool VISC, class Row>
+KTGF_INLINE void start_block(const T* const* Pm, const T* const* P0, long nb, Row row, const Consts<T>& k,
+                             RowBuffers<T>& r) {
+  const long n2 = k.n[2];
+  for (long b = 0; b < nb; ++b) {
+    row_slopes<T, 0, LIM>(Pm, row(b), k, r.hxn.data() + b * 7 * n2, n2, 0, n2);
+    row_slopes<T, 0, LIM>(P0, row(b), k, r.hx.data() + b * 7 * n2, n2, 0, n2);
+    row_faces<T, 0, RIE, VISC>(Pm, row(b), k, r.hxn.data() + b * 7 * n2, r.hx.data() + b * 7 * n2, n2,
+                               r.xlo.data() + b * n2, r.B * n2);
+  }
+}
+
+// Rows b = 0 .. nb - 1 of plane i (table P0; P1 the table of plane i + 1, whose x slopes are computed here):
+// the faces above each row along x and y and the z faces, and the row's output (o, row b at output offset
+// out(b), energy source rows src(b)); row(b) the in-plane offsets, row(-1) that of the row below the first.
+template <class T, int LIM, int RIE, bool VISC, class Out, class Row, class OutRow, class Src>
+KTGF_INLINE void sweep_rows(const T* const* P0, const T* const* P1, long nb, Row row, OutRow out, Src src,
+                            const Consts<T>& k, const Out& o, RowBuffers<T>& r) {
+  const long n2 = k.n[2], B = r.B;
+  T* hy = r.hya.data();
+  T* hyn = r.hyb.data();
+  T* ylo = r.ylo.data();
+  T* yhi = r.yhi.data();
+  row_slopes<T, 1, LIM>(P0, row(-1), k, hyn, n2, 0, n2);
+  row_slopes<T, 1, LIM>(P0, row(0), k, hy, n2, 0, n2);
+  row_faces<T, 1, RIE, VISC>(P0, row(-1), k, hyn, hy, n2, ylo, n2);
+  for (long b = 0; b < nb; ++b) {
+    const long c0 = row(b);
+    T* hxb = r.hx.data() + b * 7 * n2;
+    T* hxnb = r.hxn.data() + b * 7 * n2;
+    row_slopes<T, 0, LIM>(P1, c0, k, hxnb, n2, 0, n2);
+    row_faces<T, 0, RIE, VISC>(P0, c0, k, hxb, hxnb, n2, r.xhi.data() + b * n2, B * n2);
+    row_slopes<T, 1, LIM>(P0, row(b + 1), k, hyn, n2, 0, n2);
+    row_faces<T, 1, RIE, VISC>(P0, c0, k, hy, hyn, n2, yhi, n2);
+    row_slopes<T, 2, LIM>(P0, c0, k, r.hz.data() + 1, n2 + 2, -1, n2 + 1);
+    row_faces<T, 2, RIE, VISC>(P0, c0, k, r.hz.data() + 1, r.hz.data() + 2, n2 + 2, r.zf.data() + 1, n2 + 1, -1);
+    const T* lo[10];
+    const T* hi[10];
+    for (int v = 0; v < 5; ++v) {
+      lo[v] = r.xlo.data() + v * B * n2 + b * n2;
+      hi[v] = r.xhi.data() + v * B * n2 + b * n2;
+      lo[5 + v] = ylo + v * n2;
+      hi[5 + v] = yhi + v * n2;
+    }
+    const T* s[2];
+    src(b, s);
+    write_row(o, P0, c0, out(b), k, lo, hi, r.zf.data(), n2 + 1, r.divu.data(), s[0], s[1]);
+    std::swap(hy, hyn);  // the upper y faces and slopes become the next row's lower ones
+    std::swap(ylo, yhi);
+  }
+  std::swap(r.xlo, r.xhi);  // the upper x faces and slopes become the next plane's lower ones
+  std::swap(r.hx, r.hxn);
+}
+
+// The table of planes p - 1, p, p + 1 (p from -1 to n0) of the padded fields P (stride s0 between planes).
+template <class T>
+KTGF_INLINE void plane_table(const T* const* P, int nfield, long s0, long p, const T** table) {
+  for (int d = 0; d < 3; ++d)
+    for (int f = 0; f < NFIELD; ++f) table[d * NFIELD + f] = f < nfield ? P[f] + (p - 1 + d + GHOST) * s0 : nullptr;
+}
+
+// Sweep of padded fields (all planes in memory, `P` the NFIELD fields, or GG + 1 without the transport).
 // Each thread owns a block of planes i and sweeps them row block by row block, rows (i, j) in
 // order, keeping the fluxes of the lower x faces (a plane block) and y faces (a row) from the
 // previous plane/row, so every face is computed once (plus one x plane and one y row per block),
@@ -331,60 +424,33 @@ constexpr long ROW_BLOCK = 16;
 // slope along each axis is computed once.
 template <class T, int LIM, int RIE, bool VISC, class Out>
 void sweep(const T* const* P, const Consts<T>& k, const Out& o) {
-  const long n0 = k.n[0], n1 = k.n[1], n2 = k.n[2];
-  auto cell = [&](long i, long j) { return (i + GHOST) * k.stride[0] + (j + GHOST) * k.stride[1] + GHOST; };
+  const long n0 = k.n[0], n1 = k.n[1], n2 = k.n[2], s0 = k.stride[0], s1 = k.stride[1];
+  const int nfield = VISC ? NFIELD : GG + 1;
 #pragma omp parallel
   {
     const long B = ROW_BLOCK < n1 ? ROW_BLOCK : n1;
-    std::vector<T> xlo(5 * B * n2), xhi(5 * n2), ylo(5 * n2), yhi(5 * n2), zf(5 * (n2 + 1)), divu(n2);
-    std::vector<T> hx(7 * B * n2), hxn(7 * n2), hya(7 * n2), hyb(7 * n2), hz(7 * (n2 + 2));
+    RowBuffers<T> r(B, n2);
     int nt = 1, t = 0;
 #ifdef _OPENMP
     nt = omp_get_num_threads();
     t = omp_get_thread_num();
 #endif
     const long i0 = n0 * t / nt, i1 = n0 * (t + 1) / nt;
+    const T* Pm[3 * NFIELD];
+    const T* P0[3 * NFIELD];
+    const T* P1[3 * NFIELD];
     for (long jb = 0; jb < n1 && i0 < i1; jb += B) {
       const long je = jb + B < n1 ? jb + B : n1;
-      for (long j = jb; j < je; ++j) {
-        T* h = hx.data() + (j - jb) * 7 * n2;
-        row_slopes<T, 0, LIM>(P, cell(i0 - 1, j), k, hxn.data(), n2, 0, n2);
-        row_slopes<T, 0, LIM>(P, cell(i0, j), k, h, n2, 0, n2);
-        row_faces<T, 0, RIE, VISC>(P, cell(i0 - 1, j), k, hxn.data(), h, n2, xlo.data() + (j - jb) * n2, B * n2);
-      }
+      auto row = [&](long b) { return (jb + b + GHOST) * s1 + GHOST; };
+      plane_table(P, nfield, s0, i0 - 1, Pm);
+      plane_table(P, nfield, s0, i0, P0);
+      start_block<T, LIM, RIE, VISC>(Pm, P0, je - jb, row, k, r);
       for (long i = i0; i < i1; ++i) {
-        T* hy = hya.data();
-        T* hyn = hyb.data();
-        row_slopes<T, 1, LIM>(P, cell(i, jb - 1), k, hyn, n2, 0, n2);
-        row_slopes<T, 1, LIM>(P, cell(i, jb), k, hy, n2, 0, n2);
-        row_faces<T, 1, RIE, VISC>(P, cell(i, jb - 1), k, hyn, hy, n2, ylo.data(), n2);
-        for (long j = jb; j < je; ++j) {
-          const long c0 = cell(i, j);
-          T* hxj = hx.data() + (j - jb) * 7 * n2;
-          row_slopes<T, 0, LIM>(P, cell(i + 1, j), k, hxn.data(), n2, 0, n2);
-          row_faces<T, 0, RIE, VISC>(P, c0, k, hxj, hxn.data(), n2, xhi.data(), n2);
-          row_slopes<T, 1, LIM>(P, cell(i, j + 1), k, hyn, n2, 0, n2);
-          row_faces<T, 1, RIE, VISC>(P, c0, k, hy, hyn, n2, yhi.data(), n2);
-          row_slopes<T, 2, LIM>(P, c0, k, hz.data() + 1, n2 + 2, -1, n2 + 1);
-          row_faces<T, 2, RIE, VISC>(P, c0, k, hz.data() + 1, hz.data() + 2, n2 + 2, zf.data() + 1, n2 + 1, -1);
-          T* lo[10];
-          const T* hi[10];
-          for (int v = 0; v < 5; ++v) {
-            lo[v] = xlo.data() + v * B * n2 + (j - jb) * n2;
-            hi[v] = xhi.data() + v * n2;
-            lo[5 + v] = ylo.data() + v * n2;
-            hi[5 + v] = yhi.data() + v * n2;
-          }
-          write_row(o, P, c0, (i * n1 + j) * n2, k, lo, hi, zf.data(), n2 + 1, divu.data());
-          for (int v = 0; v < 10; ++v) {  // the upper faces become the next plane's/row's lower ones
-            T* l = lo[v];
-            const T* hh = hi[v];
-#pragma omp simd
-            for (long q = 0; q < n2; ++q) l[q] = hh[q];
-          }
-          std::copy(hxn.begin(), hxn.end(), hxj);  // plane i + 1's slopes, for the next plane
-          std::swap(hy, hyn);
-        }
+        plane_table(P, nfield, s0, i, P0);
+        plane_table(P, nfield, s0, i + 1, P1);
+        const long out0 = (i * n1 + jb) * n2;
+        sweep_rows<T, LIM, RIE, VISC>(P0, P1, je - jb, row, [&](long b) { return out0 + b * n2; },
+                                      [&](long b, const T** s) { source_rows(o, out0 + b * n2, s); }, k, o, r);
       }
     }
   }
@@ -395,7 +461,7 @@ void sweep(const T* const* P, const Consts<T>& k, const Out& o) {
 // 64 instantiations of the library of all variants took 6 minutes).
 #define KTGF_RHS 0    // KtgfFluxDivergence with the viscous fluxes
 #define KTGF_EULER 1  // KtgfFluxDivergence without them
-#define KTGF_STAGE 2  // KtgfSsprkStage, KtgfSsprkStageCells, KtgfCellsPad, KtgfSsprkStagePadded, KtgfRegisterCells
+#define KTGF_STAGE 2  // KtgfSsprkStage, KtgfSsprkStageCells, KtgfCellLimits, KtgfRegisterCells, KtgfRingElements
 #if !defined(KTGF_REAL) || !defined(KTGF_LIMITER) || !defined(KTGF_RIEMANN) || !defined(KTGF_KIND)
 #error "build with -DKTGF_REAL=double|float -DKTGF_LIMITER=0..3 -DKTGF_RIEMANN=0..1 -DKTGF_KIND=0..2 (flux_kernel.py)"
 #endif
@@ -428,17 +494,12 @@ ffi::Error check_variant(const char* entry, ffi::DataType type, int limiter, int
                                      ", the call asks for " + variant_name(type, limiter, riemann, viscous));
 }
 
-// Sweeps the padded fields in `work` (NFIELD or GG + 1 of them, each of the padded shape of n) with the output `o`.
-template <class Out>
-void sweep_padded(const long* n, const double* params, const Real* work, const Out& o) {
+// The grid constants of an (n0, n1, n2) grid with float64 params (dx, dy, dz, rho_s, ...), strides of padded fields.
+Consts<Real> consts(const long* n, const double* params) {
   Consts<Real> k;
   for (int a = 0; a < 3; ++a) k.n[a] = n[a];
-  const int nfield = BUILT_VISCOUS ? NFIELD : GG + 1;
-  const long m[3] = {k.n[0] + 2 * GHOST, k.n[1] + 2 * GHOST, k.n[2] + 2 * GHOST};
-  std::vector<const Real*> P(NFIELD, nullptr);
-  for (int f = 0; f < nfield; ++f) P[f] = work + f * m[0] * m[1] * m[2];
-  k.stride[0] = m[1] * m[2];
-  k.stride[1] = m[2];
+  k.stride[0] = (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST);
+  k.stride[1] = n[2] + 2 * GHOST;
   k.stride[2] = 1;
   const double rho_s = params[3];
   for (int a = 0; a < 3; ++a) {
@@ -446,6 +507,17 @@ void sweep_padded(const long* n, const double* params, const Real* work, const O
     k.half_inv_dx[a] = Real(0.5 / params[a]);
     k.omega_factor[a] = Real((1.0 / params[a]) / rho_s);
   }
+  return k;
+}
+
+// Sweeps the padded fields in `work` (NFIELD or GG + 1 of them, each of the padded shape of n) with the output `o`.
+template <class Out>
+void sweep_padded(const long* n, const double* params, const Real* work, const Out& o) {
+  const Consts<Real> k = consts(n, params);
+  const long M = (n[0] + 2 * GHOST) * k.stride[0];
+  const int nfield = BUILT_VISCOUS ? NFIELD : GG + 1;
+  std::vector<const Real*> P(NFIELD, nullptr);
+  for (int f = 0; f < nfield; ++f) P[f] = work + f * M;
   sweep<Real, KTGF_LIMITER, KTGF_RIEMANN, BUILT_VISCOUS>(P.data(), k, o);
 }
 
@@ -503,72 +575,180 @@ using CellsFn = void (*)(long, const double*, const T* const*, T* const*);
 template <class T>
 KTGF_INLINE T max_nan(T m, T x) { return (x > m || x != x) ? x : m; }
 
-// The cell fields of the state U (5 conservative fields) by the program, into the padded `work` (with
-// periodic ghost cells), and the source coefficients s0, s1 (unpadded); with nlim > 0 also the maxima over
-// the cells of the program's nlim limit terms, into `maxima` (reduced here, in the same pass).
+// The maxima over the cells of the `nlim` limit terms of a step-start cell program fn on the state U (its
+// cell fields and source go to a row scratch and are dropped): the step limits' closures and reductions in
+// one pass that writes nothing per cell.  A NaN term wins, as in jnp.max.
 template <class T>
-void cells_pad(CellsFn<T> fn, const double* leaf, const T* const* U, const long* n, T* work, T* s0, T* s1,
-               int nlim = 0, T* maxima = nullptr) {
-  const long m1 = n[1] + 2 * GHOST, m2 = n[2] + 2 * GHOST, plane = m1 * m2, M = (n[0] + 2 * GHOST) * plane;
+void cell_limits(CellsFn<T> fn, const double* leaf, const T* const* U, const long* n, int nlim, T* maxima) {
   for (int k = 0; k < nlim; ++k) maxima[k] = -std::numeric_limits<T>::infinity();
 #pragma omp parallel
   {
-    std::vector<T> terms(size_t(nlim) * n[2]), local(nlim, -std::numeric_limits<T>::infinity());
+    std::vector<T> scratch(size_t(NFIELD + 2 + nlim) * n[2]), local(nlim, -std::numeric_limits<T>::infinity());
     std::vector<T*> out(NFIELD + 2 + nlim);
+    for (int f = 0; f < NFIELD + 2 + nlim; ++f) out[f] = scratch.data() + f * n[2];
 #pragma omp for collapse(2) schedule(static)
     for (long i = 0; i < n[0]; ++i) {
       for (long j = 0; j < n[1]; ++j) {
-        const long src = (i * n[1] + j) * n[2];
         const T* in[5];
-        for (int v = 0; v < 5; ++v) in[v] = U[v] + src;
-        for (int f = 0; f < NFIELD; ++f) out[f] = work + f * M + (i + GHOST) * plane + (j + GHOST) * m2 + GHOST;
-        out[NFIELD] = s0 + src;
-        out[NFIELD + 1] = s1 + src;
-        for (int k = 0; k < nlim; ++k) out[NFIELD + 2 + k] = terms.data() + k * n[2];
+        for (int v = 0; v < 5; ++v) in[v] = U[v] + (i * n[1] + j) * n[2];
         fn(n[2], leaf, in, out.data());
-        for (int k = 0; k < nlim; ++k) {  // eight partial maxima: a vector, not one serial chain
-          const T* t = terms.data() + k * n[2];
-          T acc[8];
-          for (int l = 0; l < 8; ++l) acc[l] = local[k];
-          long q = 0;
-          for (; q + 8 <= n[2]; q += 8)
-            for (int l = 0; l < 8; ++l) acc[l] = max_nan(acc[l], t[q + l]);
-          for (; q < n[2]; ++q) acc[0] = max_nan(acc[0], t[q]);
-          for (int l = 1; l < 8; ++l) acc[0] = max_nan(acc[0], acc[l]);
-          local[k] = acc[0];
+        for (int k = 0; k < nlim; ++k) {  // the row's maximum and whether it holds a NaN: a vector loop
+          const T* t = out[NFIELD + 2 + k];
+          T m = local[k];
+          if (m != m) continue;  // a NaN already: it stays
+          int nan = 0;
+#pragma omp simd reduction(max : m) reduction(| : nan)
+          for (long q = 0; q < n[2]; ++q) {
+            m = t[q] > m ? t[q] : m;
+            nan |= t[q] != t[q];
+          }
+          local[k] = nan ? std::numeric_limits<T>::quiet_NaN() : m;
         }
-        for (int f = 0; f < NFIELD; ++f) {  // the row's ghost cells along z
-          T* row = out[f] - GHOST;
-          for (long q = 0; q < GHOST; ++q) {
-            row[q] = row[n[2] + q];
-            row[GHOST + n[2] + q] = row[GHOST + q];
+      }
+    }
+#pragma omp critical(ktgf_cell_limits)
+    for (int k = 0; k < nlim; ++k) maxima[k] = max_nan(maxima[k], local[k]);
+  }
+}
+
+// The fused stage's ring: planes i - 1 .. i + 2 of the cell fields (NFIELD, then the energy source s0, s1)
+// around the plane i being swept, in RING rolling slots, plus two slots that keep planes 0 and 1.
+constexpr int RING = 4;
+constexpr int NRING = NFIELD + 2;
+// Fewest rows a thread of the fused sweep owns: each thread also evaluates the closures of 2 GHOST rows
+// around its own, so more threads than n1 / MIN_ROWS would spend more on those than they gain.
+constexpr long MIN_ROWS = 4;
+
+// The threads the fused sweep uses on an (n0, n1, n2) grid.
+inline int fused_threads(const long* n) {
+  int nt = 1;
+#ifdef _OPENMP
+  nt = omp_get_max_threads();
+#endif
+  const long most = n[1] / MIN_ROWS > 1 ? n[1] / MIN_ROWS : 1;
+  return int(nt < most ? nt : most);
+}
+
+// Elements of the ring of one of nthreads threads (its n1 / nthreads rows rounded up, with ghost rows).
+inline long ring_size(const long* n, int nthreads) {
+  const long rows = (n[1] + nthreads - 1) / nthreads + 2 * GHOST;
+  return long(NRING) * (RING + 2) * rows * (n[2] + 2 * GHOST);
+}
+
+// Elements of the workspace of the fused sweep (the rings of its threads).
+inline long ring_elements(const long* n) { return fused_threads(n) * ring_size(n, fused_threads(n)); }
+
+// How far each thread of the fused sweep has got: the last plane whose cell fields it has computed; one
+// cache line each, so that the spinning reads of one thread do not slow the writes of another.
+struct alignas(64) Progress {
+  std::atomic<long> placed;
+};
+
+// Waits until the neighbours of thread t (of nt; the threads whose ghost rows are t's rows) have computed the
+// cell fields of plane p.  A spin, not an OpenMP barrier: the kernel's threads are all running, the wait is
+// short (they do the same work), and a sleeping wait under OMP_WAIT_POLICY=PASSIVE costs a wake-up each
+// time (measured: 18 % of a 64^3 step idle with a barrier per plane).
+inline void wait_for(const Progress* progress, int t, int nt, long p) {
+  for (int d : {-1, 1}) {
+    const int u = (t + d + nt) % nt;
+    for (long spins = 0; progress[u].placed.load(std::memory_order_acquire) < p; ++spins) {
+      if (spins < 4096) __builtin_ia32_pause();
+      else std::this_thread::yield();  // the other thread's core may have been taken by the host
+    }
+  }
+}
+
+// One SSP-RK3 stage whose cell fields the cell program fn (parameters leaf) computes from Uk as the sweep
+// goes, so that they never go to memory: thread t owns rows [jlo, jhi) of every plane and keeps planes
+// i - 1 .. i + 2 of its rows and GHOST rows per side in its ring (a slice of `ring` of `capacity` elements);
+// before it sweeps plane i it computes plane i + 2 into the slot of plane i - 2.  The closures are evaluated
+// once per cell, plus the ghost rows (2 GHOST / (n1 / threads) more) and the first planes.  U' may be written
+// over Uk: a thread reads Uk of plane p for the closures (at step p - 2) and the update (step p) before it
+// writes U' of plane p, and it writes plane p only once its neighbours, whose ghost rows are its rows, have
+// computed plane p (wait_for); planes 0 and 1, needed again at the end, are kept in their own slots.
+// Returns false (nothing computed) if the threads' rings do not fit in `capacity`.
+template <class T, int LIM, int RIE>
+bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const Stage<T>& o, T* ring_all,
+                 long capacity) {
+  const long n0 = kg.n[0], n1 = kg.n[1], n2 = kg.n[2], m2 = n2 + 2 * GHOST;
+  bool fits = true;
+  const int threads = fused_threads(kg.n);
+  std::vector<Progress> progress(threads);
+  for (auto& p : progress) p.placed.store(-3, std::memory_order_relaxed);
+#pragma omp parallel num_threads(threads)
+  {
+    int nt = 1, t = 0;
+#ifdef _OPENMP
+    nt = omp_get_num_threads();
+    t = omp_get_thread_num();
+#endif
+    const long per = capacity / nt;  // the same in every thread: all take the same branch (and barriers)
+    if (per < ring_size(kg.n, nt)) {
+#pragma omp single
+      fits = false;
+    } else {
+      const long jlo = n1 * t / nt, jhi = n1 * (t + 1) / nt, nj = jhi - jlo;
+      const long m1 = nj + 2 * GHOST, plane = m1 * m2, slots = RING + 2;
+      T* ring = ring_all + t * per;
+      Consts<T> k = kg;
+      k.stride[0] = plane;
+      k.stride[1] = m2;
+      RowBuffers<T> r(nj > 0 ? nj : 1, n2);
+      // Slot of plane p (-2 <= p < n0 + 2; planes 0, 1 and their periodic images n0, n0 + 1 in the kept slots).
+      auto slot_of = [&](long p) {
+        const long q = p >= n0 ? p - n0 : p;
+        return q == 0 || q == 1 ? RING + q : ((q % RING) + RING) % RING;
+      };
+      auto field = [&](int f, long s) { return ring + (long(f) * slots + s) * plane; };
+      // The cell program on the thread's rows (and ghost rows) of plane p of Uk (p < n0), into its slot.
+      auto place = [&](long p) {
+        if (p >= n0) return;  // planes 0, 1 again: kept
+        const long gp = (p + n0) % n0, s = slot_of(p);
+        T* out[NRING];
+        for (long jj = 0; jj < m1; ++jj) {
+          const long gj = ((jlo - GHOST + jj) % n1 + n1) % n1;
+          const T* in[5];
+          for (int v = 0; v < 5; ++v) in[v] = o.Uk[v] + (gp * n1 + gj) * n2;
+          for (int f = 0; f < NRING; ++f) out[f] = field(f, s) + jj * m2 + GHOST;
+          fn(n2, leaf, in, out);
+          for (int f = 0; f < NFIELD; ++f) {  // the row's ghost cells along z
+            T* row = out[f] - GHOST;
+            for (long q = 0; q < GHOST; ++q) {
+              row[q] = row[n2 + q];
+              row[GHOST + n2 + q] = row[GHOST + q];
+            }
           }
         }
+        progress[t].placed.store(p, std::memory_order_release);
+      };
+      auto table = [&](long p, const T** tab) {  // the fields of planes p - 1, p, p + 1
+        for (int d = 0; d < 3; ++d)
+          for (int f = 0; f < NFIELD; ++f) tab[d * NFIELD + f] = field(f, slot_of(p - 1 + d));
+      };
+      auto row = [&](long b) { return (b + GHOST) * m2 + GHOST; };
+      const T* P0[3 * NFIELD];
+      const T* P1[3 * NFIELD];
+      if (nj > 0) {
+        for (long p = -2; p < 2; ++p) place(p);
+        table(-1, P0);
+        table(0, P1);
+        start_block<T, LIM, RIE, true>(P0, P1, nj, row, k, r);
       }
-    }
-    if (nlim > 0) {
-#pragma omp critical(ktgf_cells_maxima)
-      for (int k = 0; k < nlim; ++k) maxima[k] = max_nan(maxima[k], local[k]);
-    }
-#pragma omp for collapse(2) schedule(static)
-    for (int f = 0; f < NFIELD; ++f) {  // ghost rows along y of the interior planes (after all rows: barrier)
-      for (long i = GHOST; i < GHOST + n[0]; ++i) {
-        T* p = work + f * M + i * plane;
-        for (long j = 0; j < GHOST; ++j) {
-          std::copy(p + (j + n[1]) * m2, p + (j + n[1] + 1) * m2, p + j * m2);
-          std::copy(p + (GHOST + j) * m2, p + (GHOST + j + 1) * m2, p + (GHOST + n[1] + j) * m2);
-        }
-      }
-    }
-#pragma omp for collapse(2) schedule(static)
-    for (int f = 0; f < NFIELD; ++f) {  // ghost planes along x
-      for (long i = 0; i < GHOST; ++i) {
-        T* b = work + f * M;
-        std::copy(b + (i + n[0]) * plane, b + (i + n[0] + 1) * plane, b + i * plane);
-        std::copy(b + (GHOST + i) * plane, b + (GHOST + i + 1) * plane, b + (GHOST + n[0] + i) * plane);
+      for (long i = 0; i < n0 && nj > 0; ++i) {
+        place(i + 2);
+        table(i, P0);
+        table(i + 1, P1);
+        const long si = slot_of(i), out0 = (i * n1 + jlo) * n2;
+        wait_for(progress.data(), t, nt, i);  // before U' of plane i overwrites their ghost rows' Uk
+        sweep_rows<T, LIM, RIE, true>(P0, P1, nj, row, [&](long b) { return out0 + b * n2; },
+                                      [&](long b, const T** src) {
+                                        src[0] = field(NFIELD, si) + row(b);
+                                        src[1] = field(NFIELD + 1, si) + row(b);
+                                      }, k, o, r);
       }
     }
   }
+  return fits;
 }
 
 ffi::Error ssprk_stage(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer uy, ffi::AnyBuffer uz,
@@ -614,25 +794,6 @@ ffi::Error grid_shape(const ffi::AnyBuffer& field, long* n) {
   return ffi::Error::Success();
 }
 
-// The stage output of the state (U0, Uk = the RemainingArgs 0..9) whose padded cell fields and source
-// coefficients s0, s1 are in `work` (NFIELD padded fields, then s0 and s1).
-Stage<Real> stage_of(ffi::RemainingArgs state, const long* n, const double* params, const Real* work,
-                     void* const* out) {
-  Stage<Real> o;
-  for (int v = 0; v < 5; ++v) {
-    o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<Real>();
-    o.Uk[v] = state.get<ffi::AnyBuffer>(5 + v)->typed_data<Real>();
-    o.U[v] = static_cast<Real*>(out[v]);
-  }
-  const long M = (n[0] + 2 * GHOST) * (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST), N = n[0] * n[1] * n[2];
-  o.s0 = work + NFIELD * M;
-  o.s1 = o.s0 + N;
-  o.a = Real(params[4]);
-  o.b = Real(1) - o.a;
-  o.dt = Real(params[5]);
-  return o;
-}
-
 // The cell program registered under `program`, checked against the precision of `type`.
 ffi::Error find_program(int64_t program, ffi::DataType type, CellProgram& p) {
   {
@@ -660,62 +821,34 @@ ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& ty
   return ffi::Error::Success();
 }
 
-// KtgfCellsPad: the cell fields and source coefficients of Uk by a step-start cell program, into the
-// workspace layout of KtgfSsprkStageCells, and the maxima of the program's `nlim` limit terms (from which
-// the step size is computed before KtgfSsprkStagePadded runs the first stage on this workspace).  It does not
-// depend on the limiter or the Riemann solver; Python calls the one of the stage library of the step.
-ffi::Error cells(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state, int64_t program, int32_t nlim,
-                 ffi::Result<ffi::AnyBuffer> work, ffi::Result<ffi::AnyBuffer> maxima) {
-  if (state.size() != 5) return ffi::Error::InvalidArgument("cells kernel: state = Uk x5");
+// KtgfCellLimits: the maxima over the cells of the `nlim` limit terms of a step-start cell program at Uk, from
+// which the step size is computed before the step's first stage.  It does not depend on the limiter or the
+// Riemann solver; Python calls the one of the stage library of the step.
+ffi::Error cell_limits_entry(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state, int64_t program, int32_t nlim,
+                             ffi::Result<ffi::AnyBuffer> maxima) {
+  if (state.size() != 5) return ffi::Error::InvalidArgument("cell limits kernel: state = Uk x5");
   ffi::DataType type;
   if (auto err = same_fields(state, 5, type); err.failure()) return err;
-  if (auto err = check_variant("KtgfCellsPad", type, KTGF_LIMITER, KTGF_RIEMANN, true); err.failure()) return err;
+  if (auto err = check_variant("KtgfCellLimits", type, KTGF_LIMITER, KTGF_RIEMANN, true); err.failure()) return err;
   if (nlim < 0 || long(maxima->element_count()) != nlim || maxima->element_type() != type)
-    return ffi::Error::InvalidArgument("cells kernel: maxima must be nlim values of the state precision");
+    return ffi::Error::InvalidArgument("cell limits kernel: maxima must be nlim values of the state precision");
   CellProgram p{nullptr, 0};
   if (auto err = find_program(program, type, p); err.failure()) return err;
   long n[3];
   if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
   const Real* U[5];
   for (int v = 0; v < 5; ++v) U[v] = state.get<ffi::AnyBuffer>(v)->typed_data<Real>();
-  Real* w = work->typed_data<Real>();
-  const long M = (n[0] + 2 * GHOST) * (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST), N = n[0] * n[1] * n[2];
-  cells_pad<Real>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(), U, n, w, w + NFIELD * M,
-                  w + NFIELD * M + N, nlim, maxima->typed_data<Real>());
+  cell_limits<Real>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(), U, n, nlim, maxima->typed_data<Real>());
   return ffi::Error::Success();
 }
 
-// KtgfSsprkStagePadded: the stage of KtgfSsprkStageCells from a workspace that KtgfCellsPad wrote.
-ffi::Error ssprk_stage_padded(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs state, int32_t limiter,
-                              int32_t riemann, ffi::Result<ffi::AnyBuffer> u0, ffi::Result<ffi::AnyBuffer> u1,
-                              ffi::Result<ffi::AnyBuffer> u2, ffi::Result<ffi::AnyBuffer> u3,
-                              ffi::Result<ffi::AnyBuffer> u4) {
-  void* const out[5] = {u0->untyped_data(), u1->untyped_data(), u2->untyped_data(), u3->untyped_data(),
-                        u4->untyped_data()};
-  if (params.element_count() != 6)
-    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
-  if (state.size() != 11) return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5, workspace)");
-  ffi::DataType type;
-  if (auto err = same_fields(state, 10, type); err.failure()) return err;
-  if (auto err = check_variant("KtgfSsprkStagePadded", type, limiter, riemann, true); err.failure()) return err;
-  auto work = state.get<ffi::AnyBuffer>(10);
-  long n[3];
-  if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
-  const long M = (n[0] + 2 * GHOST) * (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST), N = n[0] * n[1] * n[2];
-  if (!work.has_value() || work->element_type() != type || long(work->element_count()) != NFIELD * M + 2 * N)
-    return ffi::Error::InvalidArgument("stage kernel: workspace is not that of KtgfCellsPad for this state");
-  const Real* w = work->typed_data<Real>();
-  sweep_padded(n, params.typed_data(), w, stage_of(state, n, params.typed_data(), w, out));
-  return ffi::Error::Success();
-}
-
+// KtgfSsprkStageCells: one SSP-RK3 stage whose cell fields the cell program computes as the sweep goes
+// (sweep_fused); `ring` its per-thread planes (ring_elements).  U' may alias Uk (see sweep_fused).
 ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state,
                              int32_t limiter, int32_t riemann, int64_t program, ffi::Result<ffi::AnyBuffer> u0,
                              ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2,
                              ffi::Result<ffi::AnyBuffer> u3, ffi::Result<ffi::AnyBuffer> u4,
-                             ffi::Result<ffi::AnyBuffer> work) {
-  void* const out[5] = {u0->untyped_data(), u1->untyped_data(), u2->untyped_data(), u3->untyped_data(),
-                        u4->untyped_data()};
+                             ffi::Result<ffi::AnyBuffer> ring) {
   if (params.element_count() != 6)
     return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
   if (state.size() != 10) return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5)");
@@ -726,12 +859,25 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
   if (auto err = find_program(program, type, p); err.failure()) return err;
   long n[3];
   if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
-  Real* w = work->typed_data<Real>();
-  const Stage<Real> o = stage_of(state, n, params.typed_data(), w, out);
-  // Uk is read whole here, before the sweep writes U' over it.
-  cells_pad<Real>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(), o.Uk, n, w, const_cast<Real*>(o.s0),
-                  const_cast<Real*>(o.s1));
-  sweep_padded(n, params.typed_data(), w, o);
+  if (ring->element_type() != type || long(ring->element_count()) < ring_elements(n))
+    return ffi::Error::InvalidArgument("stage kernel: the ring workspace is smaller than KtgfRingElements");
+  const double* par = params.typed_data();
+  Stage<Real> o;
+  Real* const out[5] = {u0->typed_data<Real>(), u1->typed_data<Real>(), u2->typed_data<Real>(),
+                        u3->typed_data<Real>(), u4->typed_data<Real>()};
+  for (int v = 0; v < 5; ++v) {
+    o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<Real>();
+    o.Uk[v] = state.get<ffi::AnyBuffer>(5 + v)->typed_data<Real>();
+    o.U[v] = out[v];
+  }
+  o.s0 = o.s1 = nullptr;  // from the ring
+  o.a = Real(par[4]);
+  o.b = Real(1) - o.a;  // as the JAX path: 1 - a in the state precision
+  o.dt = Real(par[5]);
+  if (!sweep_fused<Real, KTGF_LIMITER, KTGF_RIEMANN>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(),
+                                                     consts(n, par), o, ring->typed_data<Real>(),
+                                                     long(ring->element_count())))
+    return ffi::Error::InvalidArgument("stage kernel: the ring workspace is too small for the threads");
   return ffi::Error::Success();
 }
 #endif  // KTGF_KIND
@@ -796,28 +942,15 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStageCells, ssprk_stage_cells,
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_y
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_z
                                   .Ret<ffi::AnyBuffer>()  // ... E
-                                  .Ret<ffi::AnyBuffer>());  // padded fields, then s0, s1 (workspace)
+                                  .Ret<ffi::AnyBuffer>());  // the planes of the fused sweep (workspace, KtgfRingElements)
 
-XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfCellsPad, cells,
+XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfCellLimits, cell_limits_entry,
                               ffi::Ffi::Bind()
                                   .Arg<ffi::Buffer<ffi::F64>>()  // the cell program's parameters
                                   .RemainingArgs()               // Uk (5)
                                   .Attr<int64_t>("program")
                                   .Attr<int32_t>("nlim")
-                                  .Ret<ffi::AnyBuffer>()    // padded fields, then s0, s1 (workspace)
                                   .Ret<ffi::AnyBuffer>());  // maxima of the nlim limit terms
-
-XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStagePadded, ssprk_stage_padded,
-                              ffi::Ffi::Bind()
-                                  .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s, a, dt)
-                                  .RemainingArgs()               // U0 (5), Uk (5), workspace of KtgfCellsPad
-                                  .Attr<int32_t>("limiter")
-                                  .Attr<int32_t>("riemann")
-                                  .Ret<ffi::AnyBuffer>()  // U' density
-                                  .Ret<ffi::AnyBuffer>()  // ... rho u_x
-                                  .Ret<ffi::AnyBuffer>()  // ... rho u_y
-                                  .Ret<ffi::AnyBuffer>()  // ... rho u_z
-                                  .Ret<ffi::AnyBuffer>());  // ... E
 
 // Registers the cell program `fn` (state precision `bits`, 32 or 64) under `key` in this library; returns 0, or
 // 1 (nothing registered) if this library is built for the other precision.
@@ -826,5 +959,11 @@ extern "C" int KtgfRegisterCells(int64_t key, void* fn, int32_t bits) {
   std::lock_guard<std::mutex> lock(programs_mutex);
   programs[key] = CellProgram{fn, bits};
   return 0;
+}
+
+// Elements of the workspace (ring) KtgfSsprkStageCells needs on an (n0, n1, n2) grid with this process's threads.
+extern "C" long KtgfRingElements(long n0, long n1, long n2) {
+  const long n[3] = {n0, n1, n2};
+  return ring_elements(n);
 }
 #endif  // KTGF_KIND

@@ -8,9 +8,10 @@ instead of once per flux component (docs/solver.md, Speed) and agrees with the J
 round-off (tests/test_solver_flux_kernel.py).  :func:`ssprk_stage` also applies the energy
 source and the stage update of :func:`.stepping.ssprk3_step` in the same sweep, so a stage of
 the explicit scheme is one closure pass (XLA) and one kernel call; :func:`ssprk_stage_cells` also
-evaluates the closures, by a generated cell program (:mod:`.cell_program`), so a stage is one call;
-a step's first stage is :func:`cell_fields` (closures and the maxima of the step-limit terms, in the
-padding pass) and :func:`ssprk_stage_padded`, with the step size computed from the maxima between them.
+evaluates the closures, by a generated cell program (:mod:`.cell_program`), plane by plane as its sweep
+goes (so the cell fields never go to memory), and a stage is one call; a step starts with
+:func:`cell_limits` (the closures and the maxima of the step-limit terms, in one pass), from which the
+step size is computed before the first stage.
 
 It is used where it applies — CPU backend, one device, a 3D fully periodic grid, float32 or
 float64 — and when it is switched on: :data:`.fluxes.FLUX_KERNEL` (default from the environment
@@ -48,20 +49,18 @@ SOURCE = Path(__file__).with_name("flux_kernel.cc")
 TARGET = "ktgf_flux_divergence"
 STAGE_TARGET = "ktgf_ssprk_stage"
 CELLS_TARGET = "ktgf_ssprk_stage_cells"
-CELLS_PAD_TARGET = "ktgf_cells_pad"
-STAGE_PADDED_TARGET = "ktgf_ssprk_stage_padded"
+LIMITS_TARGET = "ktgf_cell_limits"
 FLAGS = ("-O3", "-march=native", "-fopenmp", "-ffp-contract=off", "-fno-math-errno", "-shared", "-fPIC", "-std=c++17")
 #: What a library computes, in the order of the KTGF_KIND values of flux_kernel.cc: the viscous flux
 #: divergence (:func:`flux_divergence` with ``viscous``), the inviscid one (the explicit part of the IMEX
-#: scheme), and the SSP-RK3 stage (:func:`ssprk_stage`, :func:`ssprk_stage_cells`, :func:`cell_fields`,
-#: :func:`ssprk_stage_padded` and the cell-program registry).
+#: scheme), and the SSP-RK3 stage (:func:`ssprk_stage`, :func:`ssprk_stage_cells`, :func:`cell_limits` and the
+#: cell-program registry).
 KINDS = ("rhs", "euler", "stage")
 #: The FFI entries (C symbol: base target name) in a library of each kind.
 ENTRIES = {
     "rhs": {"KtgfFluxDivergence": TARGET},
     "euler": {"KtgfFluxDivergence": TARGET},
-    "stage": {"KtgfSsprkStage": STAGE_TARGET, "KtgfSsprkStageCells": CELLS_TARGET, "KtgfCellsPad": CELLS_PAD_TARGET,
-              "KtgfSsprkStagePadded": STAGE_PADDED_TARGET},
+    "stage": {"KtgfSsprkStage": STAGE_TARGET, "KtgfSsprkStageCells": CELLS_TARGET, "KtgfCellLimits": LIMITS_TARGET},
 }
 #: Loaded libraries by :class:`Variant`; ``"failed"``: why a build failed (none is tried after it);
 #: ``"programs"``: the (variant, key) of the cell programs registered with a stage library.
@@ -237,25 +236,16 @@ def _register(program: Any, limiter: str, riemann: str) -> None:
         done.add((v, program.key))
 
 
-def _workspace(grid: Any, dtype: Any) -> Any:
-    """The cell-program workspace: the 11 kernel cell fields with periodic ghost cells, then s0 and s1."""
-    from .fluxes import GHOST
-
-    padded = int(np.prod([n + 2 * GHOST for n in grid.cells]))
-    return jax.ShapeDtypeStruct((11 * padded + 2 * grid.size,), dtype)
-
-
-def cell_fields(Uk: Any, program: Any, leaf: Any, grid: Any, limiter: str, riemann: str) -> tuple[Any, Any]:
-    """The workspace of the step-start cell program ``program`` (:func:`.cell_program.for_physics` with
-    ``limits``) at the state Uk, and the maxima over the cells of its limit terms
-    (:data:`.stepping.LIMIT_TERMS`), reduced in the same pass: the closures and step-limit reductions of a
-    step's start in one call, so that the step size is known before :func:`ssprk_stage_padded` runs the
-    first stage on this workspace.  ``limiter``, ``riemann``: those of the stage that follows, whose library
-    this call uses (the padding pass does not depend on them)."""
+def cell_limits(Uk: Any, program: Any, leaf: Any, grid: Any, limiter: str, riemann: str) -> Any:
+    """The maxima over the cells of the limit terms (:data:`.stepping.LIMIT_TERMS`) of the step-start cell
+    program ``program`` (:func:`.cell_program.for_physics` with ``limits``) at the state Uk: the closures and
+    step-limit reductions of a step's start in one pass that writes nothing per cell, so that the step size
+    is known before the first stage.  ``limiter``, ``riemann``: those of the stage that follows, whose library
+    this call uses (the pass does not depend on them)."""
     _register(program, limiter, riemann)
     dtype = Uk[0].dtype
-    call = jax.ffi.ffi_call(_target(CELLS_PAD_TARGET, dtype, limiter, riemann, "stage"),
-                            (_workspace(grid, dtype), jax.ShapeDtypeStruct((program.nlim,), dtype)))
+    call = jax.ffi.ffi_call(_target(LIMITS_TARGET, dtype, limiter, riemann, "stage"),
+                            jax.ShapeDtypeStruct((program.nlim,), dtype))
     return call(leaf, *(jnp.asarray(f, dtype) for f in Uk), program=np.int64(program.key), nlim=np.int32(program.nlim))
 
 
@@ -265,29 +255,31 @@ def _stage_params(a: Any, dt: Any, grid: Any, rho_s: Any, dtype: Any) -> Any:
     return jnp.stack([*(jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)), *coef])
 
 
+def _ring(grid: Any, dtype: Any, v: Variant) -> Any:
+    """The workspace of :func:`ssprk_stage_cells`: the planes its threads keep (``KtgfRingElements``)."""
+    n = [ctypes.c_long(int(c)) for c in grid.cells]
+    lib = _library(v)
+    lib.KtgfRingElements.restype = ctypes.c_long
+    return jax.ShapeDtypeStruct((int(lib.KtgfRingElements(*n)),), dtype)
+
+
 def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any,
-                      limiter: str, riemann: str) -> tuple[Any, ...]:
+                      limiter: str, riemann: str, in_place: bool = True) -> tuple[Any, ...]:
     """The SSP-RK3 stage of :func:`ssprk_stage` with the cell fields and the energy source computed in
     the kernel from Uk by a cell program (:func:`.cell_program.for_physics`) with parameters ``leaf``
-    (:func:`.cell_program.leaf_values`)."""
+    (:func:`.cell_program.leaf_values`), plane by plane as the sweep goes (the fused sweep of
+    flux_kernel.cc): no cell field is written to memory.
+
+    ``in_place``: U' is written over Uk (no new buffers; the later stages of a step).  A step's first stage
+    has Uk = U0, which the later stages still read, so it writes a new buffer instead: written in place,
+    XLA would first copy U0 (measured: 7 % of a 64³ step in copies).
+    """
     _register(program, limiter, riemann)
     dtype = Uk[0].dtype
+    v = variant(dtype, limiter, riemann, "stage")
     state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
     field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
-    call = jax.ffi.ffi_call(_target(CELLS_TARGET, dtype, limiter, riemann, "stage"),
-                            (field,) * 5 + (_workspace(grid, dtype),),
-                            input_output_aliases={7 + v: v for v in range(5)})
+    call = jax.ffi.ffi_call(target(CELLS_TARGET, v), (field,) * 5 + (_ring(grid, dtype, v),),
+                            input_output_aliases={7 + v: v for v in range(5)} if in_place else None)
     params = _stage_params(a, dt, grid, rho_s, dtype)
     return tuple(call(params, leaf, *state, **_schemes(limiter, riemann), program=np.int64(program.key))[:5])
-
-
-def ssprk_stage_padded(U0: Any, Uk: Any, work: Any, a: Any, dt: Any, grid: Any, rho_s: Any, limiter: str,
-                       riemann: str) -> tuple[Any, ...]:
-    """The stage of :func:`ssprk_stage_cells` from the workspace ``work`` = :func:`cell_fields` of Uk."""
-    dtype = Uk[0].dtype
-    state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
-    field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
-    call = jax.ffi.ffi_call(_target(STAGE_PADDED_TARGET, dtype, limiter, riemann, "stage"), (field,) * 5,
-                            input_output_aliases={6 + v: v for v in range(5)})
-    params = _stage_params(a, dt, grid, rho_s, dtype)
-    return tuple(call(params, *state, work, **_schemes(limiter, riemann)))

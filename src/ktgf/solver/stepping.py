@@ -202,7 +202,7 @@ def limit_terms(W: Any, r: Any, phys: Physics, acoustics: str, spacing: Any) -> 
     kinematic viscosity (4/3 η + λ_b)/ρ and thermal diffusivity κ/(3ρ/2), the cooling rate ζ at ∇·u = 0
     and |ζ_U| (ζ = ζ0 + ζ_U ∇·u), and ±u_a (their maxima bound the central ∇·u on a periodic grid).
     Elementwise in the cell's own state, so a step-start cell program (:mod:`.cell_program`) evaluates
-    them in the stage kernel's padding pass and the kernel reduces them there.
+    them in the stage kernel and the kernel reduces them (:func:`.flux_kernel.cell_limits`).
     """
     rho, u, theta = W[0], W[1:4], W[4]
     c = phys.sound_speed(theta, r) if acoustics == "explicit" else 0.0
@@ -232,7 +232,7 @@ def limits_of_maxima(maxima: Any, grid: Grid, num: Numerics, divu_max: Any) -> A
 
 
 def kernel_limits_apply(num: Numerics) -> bool:
-    """Whether the step-start maxima may come from the stage kernel (:func:`.flux_kernel.cell_fields`, which
+    """Whether the step-start maxima may come from the stage kernel (:func:`.flux_kernel.cell_limits`, which
     runs on periodic grids only: :func:`stage_kernel_applies`): SSP-RK3 with the explicit sink, whose
     cooling limit is :func:`limits_of_maxima`'s."""
     return num.scheme == "ssprk3" and num.sink == "explicit"
@@ -259,7 +259,7 @@ def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None)
 
 
 def kernel_step_limits(maxima: Any, grid: Grid, num: Numerics) -> Any:
-    """:func:`step_limits` from the maxima the stage kernel reduced (:func:`.flux_kernel.cell_fields`;
+    """:func:`step_limits` from the maxima the stage kernel reduced (:func:`.flux_kernel.cell_limits`;
     where :func:`kernel_limits_apply`)."""
     return limits_of_maxima(maxima, grid, num, divu_bound(maxima, grid))
 
@@ -301,7 +301,7 @@ def kernel_stage_inputs(Uk: Any, r: Any, phys: Physics) -> tuple:
 
 def start_program(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> Any:
     """The step-start cell program of the SSP-RK3 stage kernel — the stage closures and the
-    :data:`LIMIT_TERMS`, :func:`.flux_kernel.cell_fields` — or None where a step does not start with it
+    :data:`LIMIT_TERMS`, :func:`.flux_kernel.cell_limits` — or None where a step does not start with it
     (no stage kernel or stage program, e.g. walls; another scheme or the implicit sink: :func:`kernel_limits_apply`)."""
     from . import fluxes
     from .cell_program import for_physics
@@ -313,10 +313,8 @@ def start_program(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> Any:
     return for_physics(phys, dtype, limits=num.acoustics)
 
 
-def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0, r0: Any = None,
-                work: Any = None) -> Any:
-    """One SSP-RK3 step of size dt (``r0``: the cell coefficients of U, if already evaluated; ``work``:
-    the cell-program workspace of U, :func:`.flux_kernel.cell_fields`, if already evaluated).
+def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0, r0: Any = None) -> Any:
+    """One SSP-RK3 step of size dt (``r0``: the cell coefficients of U, if already evaluated).
 
     Written as three stages U_{k+1} = a_k U + (1 − a_k)(U_k + Δt L(U_k)), a = (0, 3/4, 1/3),
     in a ``fori_loop`` so the right-hand side is traced (and compiled) once, not three times.
@@ -329,19 +327,19 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
     if stage_kernel_applies(grid, phys, num, U[0].dtype):
         from . import fluxes
         from .cell_program import for_physics, leaf_values
-        from .flux_kernel import ssprk_stage, ssprk_stage_cells, ssprk_stage_padded
+        from .flux_kernel import ssprk_stage, ssprk_stage_cells
 
         program = for_physics(phys, U[0].dtype) if fluxes.CELL_PROGRAM else None
         if program is not None:  # the closures inside the kernel: each stage is one call
             leaf = leaf_values(phys)
-            first = 0
-            if work is not None:  # the first stage's closures are the step limits' (advance)
-                U = tuple(U)
-                first, U1 = 1, ssprk_stage_padded(U, U, work, coef[0], dt, grid, phys.material_density,
-                                                  num.limiter, num.riemann)
-            return jax.lax.fori_loop(first, 3, lambda k, Uk: ssprk_stage_cells(
-                U, Uk, program, leaf, coef[k], dt, grid, phys.material_density, num.limiter, num.riemann),
-                tuple(U) if work is None else U1)
+            U = tuple(U)
+
+            def cells_stage(k: Any, Uk: tuple, in_place: bool = True) -> tuple:
+                return ssprk_stage_cells(U, Uk, program, leaf, coef[k], dt, grid, phys.material_density,
+                                         num.limiter, num.riemann, in_place)
+
+            # The first stage writes a new buffer (U is still needed); the later ones overwrite their input.
+            return jax.lax.fori_loop(1, 3, cells_stage, cells_stage(0, U, in_place=False))
 
         def kernel_stage(k: Any, Uk: tuple, r: Any) -> tuple:
             W, eos, transport, source = kernel_stage_inputs(Uk, r, phys)
@@ -478,16 +476,17 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
 
     def body(carry: tuple) -> tuple:
         U, t, n, _, _ = carry
-        # The closures of the step start serve both the step limits and the step's first stage:
-        # evaluated by XLA, or by the stage kernel's cell program into its workspace.
+        # The closures of the step start: evaluated by XLA, they serve both the step limits and the step's
+        # first stage; with a cell program, the kernel reduces the limit terms (and each stage evaluates
+        # its own closures as it sweeps).
         if program is None:
             r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
             lim = step_limits(U, grid, phys, num, r0)
         else:
             from .cell_program import leaf_values
-            from .flux_kernel import cell_fields
+            from .flux_kernel import cell_limits
 
-            work, maxima = cell_fields(U, program, leaf_values(phys, grid), grid, num.limiter, num.riemann)
+            maxima = cell_limits(U, program, leaf_values(phys, grid), grid, num.limiter, num.riemann)
             lim = kernel_step_limits(maxima, grid, num)
         # Time is kept in float64 whatever the state precision, so a float32 run still lands
         # exactly on t_end.
@@ -497,7 +496,7 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         if program is None:
             U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t, r0)
         else:
-            U_new = ssprk3_step(U, dt.astype(U[0].dtype), grid, phys, num, t, work=work)
+            U_new = ssprk3_step(U, dt.astype(U[0].dtype), grid, phys, num, t)
             residual = jnp.zeros((), U[0].dtype)
         bad_state = state_status(U_new, phys)
         status = jnp.where(bad_state != 0, bad_state, jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5))
