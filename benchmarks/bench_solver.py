@@ -204,13 +204,15 @@ def main() -> None:
         for p in args.precisions.split(","):
             if (scheme, "proposed", p) in rates and (scheme, "ret", p) in rates:
                 print(f"{scheme} {p}: Proposed/RET cell-step rate {rates[scheme, 'proposed', p] / rates[scheme, 'ret', p]:.2f}"
-                      f" wall, {rates['cpu', scheme, 'proposed', p] / rates['cpu', scheme, 'ret', p]:.2f} CPU"
+                      f" wall, {rates['cpu', scheme, 'proposed', p] / rates['cpu', scheme, 'ret', p]:.2f} CPU, "
+                      f"{rates['steady', scheme, 'proposed', p] / rates['steady', scheme, 'ret', p]:.2f} steady"
                       f" (NumPy reference Proposed/RET {refs['ret'] / refs['proposed']:.2f})")
         for m in args.models.split(","):
             for p in ("float32", "mixed"):
                 if (scheme, m, p) in rates and (scheme, m, "float64") in rates:
                     print(f"{scheme} {m}: {p}/float64 rate {rates[scheme, m, p] / rates[scheme, m, 'float64']:.2f}"
-                          f" wall, {rates['cpu', scheme, m, p] / rates['cpu', scheme, m, 'float64']:.2f} CPU")
+                          f" wall, {rates['cpu', scheme, m, p] / rates['cpu', scheme, m, 'float64']:.2f} CPU, "
+                          f"{rates['steady', scheme, m, p] / rates['steady', scheme, m, 'float64']:.2f} steady")
     print(f"load average at the end {os.getloadavg()}")
 
 
