@@ -99,15 +99,16 @@ def test_mu_zero_is_bit_for_bit_the_frictionless_run(scheme: str) -> None:
 
 
 @pytest.mark.parametrize("scheme", [pytest.param("imex", marks=pytest.mark.slow), "ssprk3"])
-def test_a_frictional_stress_that_vanishes_changes_no_bit(scheme: str) -> None:
-    """Below φ_min the Johnson–Jackson p_f (and so μ_f and its work) is 0: the run is the one without a stress."""
+def test_a_frictional_stress_that_vanishes_changes_nothing_but_round_off(scheme: str) -> None:
+    """Below φ_min the Johnson–Jackson p_f (and so μ_f and its work) is 0: the run is the one without a stress.
+
+    The compiled step differs by the zero terms, which XLA fuses differently, so the two runs agree to
+    round-off, not bit for bit (IMEX, jaxlib 0.10.2 on this machine: 56 of 80 densities one ulp apart,
+    1.1e-13 kg/m³ at ~1e3; a stress that did not vanish would change them by many orders more)."""
     with_stress = get_model("frictional", stress="schaeffer")
     assert with_stress.friction.jj_phi_min == 0.5
     a, b = _sheared_run(with_stress, 0.4, scheme), _sheared_run(get_model("frictional"), 0.4, scheme)
-    if scheme == "imex":
-        np.testing.assert_array_equal(a, b)
-    else:  # the explicit step's compiled graph differs by the zero terms: equal to round-off only
-        np.testing.assert_allclose(a, b, rtol=1e-14, atol=1e-14 * np.abs(b).max())
+    np.testing.assert_allclose(a, b, rtol=1e-14, atol=1e-14 * np.abs(b).max())
 
 
 # --- 3. uniform shear: the closed form of ktgf shear --mu ----------------------------------------------
