@@ -93,7 +93,7 @@ KTGF_INLINE T slope(T dm, T dp) {  // fluxes.limited_slope
 template <class T>
 struct Consts {
   long n[3];
-  long stride[3];     // of the padded fields
+  long stride[2];     // plane and row strides of the padded fields
   T inv_dx[3];        // 1/dx_a (normal derivatives, face divergence)
   T half_inv_dx[3];   // 0.5/dx_a (central derivatives)
   T omega_factor[3];  // (1/dx_a)/rho_s
@@ -500,7 +500,6 @@ Consts<Real> consts(const long* n, const double* params) {
   for (int a = 0; a < 3; ++a) k.n[a] = n[a];
   k.stride[0] = (n[1] + 2 * GHOST) * (n[2] + 2 * GHOST);
   k.stride[1] = n[2] + 2 * GHOST;
-  k.stride[2] = 1;
   const double rho_s = params[3];
   for (int a = 0; a < 3; ++a) {
     k.inv_dx[a] = Real(1.0 / params[a]);
@@ -682,7 +681,7 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
     nt = omp_get_num_threads();
     t = omp_get_thread_num();
 #endif
-    const long per = capacity / nt;  // the same in every thread: all take the same branch (and barriers)
+    const long per = capacity / nt;  // the same in every thread: all take the same branch
     if (per < ring_size(kg.n, nt)) {
 #pragma omp single
       fits = false;
@@ -691,9 +690,8 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
       const long m1 = nj + 2 * GHOST, plane = m1 * m2, slots = RING + 2;
       T* ring = ring_all + t * per;
       Consts<T> k = kg;
-      k.stride[0] = plane;
-      k.stride[1] = m2;
-      RowBuffers<T> r(nj > 0 ? nj : 1, n2);
+      k.stride[1] = m2;  // rows of the ring (planes are reached through the tables)
+      RowBuffers<T> r(nj, n2);  // nj >= MIN_ROWS: fused_threads
       // Slot of plane p (-2 <= p < n0 + 2; planes 0, 1 and their periodic images n0, n0 + 1 in the kept slots).
       auto slot_of = [&](long p) {
         const long q = p >= n0 ? p - n0 : p;
@@ -728,13 +726,11 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
       auto row = [&](long b) { return (b + GHOST) * m2 + GHOST; };
       const T* P0[3 * NFIELD];
       const T* P1[3 * NFIELD];
-      if (nj > 0) {
-        for (long p = -2; p < 2; ++p) place(p);
-        table(-1, P0);
-        table(0, P1);
-        start_block<T, LIM, RIE, true>(P0, P1, nj, row, k, r);
-      }
-      for (long i = 0; i < n0 && nj > 0; ++i) {
+      for (long p = -2; p < 2; ++p) place(p);
+      table(-1, P0);
+      table(0, P1);
+      start_block<T, LIM, RIE, true>(P0, P1, nj, row, k, r);
+      for (long i = 0; i < n0; ++i) {
         place(i + 2);
         table(i, P0);
         table(i + 1, P1);

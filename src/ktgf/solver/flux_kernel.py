@@ -134,6 +134,8 @@ def _library(v: Variant) -> Any:
         lib = ctypes.cdll.LoadLibrary(str(build(v)))
         for entry, base in ENTRIES[v.kind].items():
             jax.ffi.register_ffi_target(target(base, v), jax.ffi.pycapsule(getattr(lib, entry)), platform="cpu")
+        if v.kind == "stage":
+            lib.KtgfRingElements.restype = ctypes.c_long
         _loaded[v] = lib
     return lib
 
@@ -258,9 +260,7 @@ def _stage_params(a: Any, dt: Any, grid: Any, rho_s: Any, dtype: Any) -> Any:
 def _ring(grid: Any, dtype: Any, v: Variant) -> Any:
     """The workspace of :func:`ssprk_stage_cells`: the planes its threads keep (``KtgfRingElements``)."""
     n = [ctypes.c_long(int(c)) for c in grid.cells]
-    lib = _library(v)
-    lib.KtgfRingElements.restype = ctypes.c_long
-    return jax.ShapeDtypeStruct((int(lib.KtgfRingElements(*n)),), dtype)
+    return jax.ShapeDtypeStruct((int(_library(v).KtgfRingElements(*n)),), dtype)
 
 
 def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any,
@@ -276,10 +276,10 @@ def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any
     """
     _register(program, limiter, riemann)
     dtype = Uk[0].dtype
-    v = variant(dtype, limiter, riemann, "stage")
+    stage = variant(dtype, limiter, riemann, "stage")
     state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
     field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
-    call = jax.ffi.ffi_call(target(CELLS_TARGET, v), (field,) * 5 + (_ring(grid, dtype, v),),
-                            input_output_aliases={7 + v: v for v in range(5)} if in_place else None)
+    call = jax.ffi.ffi_call(target(CELLS_TARGET, stage), (field,) * 5 + (_ring(grid, dtype, stage),),
+                            input_output_aliases={7 + i: i for i in range(5)} if in_place else None)
     params = _stage_params(a, dt, grid, rho_s, dtype)
     return tuple(call(params, leaf, *state, **_schemes(limiter, riemann), program=np.int64(program.key))[:5])

@@ -479,6 +479,7 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         # The closures of the step start: evaluated by XLA, they serve both the step limits and the step's
         # first stage; with a cell program, the kernel reduces the limit terms (and each stage evaluates
         # its own closures as it sweeps).
+        r0 = None
         if program is None:
             r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
             lim = step_limits(U, grid, phys, num, r0)
@@ -493,11 +494,7 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         dt_stable = dt_of_limits(lim, num).astype(t.dtype)
         last = dt_stable >= t_end - t
         dt = jnp.where(last, t_end - t, dt_stable)
-        if program is None:
-            U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t, r0)
-        else:
-            U_new = ssprk3_step(U, dt.astype(U[0].dtype), grid, phys, num, t)
-            residual = jnp.zeros((), U[0].dtype)
+        U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t, r0)
         bad_state = state_status(U_new, phys)
         status = jnp.where(bad_state != 0, bad_state, jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5))
         status = jnp.where((status == 0) & ~(residual <= RESIDUAL_FAIL), 6, status)
