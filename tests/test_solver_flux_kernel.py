@@ -14,6 +14,7 @@ is announced (INFO on the ``ktgf`` logger, which the command line shows).
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import os
 import re
@@ -36,8 +37,9 @@ from ktgf.closures.models import list_models
 from ktgf.solver.friction import cell_coefficients, for_case
 from ktgf.solver.sources import cooling_source
 from ktgf.solver.state import primitive_fields
-from ktgf.solver.stepping import (LIMIT_TERMS, Numerics, advance, explicit_rhs, kernel_stage_inputs, kernel_step_limits,
-                                  limit_terms, ssprk3_step, start_program, step_limits)
+from ktgf.solver.stepping import (LIMIT_TERMS, START_TERMS, STATUS_TERMS, Numerics, advance, explicit_rhs,
+                                  kernel_stage_inputs, kernel_step_limits, limit_terms, ssprk3_step, start_program,
+                                  state_status, status_of_maxima, status_terms, step_limits)
 
 D, RHO_S = 1e-3, 2500.0
 #: float64: the kernel does the operations of the JAX path in the same order; XLA's fusion may round
@@ -236,6 +238,37 @@ def test_fused_stage_does_not_depend_on_the_threads(tmp_path) -> None:
     assert len(digests) == 1
 
 
+@pytest.mark.parametrize(("stop", "accepted"), [(0.362, 3), (0.345, 0)])
+def test_fused_loop_returns_the_last_good_state(stop: float, accepted: int) -> None:
+    """The fused loop writes each step over the one before and checks a step's state in the next step's
+    first pass: a rejected step has overwritten the last good state, which ``advance`` computes again.  A
+    flow converging on x = 0 raises the maximum φ by ≈ 0.004 a step; phi_stop stops it at the fourth step
+    (or the first: the last good state is then the initial one).  The outcome is that of the XLA closures'
+    loop, which keeps the last good state (:func:`state_status` and a select), and the returned state is the
+    one the accepted steps alone give, bit for bit."""
+    grid = _grid()
+    phys = dataclasses.replace(for_case(_physics("ret"), "cooling", grid), phi_stop=stop)
+    U = list(_state(grid, phys, jnp.float64, phi=0.3))
+    x = (np.arange(grid.cells[0]) + 0.5) / grid.cells[0]
+    u = -0.02 * np.sin(2.0 * np.pi * x)[:, None, None]  # ≈ the thermal speed (0.016 m/s)
+    U[4] = U[4] + U[1] * u + 0.5 * U[0] * u**2
+    U[1] = U[1] + U[0] * u
+    U = tuple(U)
+    assert 0.343 < float(jnp.max(U[0])) / RHO_S < 0.345  # the initial state is fine
+    num = Numerics(scheme="ssprk3")
+    fused = _with_kernel(True, lambda: advance(U, 0.0, 1e30, 10, grid, phys, num))
+    assert _with_kernel(True, lambda: start_program(grid, phys, num, jnp.float64)) is not None  # the fused loop
+    kept = _with_kernel(True, lambda: advance(U, 0.0, 1e30, 10, grid, phys, num), cells=False)
+    assert [int(fused[k]) for k in (2, 3)] == [int(kept[k]) for k in (2, 3)] == [accepted, 3]
+    assert float(fused[1]) == pytest.approx(float(kept[1]), rel=1e-12)
+    assert float(fused[1]) > 0.0 if accepted else float(fused[1]) == 0.0
+    assert _close(fused[0], kept[0]) < RTOL[jnp.float64]
+    assert int(state_status(tuple(fused[0]), phys)) == 0
+    alone = _with_kernel(True, lambda: advance(U, 0.0, 1e30, accepted, grid, phys, num))
+    assert int(alone[2]) == accepted and int(alone[3]) == 0
+    assert np.array_equal(np.asarray(fused[0]), np.asarray(alone[0]))
+
+
 def test_fused_stage_refuses_a_small_ring(monkeypatch) -> None:
     """The fused stage's workspace (its threads' rings) is sized by the kernel (KtgfRingElements): one element
     short, the call is an error, not a write past the buffer."""
@@ -323,7 +356,8 @@ def test_step_limits_reduced_in_the_kernel(model: str, dtype) -> None:
     """The step limits from the maxima the kernel reduces in its padding pass are those of the XLA
     closures and reductions (:func:`step_limits`; float32: of the float64 state, to the float32 closures'
     rounding); each of the four follows its own term, so a swap of terms, axes or cell sizes shows, and a
-    NaN term (θ < 0 in one cell) reaches the maxima as in ``jnp.max``."""
+    NaN term (θ < 0 in one cell) reaches the maxima as in ``jnp.max``.  The same pass reduces the state
+    check's terms: each status code comes out as :func:`state_status` gives it."""
     from ktgf.solver.cell_program import leaf_values
 
     grid = _grid()
@@ -331,7 +365,7 @@ def test_step_limits_reduced_in_the_kernel(model: str, dtype) -> None:
     U = _state(grid, phys, dtype, phi=0.5)
     num = Numerics(scheme="ssprk3")
     program = _with_kernel(True, lambda: start_program(grid, phys, num, dtype))
-    assert program is not None and program.nlim == len(LIMIT_TERMS)
+    assert program is not None and program.nlim == len(START_TERMS) == len(LIMIT_TERMS) + len(STATUS_TERMS)
     reduce = jax.jit(lambda U: flux_kernel.cell_limits(U, program, leaf_values(phys, grid), grid, num.limiter,
                                                        num.riemann))
     got = np.asarray(kernel_step_limits(reduce(U), grid, num), np.float64)
@@ -341,13 +375,26 @@ def test_step_limits_reduced_in_the_kernel(model: str, dtype) -> None:
     assert len(set(np.round(want / want.min(), 6))) == 4  # four different limits: a swap would show
     # Each maximum, from every cell (the threads' partial maxima merged), against NumPy's of the XLA terms.
     W = primitive_fields(U)
-    terms = limit_terms(W, cell_coefficients(W, grid, phys), phys, num.acoustics, grid.spacing)
+    terms = (*limit_terms(W, cell_coefficients(W, grid, phys), phys, num.acoustics, grid.spacing), *status_terms(U, W))
     np.testing.assert_allclose(np.asarray(reduce(U), np.float64), [float(np.max(np.asarray(f))) for f in terms],
                                rtol=tol)
+
+    stop = dataclasses.replace(phys, phi_stop=0.6)  # above the state's φ (the frictional model's own is below)
+
+    def status(U: tuple) -> tuple[int, int]:  # (from the kernel's maxima, from state_status)
+        return int(status_of_maxima(reduce(U)[len(LIMIT_TERMS):], stop)), int(state_status(U, stop))
+
+    assert status(U) == (0, 0)
+    cell = (5, 7, 9)  # the last cell of a thread
     cold = list(U)
-    cold[4] = cold[4].at[5, 7, 9].set(0.5 * (cold[1][5, 7, 9] ** 2 + cold[2][5, 7, 9] ** 2 + cold[3][5, 7, 9] ** 2)
-                                      / cold[0][5, 7, 9] * 0.5)  # kinetic energy > E: θ < 0 in the last cell of a thread
+    cold[4] = cold[4].at[cell].set(0.5 * (cold[1][cell] ** 2 + cold[2][cell] ** 2 + cold[3][cell] ** 2)
+                                   / cold[0][cell] * 0.5)  # kinetic energy > E: θ < 0
     assert np.isnan(np.asarray(reduce(tuple(cold)))[0])  # c = √(θg) is NaN there
+    assert status(tuple(cold)) == (2, 2)
+    for v, value, code in ((3, np.inf, 1), (1, np.nan, 1), (0, 0.6 * RHO_S, 3), (0, 0.0, 4)):
+        bad = list(U)
+        bad[v] = bad[v].at[cell].set(value)
+        assert status(tuple(bad)) == (code, code), (v, value)
 
 
 def _sweeps(library) -> set[tuple[str, ...]]:

@@ -40,7 +40,8 @@ from jax.extend.core import Literal
 from .cxx import shared_library
 
 #: Outputs of a cell program, in the order the kernel stores them (its Field enum, then s0, s1); a
-#: step-start program (``limits``) adds :data:`.stepping.LIMIT_TERMS`, which the kernel reduces to maxima.
+#: step-start program (``limits``) adds :data:`.stepping.LIMIT_TERMS` and :data:`.stepping.STATUS_TERMS`, which the
+#: kernel reduces to maxima.
 OUTPUTS = ("rho", "u_x", "u_y", "u_z", "theta", "p_star", "g", "eta", "lambda_b", "kappa", "omega", "s0", "s1")
 FLAGS = ("-O3", "-march=native", "-fopenmp-simd", "-ffp-contract=off", "-fno-math-errno", "-shared", "-fPIC",
          "-std=c++17")
@@ -211,13 +212,14 @@ def source_for(treedef: Any, avals: tuple, dtype: Any, limits: str | None = None
     ``treedef`` and parameter types ``avals`` (raises :class:`Unsupported`).
 
     ``limits`` (the acoustics, ``"explicit"`` or ``"implicit"``): a step-start program, whose outputs add the
-    :data:`.stepping.LIMIT_TERMS` of a 3D grid; its parameters then end with the three cell sizes Δx_a,
+    :data:`.stepping.LIMIT_TERMS` of a 3D grid and the :data:`.stepping.STATUS_TERMS` of the state (together
+    :data:`.stepping.START_TERMS`); its parameters then end with the three cell sizes Δx_a,
     traced as Python floats are (weakly typed), so the terms round as in :func:`.stepping.step_limits`.
     """
     from .friction import cell_coefficients, needs_rate
     from .physics import is_frictional
     from .state import primitive_fields
-    from .stepping import LIMIT_TERMS, kernel_stage_inputs, limit_terms
+    from .stepping import START_TERMS, kernel_stage_inputs, limit_terms, status_terms
 
     phys = jax.tree_util.tree_unflatten(treedef, avals)
     if needs_rate(phys):
@@ -232,10 +234,10 @@ def source_for(treedef: Any, avals: tuple, dtype: Any, limits: str | None = None
         if is_frictional(r):
             raise Unsupported("a frictional stress")
         W, eos, transport, source = kernel_stage_inputs(U, r, ph)
-        extra = () if limits is None else limit_terms(W, r, ph, limits, leaves[nleaf:])
+        extra = () if limits is None else (*limit_terms(W, r, ph, limits, leaves[nleaf:]), *status_terms(U, W))
         return (*W, *eos, *transport, *source, *extra)
 
-    nout = len(OUTPUTS) + (0 if limits is None else len(LIMIT_TERMS))
+    nout = len(OUTPUTS) + (0 if limits is None else len(START_TERMS))
     state = tuple(jax.ShapeDtypeStruct((), dtype) for _ in range(5))
     closed = jax.make_jaxpr(cells)(state, list(avals))
     ctype = _ctype(dtype)
@@ -268,12 +270,12 @@ def _compiled(source: str, dtype: Any, nlim: int, what: str) -> CellProgram:
 
 @functools.lru_cache(maxsize=None)
 def _program(treedef: Any, avals: tuple, dtype: Any, limits: str | None) -> CellProgram | None:
-    from .stepping import LIMIT_TERMS
+    from .stepping import START_TERMS
 
     model = jax.tree_util.tree_unflatten(treedef, avals).model.name
     what = f"the {np.dtype(dtype).name} {'step-start ' if limits else ''}cell program of {model}"
     try:
-        return _compiled(source_for(treedef, avals, dtype, limits), dtype, 0 if limits is None else len(LIMIT_TERMS),
+        return _compiled(source_for(treedef, avals, dtype, limits), dtype, 0 if limits is None else len(START_TERMS),
                          what)
     except (Unsupported, RuntimeError, OSError):
         return None

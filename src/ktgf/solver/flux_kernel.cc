@@ -664,7 +664,8 @@ inline void wait_for(const Progress* progress, int t, int nt, long p) {
 // once per cell, plus the ghost rows (2 GHOST / (n1 / threads) more) and the first planes.  U' may be written
 // over Uk: a thread reads Uk of plane p for the closures (at step p - 2) and the update (step p) before it
 // writes U' of plane p, and it writes plane p only once its neighbours, whose ghost rows are its rows, have
-// computed plane p (wait_for); planes 0 and 1, needed again at the end, are kept in their own slots.
+// computed plane p (wait_for); planes 0 and 1, needed again at the end, are kept in their own slots.  U' may
+// instead be written over U0, which is read only at the cell being written.
 // Returns false (nothing computed) if the threads' rings do not fit in `capacity`.
 template <class T, int LIM, int RIE>
 bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const Stage<T>& o, T* ring_all,
@@ -839,7 +840,7 @@ ffi::Error cell_limits_entry(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs stat
 }
 
 // KtgfSsprkStageCells: one SSP-RK3 stage whose cell fields the cell program computes as the sweep goes
-// (sweep_fused); `ring` its per-thread planes (ring_elements).  U' may alias Uk (see sweep_fused).
+// (sweep_fused); `ring` its per-thread planes (ring_elements).  U' may alias Uk or U0 (see sweep_fused).
 ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state,
                              int32_t limiter, int32_t riemann, int64_t program, ffi::Result<ffi::AnyBuffer> u0,
                              ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2,

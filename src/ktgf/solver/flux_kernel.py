@@ -239,10 +239,10 @@ def _register(program: Any, limiter: str, riemann: str) -> None:
 
 
 def cell_limits(Uk: Any, program: Any, leaf: Any, grid: Any, limiter: str, riemann: str) -> Any:
-    """The maxima over the cells of the limit terms (:data:`.stepping.LIMIT_TERMS`) of the step-start cell
-    program ``program`` (:func:`.cell_program.for_physics` with ``limits``) at the state Uk: the closures and
-    step-limit reductions of a step's start in one pass that writes nothing per cell, so that the step size
-    is known before the first stage.  ``limiter``, ``riemann``: those of the stage that follows, whose library
+    """The maxima over the cells of the terms (:data:`.stepping.START_TERMS`: step limits, then state status) of
+    the step-start cell program ``program`` (:func:`.cell_program.for_physics` with ``limits``) at the state Uk:
+    the closures, step-limit and state-check reductions of a step's start in one pass that writes nothing per
+    cell, so that the step size is known before the first stage.  ``limiter``, ``riemann``: those of the stage that follows, whose library
     this call uses (the pass does not depend on them)."""
     _register(program, limiter, riemann)
     dtype = Uk[0].dtype
@@ -264,22 +264,25 @@ def _ring(grid: Any, dtype: Any, v: Variant) -> Any:
 
 
 def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any,
-                      limiter: str, riemann: str, in_place: bool = True) -> tuple[Any, ...]:
+                      limiter: str, riemann: str, write_over: str = "uk") -> tuple[Any, ...]:
     """The SSP-RK3 stage of :func:`ssprk_stage` with the cell fields and the energy source computed in
     the kernel from Uk by a cell program (:func:`.cell_program.for_physics`) with parameters ``leaf``
     (:func:`.cell_program.leaf_values`), plane by plane as the sweep goes (the fused sweep of
     flux_kernel.cc): no cell field is written to memory.
 
-    ``in_place``: U' is written over Uk (no new buffers; the later stages of a step).  A step's first stage
-    has Uk = U0, which the later stages still read, so it writes a new buffer instead: written in place,
-    XLA would first copy U0 (measured: 7 % of a 64³ step in copies).
+    ``write_over``: which input buffers U' is written over, so that the stage needs no new ones: ``"uk"`` (the
+    second stage of a step), ``"u0"`` (the last stage, when the caller no longer needs the step's start state:
+    the kernel reads U0 only at the cell it writes) or ``"new"`` (fresh buffers).  A step's first stage has
+    Uk = U0, which the later stages still read, so it writes new buffers: written in place, XLA would first
+    copy U0 (measured: 7 % of a 64³ step in copies).
     """
     _register(program, limiter, riemann)
     dtype = Uk[0].dtype
     stage = variant(dtype, limiter, riemann, "stage")
     state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
     field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
+    first = {"u0": 2, "uk": 7, "new": None}[write_over]  # the inputs are params, leaf, U0 (5), Uk (5)
     call = jax.ffi.ffi_call(target(CELLS_TARGET, stage), (field,) * 5 + (_ring(grid, dtype, stage),),
-                            input_output_aliases={7 + i: i for i in range(5)} if in_place else None)
+                            input_output_aliases=None if first is None else {first + i: i for i in range(5)})
     params = _stage_params(a, dt, grid, rho_s, dtype)
     return tuple(call(params, leaf, *state, **_schemes(limiter, riemann), program=np.int64(program.key))[:5])

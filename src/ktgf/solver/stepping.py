@@ -193,6 +193,9 @@ def rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> Any:
 
 #: The cell fields whose maxima give the step limits (:func:`limit_terms`, :func:`limits_of_maxima`).
 LIMIT_TERMS = ("wave", "viscous", "conductive", "zeta", "abs_zeta_u", "u_x", "u_y", "u_z", "-u_x", "-u_y", "-u_z")
+#: What a step-start cell program reduces (:func:`.flux_kernel.cell_limits`): the limit terms, then the
+#: state's :data:`STATUS_TERMS`.
+START_TERMS = LIMIT_TERMS + ("nonfinite", "-theta", "rho", "-rho")
 
 
 def limit_terms(W: Any, r: Any, phys: Physics, acoustics: str, spacing: Any) -> tuple:
@@ -313,13 +316,16 @@ def start_program(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> Any:
     return for_physics(phys, dtype, limits=num.acoustics)
 
 
-def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0, r0: Any = None) -> Any:
+def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0, r0: Any = None,
+                consume: bool = False) -> Any:
     """One SSP-RK3 step of size dt (``r0``: the cell coefficients of U, if already evaluated).
 
     Written as three stages U_{k+1} = a_k U + (1 − a_k)(U_k + Δt L(U_k)), a = (0, 3/4, 1/3),
     in a ``fori_loop`` so the right-hand side is traced (and compiled) once, not three times.
     Where :func:`stage_kernel_applies`, each stage is the closures (XLA) and one kernel call, or
     only the kernel call where the closures have a cell program (:mod:`.cell_program`).
+    ``consume``: the caller does not use U after the step, so (with a cell program) the last stage writes
+    the new state over U's buffers and a step allocates none.
     """
     coef = jnp.asarray([0.0, 0.75, 1.0 / 3.0], dtype=U[0].dtype)
     when = jnp.asarray([0.0, 1.0, 0.5], dtype=jnp.result_type(t, float))  # stage times / Δt
@@ -334,12 +340,14 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
             leaf = leaf_values(phys)
             U = tuple(U)
 
-            def cells_stage(k: Any, Uk: tuple, in_place: bool = True) -> tuple:
+            def cells_stage(k: int, Uk: tuple, write_over: str) -> tuple:
                 return ssprk_stage_cells(U, Uk, program, leaf, coef[k], dt, grid, phys.material_density,
-                                         num.limiter, num.riemann, in_place)
+                                         num.limiter, num.riemann, write_over)
 
-            # The first stage writes a new buffer (U is still needed); the later ones overwrite their input.
-            return jax.lax.fori_loop(1, 3, cells_stage, cells_stage(0, U, in_place=False))
+            # The first stage writes new buffers (U is still needed), the second overwrites its input, the last
+            # its input or U.
+            U2 = cells_stage(1, cells_stage(0, U, "new"), "uk")
+            return cells_stage(2, U2, "u0" if consume else "uk")
 
         def kernel_stage(k: Any, Uk: tuple, r: Any) -> tuple:
             W, eos, transport, source = kernel_stage_inputs(Uk, r, phys)
@@ -415,13 +423,14 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
 
 
 def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0,
-                r0: Any = None) -> tuple[Any, Any]:
+                r0: Any = None, consume: bool = False) -> tuple[Any, Any]:
     """One step of the configured scheme from time t: (state, implicit residual / tolerance — 0 for SSP-RK3).
 
-    ``r0``: the cell coefficients of U, if already evaluated."""
+    ``r0``: the cell coefficients of U, if already evaluated; ``consume``: U is not used after the step
+    (:func:`ssprk3_step`)."""
     if num.scheme == "imex":
         return imex_step(U, dt, grid, phys, num, t, r0)
-    return ssprk3_step(U, dt, grid, phys, num, t, r0), jnp.zeros((), U[0].dtype)
+    return ssprk3_step(U, dt, grid, phys, num, t, r0, consume), jnp.zeros((), U[0].dtype)
 
 
 #: CPU time of one IMEX step over one SSP-RK3 step, measured (RET at φ = 0.5 with Δx = ℓ, 32³:
@@ -449,16 +458,34 @@ def binding_limit(lim: Any, scheme: str) -> str:
 RESIDUAL_FAIL = 10.0
 
 
-def state_status(U: Any, phys: Physics) -> Any:
-    """Status code (0 fine, 1 non-finite, 2 θ ≤ 0, 3 φ ≥ phi_stop, 4 ρ ≤ 0) of a state."""
-    W = primitive_fields(U)
-    finite = jnp.all(jnp.stack([jnp.all(jnp.isfinite(f)) for f in U]))
+#: The cell fields whose maxima give a state's status code (:func:`status_of_maxima`): 0·Σ U (0, or NaN
+#: where a conservative field is NaN or infinite), −θ, ρ and −ρ.
+STATUS_TERMS = START_TERMS[len(LIMIT_TERMS):]
+
+
+def status_terms(U: Any, W: Any) -> tuple:
+    """The cell fields of :data:`STATUS_TERMS` of a state U with primitive fields W.  Elementwise, so a
+    step-start cell program evaluates them with the limit terms and the kernel reduces them
+    (:func:`.flux_kernel.cell_limits`): the state check of a step is then part of the next step's first pass."""
+    nonfinite = sum(0.0 * f for f in U)  # 0·x is 0 for finite x, NaN for NaN and ±inf
+    return nonfinite, -W[4], W[0], -W[0]
+
+
+def status_of_maxima(maxima: Any, phys: Physics) -> Any:
+    """Status code (0 fine, 1 non-finite, 2 θ ≤ 0, 3 φ ≥ phi_stop, 4 ρ ≤ 0; the first that applies) from the
+    maxima over the cells of :data:`STATUS_TERMS` (a NaN wins a maximum, as in ``jnp.max``)."""
+    nonfinite, neg_theta, rho, neg_rho = maxima
     return jnp.where(
-        ~finite, 1,
-        jnp.where(jnp.min(W[4]) <= 0.0, 2,
-                  jnp.where(jnp.max(W[0]) >= phys.phi_stop * phys.material_density, 3,
-                            jnp.where(jnp.min(W[0]) <= 0.0, 4, 0))),
+        ~jnp.isfinite(nonfinite), 1,
+        jnp.where(neg_theta >= 0.0, 2,
+                  jnp.where(rho >= phys.phi_stop * phys.material_density, 3,
+                            jnp.where(neg_rho >= 0.0, 4, 0))),
     ).astype(jnp.int32)
+
+
+def state_status(U: Any, phys: Physics) -> Any:
+    """Status code (:func:`status_of_maxima`) of a state."""
+    return status_of_maxima([jnp.max(f) for f in status_terms(U, primitive_fields(U))], phys)
 
 
 @jax.jit
@@ -468,48 +495,70 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
     Returns ``(U, t, steps, status, dt)``: the last good state and its time, the number of
     accepted steps, the status code of the first rejected step (0 if none) and the Δt of the
     last attempted step (to reproduce a failure for its diagnosis).
+
+    With a step-start cell program (:func:`start_program`) the loop keeps no second state: each step is
+    written over the one before (:func:`ssprk3_step`'s ``consume``), and its state check is part of the next
+    step's first pass (:func:`.flux_kernel.cell_limits` reduces the :data:`STATUS_TERMS` with the limit
+    terms).  A rejected step has then overwritten the last good state, which is computed again from U by
+    repeating the accepted steps: the same compiled steps, so the same bits (the kernels do not depend on
+    the thread count: tests/test_solver_flux_kernel.py).
     """
+    program = start_program(grid, phys, num, U[0].dtype)
 
-    def cond(carry: tuple) -> Any:
-        _, t, n, status, _ = carry
-        return (t < t_end) & (n < max_steps) & (status == 0)
+    def cond_before(limit: Any) -> Any:
+        return lambda carry: (carry[1] < t_end) & (carry[2] < limit) & (carry[3] == 0)
 
-    def body(carry: tuple) -> tuple:
-        U, t, n, _, _ = carry
-        # The closures of the step start: evaluated by XLA, they serve both the step limits and the step's
-        # first stage; with a cell program, the kernel reduces the limit terms (and each stage evaluates
-        # its own closures as it sweeps).
-        r0 = None
-        if program is None:
-            r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
-            lim = step_limits(U, grid, phys, num, r0)
-        else:
-            from .cell_program import leaf_values
-            from .flux_kernel import cell_limits
-
-            maxima = cell_limits(U, program, leaf_values(phys, grid), grid, num.limiter, num.riemann)
-            lim = kernel_step_limits(maxima, grid, num)
+    def step_size(lim: Any, t: Any) -> tuple:
         # Time is kept in float64 whatever the state precision, so a float32 run still lands
         # exactly on t_end.
         dt_stable = dt_of_limits(lim, num).astype(t.dtype)
         last = dt_stable >= t_end - t
-        dt = jnp.where(last, t_end - t, dt_stable)
-        U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t, r0)
-        bad_state = state_status(U_new, phys)
+        return dt_stable, jnp.where(last, t_end - t, dt_stable), last
+
+    def outcome(bad_state: Any, residual: Any, dt_stable: Any, dt: Any, last: Any, t: Any, n: Any) -> tuple:
+        """The step's status and, if it is accepted, the new time and step count."""
         status = jnp.where(bad_state != 0, bad_state, jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5))
         status = jnp.where((status == 0) & ~(residual <= RESIDUAL_FAIL), 6, status)
         good = status == 0
-        U = tuple(jnp.where(good, a, b) for a, b in zip(U_new, U))
-        t = jnp.where(good, jnp.where(last, t_end, t + dt), t)
-        return U, t, n + good.astype(n.dtype), status, dt
+        return status, good, jnp.where(good, jnp.where(last, t_end, t + dt), t), n + good.astype(n.dtype)
+
+    def body(carry: tuple) -> tuple:
+        U, t, n, _, _ = carry
+        # The closures of the step start, evaluated by XLA, serve both the step limits and the step's first stage.
+        r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
+        dt_stable, dt, last = step_size(step_limits(U, grid, phys, num, r0), t)
+        U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t, r0)
+        status, good, t, n = outcome(state_status(U_new, phys), residual, dt_stable, dt, last, t, n)
+        return tuple(jnp.where(good, a, b) for a, b in zip(U_new, U)), t, n, status, dt
+
+    def fused_body(carry: tuple) -> tuple:
+        U, t, n, _, _, maxima = carry  # maxima: of START_TERMS at U
+        dt_stable, dt, last = step_size(kernel_step_limits(maxima, grid, num), t)
+        U = ssprk3_step(U, dt.astype(U[0].dtype), grid, phys, num, t, consume=True)
+        maxima = start_maxima(U)
+        status, _, t, n = outcome(status_of_maxima(maxima[len(LIMIT_TERMS):], phys), 0.0, dt_stable, dt, last, t, n)
+        return U, t, n, status, dt, maxima
 
     U = tuple(U)
-    program = start_program(grid, phys, num, U[0].dtype)
     t = jnp.asarray(t, jnp.float64)
     t_end = jnp.asarray(t_end, jnp.float64)
-    init = (U, t, jnp.zeros((), jnp.int32), jnp.zeros((), jnp.int32), jnp.zeros((), jnp.float64))
-    U, t, n, status, dt = jax.lax.while_loop(cond, body, init)
-    return jnp.stack(U), t, n, status, dt
+    zero = jnp.zeros((), jnp.int32)
+    init = (U, t, zero, zero, jnp.zeros((), jnp.float64))
+    if program is None:
+        U, t, n, status, dt = jax.lax.while_loop(cond_before(max_steps), body, init)
+        return jnp.stack(U), t, n, status, dt
+
+    from .cell_program import leaf_values
+    from .flux_kernel import cell_limits
+
+    def start_maxima(U: tuple) -> Any:
+        return cell_limits(U, program, leaf_values(phys, grid), grid, num.limiter, num.riemann)
+
+    init = (*init, start_maxima(U))
+    U_end, t, n, status, dt, _ = jax.lax.while_loop(cond_before(max_steps), fused_body, init)
+    U_end = jax.lax.cond(status == 0, lambda: U_end,
+                         lambda: jax.lax.while_loop(cond_before(n), fused_body, init)[0])
+    return jnp.stack(U_end), t, n, status, dt
 
 
 @jax.jit
