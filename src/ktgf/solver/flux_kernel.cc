@@ -389,8 +389,17 @@ KTGF_INLINE void sweep_rows(const T* const* P0, const T* const* P1, long nb, Row
     row_faces<T, 0, RIE, VISC>(P0, c0, k, hxb, hxnb, n2, r.xhi.data() + b * n2, B * n2);
     row_slopes<T, 1, LIM>(P0, row(b + 1), k, hyn, n2, 0, n2);
     row_faces<T, 1, RIE, VISC>(P0, c0, k, hy, hyn, n2, yhi, n2);
-    row_slopes<T, 2, LIM>(P0, c0, k, r.hz.data() + 1, n2 + 2, -1, n2 + 1);
-    row_faces<T, 2, RIE, VISC>(P0, c0, k, r.hz.data() + 1, r.hz.data() + 2, n2 + 2, r.zf.data() + 1, n2 + 1, -1);
+    // z: the n2 slopes and faces of the row's own cells, then the periodic images (the slopes of cells -1 and n2,
+    // the face below cell 0): the same inputs, so the same bits, and a whole number of vectors (no scalar tail).
+    T* hz = r.hz.data() + 1;
+    T* zf = r.zf.data() + 1;
+    row_slopes<T, 2, LIM>(P0, c0, k, hz, n2 + 2, 0, n2);
+    for (int f = 0; f < 7; ++f) {
+      hz[f * (n2 + 2) - 1] = hz[f * (n2 + 2) + n2 - 1];
+      hz[f * (n2 + 2) + n2] = hz[f * (n2 + 2)];
+    }
+    row_faces<T, 2, RIE, VISC>(P0, c0, k, hz, hz + 1, n2 + 2, zf, n2 + 1, 0);
+    for (int v = 0; v < 5; ++v) zf[v * (n2 + 1) - 1] = zf[v * (n2 + 1) + n2 - 1];
     const T* lo[10];
     const T* hi[10];
     for (int v = 0; v < 5; ++v) {
