@@ -238,14 +238,15 @@ def test_fused_stage_does_not_depend_on_the_threads(tmp_path) -> None:
     assert len(digests) == 1
 
 
-@pytest.mark.parametrize(("stop", "accepted"), [(0.362, 3), (0.345, 0)])
-def test_fused_loop_returns_the_last_good_state(stop: float, accepted: int) -> None:
+@pytest.mark.parametrize(("stop", "accepted", "budget"), [(0.362, 3, 10), (0.362, 3, 4), (0.345, 0, 10), (0.345, 0, 1)])
+def test_fused_loop_returns_the_last_good_state(stop: float, accepted: int, budget: int) -> None:
     """The fused loop writes each step over the one before and checks a step's state in the next step's
-    first pass: a rejected step has overwritten the last good state, which ``advance`` computes again.  A
-    flow converging on x = 0 raises the maximum φ by ≈ 0.004 a step; phi_stop stops it at the fourth step
-    (or the first: the last good state is then the initial one).  The outcome is that of the XLA closures'
-    loop, which keeps the last good state (:func:`state_status` and a select), and the returned state is the
-    one the accepted steps alone give, bit for bit."""
+    first stage (the call's last step after the loop: a budget of ``accepted`` + 1 steps): a rejected step has
+    overwritten the last good state, which ``advance`` computes again.  A flow converging on x = 0 raises the
+    maximum φ by ≈ 0.004 a step; phi_stop stops it at the fourth step (or the first: the last good state is
+    then the initial one).  The outcome is that of the XLA closures' loop, which keeps the last good state
+    (:func:`state_status` and a select), and the returned state is the one the accepted steps alone give,
+    bit for bit."""
     grid = _grid()
     phys = dataclasses.replace(for_case(_physics("ret"), "cooling", grid), phi_stop=stop)
     U = list(_state(grid, phys, jnp.float64, phi=0.3))
@@ -256,9 +257,9 @@ def test_fused_loop_returns_the_last_good_state(stop: float, accepted: int) -> N
     U = tuple(U)
     assert 0.343 < float(jnp.max(U[0])) / RHO_S < 0.345  # the initial state is fine
     num = Numerics(scheme="ssprk3")
-    fused = _with_kernel(True, lambda: advance(U, 0.0, 1e30, 10, grid, phys, num))
+    fused = _with_kernel(True, lambda: advance(U, 0.0, 1e30, budget, grid, phys, num))
     assert _with_kernel(True, lambda: start_program(grid, phys, num, jnp.float64)) is not None  # the fused loop
-    kept = _with_kernel(True, lambda: advance(U, 0.0, 1e30, 10, grid, phys, num), cells=False)
+    kept = _with_kernel(True, lambda: advance(U, 0.0, 1e30, budget, grid, phys, num), cells=False)
     assert [int(fused[k]) for k in (2, 3)] == [int(kept[k]) for k in (2, 3)] == [accepted, 3]
     assert float(fused[1]) == pytest.approx(float(kept[1]), rel=1e-12)
     assert float(fused[1]) > 0.0 if accepted else float(fused[1]) == 0.0
@@ -380,6 +381,11 @@ def test_step_limits_reduced_in_the_kernel(model: str, dtype) -> None:
                                rtol=tol)
 
     stop = dataclasses.replace(phys, phi_stop=0.6)  # above the state's φ (the frictional model's own is below)
+
+    # A step's first stage reduces the same terms as it sweeps (each thread its rows, ghost rows too): the same maxima.
+    _, swept = jax.jit(lambda U: flux_kernel.rate_cells(U, program, leaf_values(phys, grid), grid, RHO_S, num.limiter,
+                                                        num.riemann))(U)
+    assert np.array_equal(np.asarray(swept), np.asarray(reduce(U)), equal_nan=True)
 
     def status(U: tuple) -> tuple[int, int]:  # (from the kernel's maxima, from state_status)
         return int(status_of_maxima(reduce(U)[len(LIMIT_TERMS):], stop)), int(state_status(U, stop))

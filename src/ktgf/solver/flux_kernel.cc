@@ -24,9 +24,12 @@
 //   the program's float64 parameters, U0 and Uk; attribute `program` the key.  The closures are
 //   evaluated plane by plane as the sweep goes (sweep_fused), into a small ring of planes per thread, so
 //   the cell fields never go to memory (measured 1.3x faster per stage at 64^3 than a padding pass that
-//   wrote them all, then a sweep that read them back; bit-identical output).
+//   wrote them all, then a sweep that read them back; bit-identical output).  Attribute `mode`: the
+//   stage update; or (a step's first stage, before its dt is known) the rate L = -div F + source, written
+//   with the maxima of the step-limit and state-check terms of a step-start program, from which XLA
+//   computes dt; or the second stage from that rate, with Uk = U0 + dt L0 computed as it is read.
 // * KtgfCellLimits: the maxima over the cells of the step-limit terms of a step-start cell program (the
-//   closures and the terms), from which XLA computes dt (a few scalars) before the step's first stage.
+//   closures and the terms) alone: the check of a chunk's last state.
 // KtgfFluxDivergence and KtgfSsprkStage output a workspace holding their input fields with two periodic
 // ghost cells per side, KtgfSsprkStageCells its ring (outputs, so that XLA owns and reuses the memory).
 // The padded fields are swept in blocks of ROW_BLOCK rows along the second axis so that the five planes
@@ -223,14 +226,19 @@ struct Rhs {
   T* dU[5];
   T* divu;
 };
+// What a stage writes (Stage::mode): U' = a U0 + b (Uk + dt L); L itself (a step's first stage, whose dt is
+// not known yet: the step size comes from the limit terms this stage reduces); or U' with Uk = U0 + dt L0 (the
+// second stage, from the first one's L0: Uk is the first stage's U' = 0 U0 + 1 (U0 + dt L0), computed again).
+enum StageMode { UPDATE = 0, RATE = 1, FROM_RATE = 2 };
 template <class T>
 struct Stage {
   const T* U0[5];
-  const T* Uk[5];
+  const T* Uk[5];  // FROM_RATE: L0
   const T* s0;  // energy source = s0 + s1 div u
   const T* s1;
   T a, b, dt;   // U' = a U0 + b (Uk + dt L), b = 1 - a
-  T* U[5];
+  T* U[5];      // RATE: L
+  int mode = UPDATE;
 };
 
 // Face fluxes along A of the row starting at padded cell c0: the faces between q and its
@@ -301,31 +309,43 @@ KTGF_INLINE void write_row(const Rhs<T>& o, const T* const* P, long c0, long out
   row_divu(P, c0, k, o.divu + out);
 }
 
+// Field v of a stage's output row at offset `out` (write_row); SRC: with the energy source s0 + s1 div u.
+template <class T, int MODE, bool SRC>
+KTGF_INLINE void stage_row(const Stage<T>& o, int v, long out, const Consts<T>& k, const T* lo, const T* hi,
+                           const T* ylo, const T* yhi, const T* zv, const T* divu, const T* s0, const T* s1) {
+  const long n2 = k.n[2];
+  const T* u0 = o.U0[v] + out;
+  const T* uk = o.Uk[v] + out;
+  T* d = o.U[v] + out;
+#pragma omp simd
+  for (long q = 0; q < n2; ++q) {
+    T L = cell_div(lo, hi, ylo, yhi, zv, q, k);
+    if (SRC) L = L + (s0[q] + s1[q] * divu[q]);
+    if (MODE == RATE) {
+      d[q] = L;
+    } else {
+      const T u = MODE == FROM_RATE ? u0[q] + o.dt * uk[q] : uk[q];
+      d[q] = o.a * u0[q] + o.b * (u + o.dt * L);
+    }
+  }
+}
+
+template <class T, int MODE>
+KTGF_INLINE void stage_rows(const Stage<T>& o, long out, const Consts<T>& k, const T* const* lo, const T* const* hi,
+                            const T* z, long zld, const T* divu, const T* s0, const T* s1) {
+  for (int v = 0; v < 4; ++v)
+    stage_row<T, MODE, false>(o, v, out, k, lo[v], hi[v], lo[5 + v], hi[5 + v], z + v * zld, divu, s0, s1);
+  stage_row<T, MODE, true>(o, 4, out, k, lo[4], hi[4], lo[9], hi[9], z + 4 * zld, divu, s0, s1);
+}
+
 template <class T>
 KTGF_INLINE void write_row(const Stage<T>& o, const T* const* P, long c0, long out, const Consts<T>& k,
                            const T* const* lo, const T* const* hi, const T* z, long zld, T* divu, const T* s0,
                            const T* s1) {
-  const long n2 = k.n[2];
   row_divu(P, c0, k, divu);
-  for (int v = 0; v < 5; ++v) {
-    const T* u0 = o.U0[v] + out;
-    const T* uk = o.Uk[v] + out;
-    T* d = o.U[v] + out;
-    const T* zv = z + v * zld;
-    if (v == 4) {
-#pragma omp simd
-      for (long q = 0; q < n2; ++q) {
-        const T L = cell_div(lo[v], hi[v], lo[5 + v], hi[5 + v], zv, q, k) + (s0[q] + s1[q] * divu[q]);
-        d[q] = o.a * u0[q] + o.b * (uk[q] + o.dt * L);
-      }
-    } else {
-#pragma omp simd
-      for (long q = 0; q < n2; ++q) {
-        const T L = cell_div(lo[v], hi[v], lo[5 + v], hi[5 + v], zv, q, k);
-        d[q] = o.a * u0[q] + o.b * (uk[q] + o.dt * L);
-      }
-    }
-  }
+  if (o.mode == RATE) stage_rows<T, RATE>(o, out, k, lo, hi, z, zld, divu, s0, s1);
+  else if (o.mode == FROM_RATE) stage_rows<T, FROM_RATE>(o, out, k, lo, hi, z, zld, divu, s0, s1);
+  else stage_rows<T, UPDATE>(o, out, k, lo, hi, z, zld, divu, s0, s1);
 }
 
 // The energy source rows of the output at offset `out` (a stage's s0, s1; none for Rhs).
@@ -583,6 +603,23 @@ using CellsFn = void (*)(long, const double*, const T* const*, T* const*);
 template <class T>
 KTGF_INLINE T max_nan(T m, T x) { return (x > m || x != x) ? x : m; }
 
+// Merges the maxima of a row of n cells of the nlim terms t[k] into local[k]: a NaN wins, as in jnp.max.
+template <class T>
+KTGF_INLINE void row_maxima(T* const* t, long n, int nlim, T* local) {
+  for (int k = 0; k < nlim; ++k) {  // the row's maximum and whether it holds a NaN: a vector loop
+    const T* r = t[k];
+    T m = local[k];
+    if (m != m) continue;  // a NaN already: it stays
+    int nan = 0;
+#pragma omp simd reduction(max : m) reduction(| : nan)
+    for (long q = 0; q < n; ++q) {
+      m = r[q] > m ? r[q] : m;
+      nan |= r[q] != r[q];
+    }
+    local[k] = nan ? std::numeric_limits<T>::quiet_NaN() : m;
+  }
+}
+
 // The maxima over the cells of the `nlim` limit terms of a step-start cell program fn on the state U (its
 // cell fields and source go to a row scratch and are dropped): the step limits' closures and reductions in
 // one pass that writes nothing per cell.  A NaN term wins, as in jnp.max.
@@ -600,18 +637,7 @@ void cell_limits(CellsFn<T> fn, const double* leaf, const T* const* U, const lon
         const T* in[5];
         for (int v = 0; v < 5; ++v) in[v] = U[v] + (i * n[1] + j) * n[2];
         fn(n[2], leaf, in, out.data());
-        for (int k = 0; k < nlim; ++k) {  // the row's maximum and whether it holds a NaN: a vector loop
-          const T* t = out[NFIELD + 2 + k];
-          T m = local[k];
-          if (m != m) continue;  // a NaN already: it stays
-          int nan = 0;
-#pragma omp simd reduction(max : m) reduction(| : nan)
-          for (long q = 0; q < n[2]; ++q) {
-            m = t[q] > m ? t[q] : m;
-            nan |= t[q] != t[q];
-          }
-          local[k] = nan ? std::numeric_limits<T>::quiet_NaN() : m;
-        }
+        row_maxima(out.data() + NFIELD + 2, n[2], nlim, local.data());
       }
     }
 #pragma omp critical(ktgf_cell_limits)
@@ -674,13 +700,17 @@ inline void wait_for(const Progress* progress, int t, int nt, long p) {
 // over Uk: a thread reads Uk of plane p for the closures (at step p - 2) and the update (step p) before it
 // writes U' of plane p, and it writes plane p only once its neighbours, whose ghost rows are its rows, have
 // computed plane p (wait_for); planes 0 and 1, needed again at the end, are kept in their own slots.  U' may
-// instead be written over U0, which is read only at the cell being written.
+// instead be written over U0, which is read only at the cell being written.  o.mode (StageMode) says what is
+// written; FROM_RATE rows of Uk are computed from U0 and L0 as they are read.  nlim > 0 (a step-start program
+// fn): the maxima of its nlim limit terms over the cells also go to `maxima`, each thread reducing the rows it
+// evaluates (its ghost rows too: a maximum taken twice is the same).
 // Returns false (nothing computed) if the threads' rings do not fit in `capacity`.
 template <class T, int LIM, int RIE>
 bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const Stage<T>& o, T* ring_all,
-                 long capacity) {
+                 long capacity, int nlim = 0, T* maxima = nullptr) {
   const long n0 = kg.n[0], n1 = kg.n[1], n2 = kg.n[2], m2 = n2 + 2 * GHOST;
   bool fits = true;
+  for (int q = 0; q < nlim; ++q) maxima[q] = -std::numeric_limits<T>::infinity();
   const int threads = fused_threads(kg.n);
   std::vector<Progress> progress(threads);
   for (auto& p : progress) p.placed.store(-3, std::memory_order_relaxed);
@@ -702,6 +732,11 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
       Consts<T> k = kg;
       k.stride[1] = m2;  // rows of the ring (planes are reached through the tables)
       RowBuffers<T> r(nj, n2);  // nj >= MIN_ROWS: fused_threads
+      // FROM_RATE: a row of Uk = U0 + dt L0; nlim > 0: a row of the limit terms and the thread's maxima.
+      std::vector<T> uk_row(o.mode == FROM_RATE ? 5 * n2 : 0), terms(size_t(nlim) * n2);
+      std::vector<T> local(nlim, -std::numeric_limits<T>::infinity());
+      std::vector<T*> out(NRING + nlim);  // the program's outputs: the ring's fields, then the limit terms
+      for (int q = 0; q < nlim; ++q) out[NRING + q] = terms.data() + q * n2;
       // Slot of plane p (-2 <= p < n0 + 2; planes 0, 1 and their periodic images n0, n0 + 1 in the kept slots).
       auto slot_of = [&](long p) {
         const long q = p >= n0 ? p - n0 : p;
@@ -712,13 +747,22 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
       auto place = [&](long p) {
         if (p >= n0) return;  // planes 0, 1 again: kept
         const long gp = (p + n0) % n0, s = slot_of(p);
-        T* out[NRING];
         for (long jj = 0; jj < m1; ++jj) {
-          const long gj = ((jlo - GHOST + jj) % n1 + n1) % n1;
+          const long gj = ((jlo - GHOST + jj) % n1 + n1) % n1, at = (gp * n1 + gj) * n2;
           const T* in[5];
-          for (int v = 0; v < 5; ++v) in[v] = o.Uk[v] + (gp * n1 + gj) * n2;
+          for (int v = 0; v < 5; ++v) in[v] = o.Uk[v] + at;
+          if (o.mode == FROM_RATE) {  // Uk as the first stage computed it: 0 U0 + 1 (U0 + dt L0)
+            for (int v = 0; v < 5; ++v) {
+              T* u = uk_row.data() + v * n2;
+              const T *u0 = o.U0[v] + at, *l0 = o.Uk[v] + at;
+#pragma omp simd
+              for (long q = 0; q < n2; ++q) u[q] = u0[q] + o.dt * l0[q];
+              in[v] = u;
+            }
+          }
           for (int f = 0; f < NRING; ++f) out[f] = field(f, s) + jj * m2 + GHOST;
-          fn(n2, leaf, in, out);
+          fn(n2, leaf, in, out.data());
+          row_maxima(out.data() + NRING, n2, nlim, local.data());  // ghost rows too: a maximum again changes nothing
           for (int f = 0; f < NFIELD; ++f) {  // the row's ghost cells along z
             T* row = out[f] - GHOST;
             for (long q = 0; q < GHOST; ++q) {
@@ -752,6 +796,8 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
                                         src[1] = field(NFIELD + 1, si) + row(b);
                                       }, k, o, r);
       }
+#pragma omp critical(ktgf_fused_maxima)
+      for (int q = 0; q < nlim; ++q) maxima[q] = max_nan(maxima[q], local[q]);
     }
   }
   return fits;
@@ -849,18 +895,29 @@ ffi::Error cell_limits_entry(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs stat
 }
 
 // KtgfSsprkStageCells: one SSP-RK3 stage whose cell fields the cell program computes as the sweep goes
-// (sweep_fused); `ring` its per-thread planes (ring_elements).  U' may alias Uk or U0 (see sweep_fused).
+// (sweep_fused); `ring` its per-thread planes (ring_elements).  `mode` (StageMode): UPDATE, state (U0, Uk);
+// RATE, state U0, writes L(U0) and the maxima of the program's `nlim` limit terms (a step-start program);
+// FROM_RATE, state (U0, L0).  U' may alias Uk (L0) or U0 (see sweep_fused).
 ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state,
-                             int32_t limiter, int32_t riemann, int64_t program, ffi::Result<ffi::AnyBuffer> u0,
-                             ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2,
-                             ffi::Result<ffi::AnyBuffer> u3, ffi::Result<ffi::AnyBuffer> u4,
+                             int32_t limiter, int32_t riemann, int64_t program, int32_t mode, int32_t nlim,
+                             ffi::Result<ffi::AnyBuffer> u0, ffi::Result<ffi::AnyBuffer> u1,
+                             ffi::Result<ffi::AnyBuffer> u2, ffi::Result<ffi::AnyBuffer> u3,
+                             ffi::Result<ffi::AnyBuffer> u4, ffi::Result<ffi::AnyBuffer> maxima,
                              ffi::Result<ffi::AnyBuffer> ring) {
   if (params.element_count() != 6)
     return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
-  if (state.size() != 10) return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5)");
+  if (mode != UPDATE && mode != RATE && mode != FROM_RATE)
+    return ffi::Error::InvalidArgument("stage kernel: mode must be 0 (update), 1 (rate) or 2 (from rate)");
+  const size_t nstate = mode == RATE ? 5 : 10;
+  if (state.size() != nstate)
+    return ffi::Error::InvalidArgument(mode == RATE ? "stage kernel: state = U0 x5" : "stage kernel: state = (U0 x5, Uk x5)");
   ffi::DataType type;
-  if (auto err = same_fields(state, 10, type); err.failure()) return err;
+  if (auto err = same_fields(state, nstate, type); err.failure()) return err;
   if (auto err = check_variant("KtgfSsprkStageCells", type, limiter, riemann, true); err.failure()) return err;
+  if (nlim < 0 || (mode != RATE && nlim != 0) || long(maxima->element_count()) != nlim ||
+      maxima->element_type() != type)
+    return ffi::Error::InvalidArgument("stage kernel: maxima must be nlim values of the state precision (nlim = 0 "
+                                       "unless mode = 1)");
   CellProgram p{nullptr, 0};
   if (auto err = find_program(program, type, p); err.failure()) return err;
   long n[3];
@@ -873,16 +930,17 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
                         u3->typed_data<Real>(), u4->typed_data<Real>()};
   for (int v = 0; v < 5; ++v) {
     o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<Real>();
-    o.Uk[v] = state.get<ffi::AnyBuffer>(5 + v)->typed_data<Real>();
+    o.Uk[v] = state.get<ffi::AnyBuffer>(mode == RATE ? v : 5 + v)->typed_data<Real>();
     o.U[v] = out[v];
   }
   o.s0 = o.s1 = nullptr;  // from the ring
   o.a = Real(par[4]);
   o.b = Real(1) - o.a;  // as the JAX path: 1 - a in the state precision
   o.dt = Real(par[5]);
+  o.mode = mode;
   if (!sweep_fused<Real, KTGF_LIMITER, KTGF_RIEMANN>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(),
                                                      consts(n, par), o, ring->typed_data<Real>(),
-                                                     long(ring->element_count())))
+                                                     long(ring->element_count()), nlim, maxima->typed_data<Real>()))
     return ffi::Error::InvalidArgument("stage kernel: the ring workspace is too small for the threads");
   return ffi::Error::Success();
 }
@@ -939,15 +997,18 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStageCells, ssprk_stage_cells,
                               ffi::Ffi::Bind()
                                   .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s, a, dt)
                                   .Arg<ffi::Buffer<ffi::F64>>()  // the cell program's parameters
-                                  .RemainingArgs()               // U0 (5), Uk (5)
+                                  .RemainingArgs()               // U0 (5)[, Uk or L0 (5)]
                                   .Attr<int32_t>("limiter")
                                   .Attr<int32_t>("riemann")
                                   .Attr<int64_t>("program")
-                                  .Ret<ffi::AnyBuffer>()  // U' density
+                                  .Attr<int32_t>("mode")
+                                  .Attr<int32_t>("nlim")
+                                  .Ret<ffi::AnyBuffer>()  // U' density (RATE: L)
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_x
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_y
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_z
                                   .Ret<ffi::AnyBuffer>()  // ... E
+                                  .Ret<ffi::AnyBuffer>()  // maxima of the nlim limit terms (RATE)
                                   .Ret<ffi::AnyBuffer>());  // the planes of the fused sweep (workspace, KtgfRingElements)
 
 XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfCellLimits, cell_limits_entry,

@@ -9,9 +9,11 @@ round-off (tests/test_solver_flux_kernel.py).  :func:`ssprk_stage` also applies 
 source and the stage update of :func:`.stepping.ssprk3_step` in the same sweep, so a stage of
 the explicit scheme is one closure pass (XLA) and one kernel call; :func:`ssprk_stage_cells` also
 evaluates the closures, by a generated cell program (:mod:`.cell_program`), plane by plane as its sweep
-goes (so the cell fields never go to memory), and a stage is one call; a step starts with
-:func:`cell_limits` (the closures and the maxima of the step-limit terms, in one pass), from which the
-step size is computed before the first stage.
+goes (so the cell fields never go to memory), and a stage is one call.  A step's first stage, whose Δt is not
+known yet, is :func:`rate_cells`: it writes the rate L(U) and reduces the maxima of the step-limit and
+state-check terms of the closures it evaluates anyway, from which the step size is computed; the second stage
+reads U + Δt L.  :func:`cell_limits` is that reduction alone (the closures and the maxima, in one pass that
+writes nothing per cell).
 
 It is used where it applies — CPU backend, one device, a 3D fully periodic grid, float32 or
 float64 — and when it is switched on: :data:`.fluxes.FLUX_KERNEL` (default from the environment
@@ -263,8 +265,27 @@ def _ring(grid: Any, dtype: Any, v: Variant) -> Any:
     return jax.ShapeDtypeStruct((int(_library(v).KtgfRingElements(*n)),), dtype)
 
 
+#: The modes of a stage of :func:`ssprk_stage_cells` (StageMode of flux_kernel.cc).
+STAGE_MODES = {"update": 0, "rate": 1, "from_rate": 2}
+
+
+def _stage_cells(state: list, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any, limiter: str,
+                 riemann: str, mode: str, aliases: dict | None) -> tuple:
+    _register(program, limiter, riemann)
+    dtype = state[0].dtype
+    stage = variant(dtype, limiter, riemann, "stage")
+    field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
+    maxima = jax.ShapeDtypeStruct((program.nlim if mode == "rate" else 0,), dtype)
+    call = jax.ffi.ffi_call(target(CELLS_TARGET, stage), (field,) * 5 + (maxima, _ring(grid, dtype, stage)),
+                            input_output_aliases=aliases)
+    params = _stage_params(a, dt, grid, rho_s, dtype)
+    out = call(params, leaf, *state, **_schemes(limiter, riemann), program=np.int64(program.key),
+               mode=np.int32(STAGE_MODES[mode]), nlim=np.int32(maxima.shape[0]))
+    return tuple(out[:5]), out[5]
+
+
 def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any,
-                      limiter: str, riemann: str, write_over: str = "uk") -> tuple[Any, ...]:
+                      limiter: str, riemann: str, write_over: str = "uk", from_rate: bool = False) -> tuple[Any, ...]:
     """The SSP-RK3 stage of :func:`ssprk_stage` with the cell fields and the energy source computed in
     the kernel from Uk by a cell program (:func:`.cell_program.for_physics`) with parameters ``leaf``
     (:func:`.cell_program.leaf_values`), plane by plane as the sweep goes (the fused sweep of
@@ -275,14 +296,23 @@ def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any
     the kernel reads U0 only at the cell it writes) or ``"new"`` (fresh buffers).  A step's first stage has
     Uk = U0, which the later stages still read, so it writes new buffers: written in place, XLA would first
     copy U0 (measured: 7 % of a 64³ step in copies).
+
+    ``from_rate``: ``Uk`` is the rate L0 = L(U0) of :func:`rate_cells`, and the stage's Uk is U0 + Δt L0 (the
+    first stage's U', computed again where it is read).
     """
-    _register(program, limiter, riemann)
     dtype = Uk[0].dtype
-    stage = variant(dtype, limiter, riemann, "stage")
     state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
-    field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
     first = {"u0": 2, "uk": 7, "new": None}[write_over]  # the inputs are params, leaf, U0 (5), Uk (5)
-    call = jax.ffi.ffi_call(target(CELLS_TARGET, stage), (field,) * 5 + (_ring(grid, dtype, stage),),
-                            input_output_aliases=None if first is None else {first + i: i for i in range(5)})
-    params = _stage_params(a, dt, grid, rho_s, dtype)
-    return tuple(call(params, leaf, *state, **_schemes(limiter, riemann), program=np.int64(program.key))[:5])
+    aliases = None if first is None else {first + i: i for i in range(5)}
+    return _stage_cells(state, program, leaf, a, dt, grid, rho_s, limiter, riemann,
+                        "from_rate" if from_rate else "update", aliases)[0]
+
+
+def rate_cells(U: Any, program: Any, leaf: Any, grid: Any, rho_s: Any, limiter: str, riemann: str) -> tuple:
+    """The first stage of a fused SSP-RK3 step before its Δt is known: ``(L, maxima)``, the rate
+    L(U) = −∇·F + S (into new buffers) and the maxima over the cells of the :data:`.stepping.START_TERMS` of
+    the step-start cell program ``program`` (parameters ``leaf``, :func:`.cell_program.leaf_values` with the
+    grid), which the kernel reduces as it sweeps: the closures of U are evaluated once, for both.  The step's
+    second stage takes L as its ``Uk`` (:func:`ssprk_stage_cells` with ``from_rate``)."""
+    state = [jnp.asarray(f, U[0].dtype) for f in U]
+    return _stage_cells(state, program, leaf, 0.0, 0.0, grid, rho_s, limiter, riemann, "rate", None)

@@ -337,17 +337,11 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
 
         program = for_physics(phys, U[0].dtype) if fluxes.CELL_PROGRAM else None
         if program is not None:  # the closures inside the kernel: each stage is one call
-            leaf = leaf_values(phys)
             U = tuple(U)
-
-            def cells_stage(k: int, Uk: tuple, write_over: str) -> tuple:
-                return ssprk_stage_cells(U, Uk, program, leaf, coef[k], dt, grid, phys.material_density,
-                                         num.limiter, num.riemann, write_over)
-
-            # The first stage writes new buffers (U is still needed), the second overwrites its input, the last
-            # its input or U.
-            U2 = cells_stage(1, cells_stage(0, U, "new"), "uk")
-            return cells_stage(2, U2, "u0" if consume else "uk")
+            # The first stage writes new buffers (U is still needed).
+            U1 = ssprk_stage_cells(U, U, program, leaf_values(phys), coef[0], dt, grid, phys.material_density,
+                                   num.limiter, num.riemann, "new")
+            return later_cell_stages(U, U1, dt, grid, phys, num, consume)
 
         def kernel_stage(k: Any, Uk: tuple, r: Any) -> tuple:
             W, eos, transport, source = kernel_stage_inputs(Uk, r, phys)
@@ -366,6 +360,25 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
         return tuple(a * u + (1.0 - a) * (uk + dt * l) for u, uk, l in zip(U, Uk, L))
 
     return jax.lax.fori_loop(0, 3, stage, tuple(U))
+
+
+def later_cell_stages(U: tuple, Uk: tuple, dt: Any, grid: Grid, phys: Physics, num: Numerics, consume: bool = False,
+                      from_rate: bool = False) -> tuple:
+    """The second and third stages of an SSP-RK3 step from U whose stages are kernel calls with the closures
+    in a cell program (:func:`ssprk3_step`): from the first stage's U1 = ``Uk``, or (``from_rate``) from its rate
+    L(U) (:func:`.flux_kernel.rate_cells`: U1 = U + Δt L).  The second stage writes over its input, the third
+    over its input or (``consume``) over U."""
+    from .cell_program import for_physics, leaf_values
+    from .flux_kernel import ssprk_stage_cells
+
+    program, leaf = for_physics(phys, U[0].dtype), leaf_values(phys)
+
+    def cells_stage(a: float, Uk: tuple, write_over: str, from_rate: bool = False) -> tuple:
+        return ssprk_stage_cells(U, Uk, program, leaf, jnp.asarray(a, U[0].dtype), dt, grid, phys.material_density,
+                                 num.limiter, num.riemann, write_over, from_rate)
+
+    U2 = cells_stage(0.75, Uk, "uk", from_rate)
+    return cells_stage(1.0 / 3.0, U2, "u0" if consume else "uk")
 
 
 def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0,
@@ -496,12 +509,14 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
     accepted steps, the status code of the first rejected step (0 if none) and the Δt of the
     last attempted step (to reproduce a failure for its diagnosis).
 
-    With a step-start cell program (:func:`start_program`) the loop keeps no second state: each step is
-    written over the one before (:func:`ssprk3_step`'s ``consume``), and its state check is part of the next
-    step's first pass (:func:`.flux_kernel.cell_limits` reduces the :data:`STATUS_TERMS` with the limit
-    terms).  A rejected step has then overwritten the last good state, which is computed again from U by
-    repeating the accepted steps: the same compiled steps, so the same bits (the kernels do not depend on
-    the thread count: tests/test_solver_flux_kernel.py).
+    With a step-start cell program (:func:`start_program`) a step is three kernel calls and keeps no second
+    state.  Its first stage evaluates the closures of U once for both the rate L(U) and the maxima of the
+    :data:`START_TERMS` (:func:`.flux_kernel.rate_cells`), so Δt is known after it, and the second stage takes
+    U + Δt L(U) as its input (:func:`later_cell_stages`); the third writes the new state over U.  The maxima
+    also hold U's status: a step's state is checked in the next step's first stage (the last one's by
+    :func:`.flux_kernel.cell_limits` after the loop), and a rejected step has overwritten the last good state,
+    which is computed again from U by repeating the accepted steps: the same compiled steps, so the same
+    bits (the kernels do not depend on the thread count: tests/test_solver_flux_kernel.py).
     """
     program = start_program(grid, phys, num, U[0].dtype)
 
@@ -515,12 +530,8 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         last = dt_stable >= t_end - t
         return dt_stable, jnp.where(last, t_end - t, dt_stable), last
 
-    def outcome(bad_state: Any, residual: Any, dt_stable: Any, dt: Any, last: Any, t: Any, n: Any) -> tuple:
-        """The step's status and, if it is accepted, the new time and step count."""
-        status = jnp.where(bad_state != 0, bad_state, jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5))
-        status = jnp.where((status == 0) & ~(residual <= RESIDUAL_FAIL), 6, status)
-        good = status == 0
-        return status, good, jnp.where(good, jnp.where(last, t_end, t + dt), t), n + good.astype(n.dtype)
+    def size_status(dt_stable: Any, dt: Any) -> Any:
+        return jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5)
 
     def body(carry: tuple) -> tuple:
         U, t, n, _, _ = carry
@@ -528,16 +539,12 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
         dt_stable, dt, last = step_size(step_limits(U, grid, phys, num, r0), t)
         U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t, r0)
-        status, good, t, n = outcome(state_status(U_new, phys), residual, dt_stable, dt, last, t, n)
-        return tuple(jnp.where(good, a, b) for a, b in zip(U_new, U)), t, n, status, dt
-
-    def fused_body(carry: tuple) -> tuple:
-        U, t, n, _, _, maxima = carry  # maxima: of START_TERMS at U
-        dt_stable, dt, last = step_size(kernel_step_limits(maxima, grid, num), t)
-        U = ssprk3_step(U, dt.astype(U[0].dtype), grid, phys, num, t, consume=True)
-        maxima = start_maxima(U)
-        status, _, t, n = outcome(status_of_maxima(maxima[len(LIMIT_TERMS):], phys), 0.0, dt_stable, dt, last, t, n)
-        return U, t, n, status, dt, maxima
+        bad_state = state_status(U_new, phys)
+        status = jnp.where(bad_state != 0, bad_state, size_status(dt_stable, dt))
+        status = jnp.where((status == 0) & ~(residual <= RESIDUAL_FAIL), 6, status)
+        good = status == 0
+        t = jnp.where(good, jnp.where(last, t_end, t + dt), t)
+        return tuple(jnp.where(good, a, b) for a, b in zip(U_new, U)), t, n + good.astype(n.dtype), status, dt
 
     U = tuple(U)
     t = jnp.asarray(t, jnp.float64)
@@ -549,15 +556,35 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         return jnp.stack(U), t, n, status, dt
 
     from .cell_program import leaf_values
-    from .flux_kernel import cell_limits
+    from .flux_kernel import cell_limits, rate_cells
 
-    def start_maxima(U: tuple) -> Any:
-        return cell_limits(U, program, leaf_values(phys, grid), grid, num.limiter, num.riemann)
+    leaf = leaf_values(phys, grid)
+    nlim = len(LIMIT_TERMS)
 
-    init = (*init, start_maxima(U))
-    U_end, t, n, status, dt, _ = jax.lax.while_loop(cond_before(max_steps), fused_body, init)
+    def fused_body(carry: tuple) -> tuple:
+        # U: the state after n steps of the call, the n-th not checked yet; t_before: the time before that step.
+        U, t, n, _, dt_before, t_before = carry
+        L, maxima = rate_cells(U, program, leaf, grid, phys.material_density, num.limiter, num.riemann)
+        dt_stable, dt, last = step_size(kernel_step_limits(maxima[:nlim], grid, num), t)
+        U_new = later_cell_stages(U, L, dt.astype(U[0].dtype), grid, phys, num, consume=True, from_rate=True)
+        bad = status_of_maxima(maxima[nlim:], phys)
+        # A bad U rejects the step that made it (if any: U may be the call's start) and this one is not taken.
+        undo = (bad != 0) & (n > 0)
+        status = jnp.where(bad != 0, bad, size_status(dt_stable, dt))
+        good = status == 0
+        t_new = jnp.where(good, jnp.where(last, t_end, t + dt), jnp.where(undo, t_before, t))
+        n_new = n + good.astype(n.dtype) - undo.astype(n.dtype)
+        return U_new, t_new, n_new, status, jnp.where(undo, dt_before, dt), t
+
+    start = (*init, t)
+    U_end, t, n, status, dt, t_before = jax.lax.while_loop(cond_before(max_steps), fused_body, start)
+    last_state = status_of_maxima(cell_limits(U_end, program, leaf, grid, num.limiter, num.riemann)[nlim:], phys)
+    undo = (status == 0) & (n > 0) & (last_state != 0)  # the last step's state, checked here
+    status = jnp.where(undo, last_state, status)
+    t = jnp.where(undo, t_before, t)
+    n = n - undo.astype(n.dtype)
     U_end = jax.lax.cond(status == 0, lambda: U_end,
-                         lambda: jax.lax.while_loop(cond_before(n), fused_body, init)[0])
+                         lambda: jax.lax.while_loop(cond_before(n), fused_body, start)[0])
     return jnp.stack(U_end), t, n, status, dt
 
 
