@@ -316,16 +316,13 @@ def start_program(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> Any:
     return for_physics(phys, dtype, limits=num.acoustics)
 
 
-def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0, r0: Any = None,
-                consume: bool = False) -> Any:
+def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0, r0: Any = None) -> Any:
     """One SSP-RK3 step of size dt (``r0``: the cell coefficients of U, if already evaluated).
 
     Written as three stages U_{k+1} = a_k U + (1 − a_k)(U_k + Δt L(U_k)), a = (0, 3/4, 1/3),
     in a ``fori_loop`` so the right-hand side is traced (and compiled) once, not three times.
     Where :func:`stage_kernel_applies`, each stage is the closures (XLA) and one kernel call, or
     only the kernel call where the closures have a cell program (:mod:`.cell_program`).
-    ``consume``: the caller does not use U after the step, so (with a cell program) the last stage writes
-    the new state over U's buffers and a step allocates none.
     """
     coef = jnp.asarray([0.0, 0.75, 1.0 / 3.0], dtype=U[0].dtype)
     when = jnp.asarray([0.0, 1.0, 0.5], dtype=jnp.result_type(t, float))  # stage times / Δt
@@ -341,7 +338,7 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
             # The first stage writes new buffers (U is still needed).
             U1 = ssprk_stage_cells(U, U, program, leaf_values(phys), coef[0], dt, grid, phys.material_density,
                                    num.limiter, num.riemann, "new")
-            return later_cell_stages(U, U1, dt, grid, phys, num, consume)
+            return later_cell_stages(U, U1, dt, grid, phys, num)
 
         def kernel_stage(k: Any, Uk: tuple, r: Any) -> tuple:
             W, eos, transport, source = kernel_stage_inputs(Uk, r, phys)
@@ -436,14 +433,13 @@ def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any 
 
 
 def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0,
-                r0: Any = None, consume: bool = False) -> tuple[Any, Any]:
+                r0: Any = None) -> tuple[Any, Any]:
     """One step of the configured scheme from time t: (state, implicit residual / tolerance — 0 for SSP-RK3).
 
-    ``r0``: the cell coefficients of U, if already evaluated; ``consume``: U is not used after the step
-    (:func:`ssprk3_step`)."""
+    ``r0``: the cell coefficients of U, if already evaluated."""
     if num.scheme == "imex":
         return imex_step(U, dt, grid, phys, num, t, r0)
-    return ssprk3_step(U, dt, grid, phys, num, t, r0, consume), jnp.zeros((), U[0].dtype)
+    return ssprk3_step(U, dt, grid, phys, num, t, r0), jnp.zeros((), U[0].dtype)
 
 
 #: CPU time of one IMEX step over one SSP-RK3 step, measured (RET at φ = 0.5 with Δx = ℓ, 32³:
