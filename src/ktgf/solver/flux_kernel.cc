@@ -699,8 +699,9 @@ inline void wait_for(const Progress* progress, int t, int nt, long p) {
 // once per cell, plus the ghost rows (2 GHOST / (n1 / threads) more) and the first planes.  U' may be written
 // over Uk: a thread reads Uk of plane p for the closures (at step p - 2) and the update (step p) before it
 // writes U' of plane p, and it writes plane p only once its neighbours, whose ghost rows are its rows, have
-// computed plane p (wait_for); planes 0 and 1, needed again at the end, are kept in their own slots.  U' may
-// instead be written over U0, which is read only at the cell being written.  o.mode (StageMode) says what is
+// computed plane p (wait_for; only then: a stage that writes elsewhere runs its threads unsynchronised); planes
+// 0 and 1, needed again at the end, are kept in their own slots.  U' may instead be written over U0, which is
+// read only at the cell being written (except by FROM_RATE's closures, which then wait too).  o.mode (StageMode) says what is
 // written; FROM_RATE rows of Uk are computed from U0 and L0 as they are read.  nlim > 0 (a step-start program
 // fn): the maxima of its nlim limit terms over the cells also go to `maxima`, each thread reducing the rows it
 // evaluates (its ghost rows too: a maximum taken twice is the same).
@@ -712,6 +713,10 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
   bool fits = true;
   for (int q = 0; q < nlim; ++q) maxima[q] = -std::numeric_limits<T>::infinity();
   const int threads = fused_threads(kg.n);
+  // Whether U' is written over what the neighbours read for their ghost rows (Uk; with FROM_RATE also U0): only
+  // then does a thread wait for them before it writes a plane.
+  bool shared = false;
+  for (int v = 0; v < 5; ++v) shared = shared || o.U[v] == o.Uk[v] || (o.mode == FROM_RATE && o.U[v] == o.U0[v]);
   std::vector<Progress> progress(threads);
   for (auto& p : progress) p.placed.store(-3, std::memory_order_relaxed);
 #pragma omp parallel num_threads(threads)
@@ -789,7 +794,7 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
         table(i, P0);
         table(i + 1, P1);
         const long si = slot_of(i), out0 = (i * n1 + jlo) * n2;
-        wait_for(progress.data(), t, nt, i);  // before U' of plane i overwrites their ghost rows' Uk
+        if (shared) wait_for(progress.data(), t, nt, i);  // before U' of plane i overwrites their ghost rows' Uk
         sweep_rows<T, LIM, RIE, true>(P0, P1, nj, row, [&](long b) { return out0 + b * n2; },
                                       [&](long b, const T** src) {
                                         src[0] = field(NFIELD, si) + row(b);
