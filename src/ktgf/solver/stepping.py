@@ -29,7 +29,7 @@ One Δt per step from the limits at the step start.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import jax
@@ -445,16 +445,30 @@ def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
 #: CPU time of one IMEX step over one SSP-RK3 step, measured (RET at φ = 0.5 with Δx = ℓ, 32³:
 #: 108 ms against 36 ms with BiCGSTAB; 143–165 against 35–37 ms with the earlier GMRES).
 IMEX_COST = 3.0
+#: The same where SSP-RK3 runs as the fused loop of cell-program kernel calls (:func:`start_program`: CPU, one
+#: device, a 3D periodic grid), measured at stop 27 (RET, φ = 0.5, Δx = ℓ, float64, steady state, ms of CPU per
+#: step): 7.6 against 0.8 at 16³, 50.5 against 5.9 at 32³, 430.8 against 46.9 at 64³ (9.5, 8.6, 9.2×).
+IMEX_COST_FUSED = 9.0
 #: ``auto`` picks IMEX when its step is more than this many times the explicit one: the
-#: break-even IMEX_COST times two, a margin for its compilation (≈ 4× that of SSP-RK3, measured).
-IMEX_AUTO_RATIO = 6.0
+#: break-even IMEX_COST times two, a margin for its compilation (≈ 4× that of SSP-RK3, measured;
+#: 10× against the fused loop: 6.8 s against 0.6–0.7 s at 32³).
+IMEX_AUTO_RATIO = 2.0 * IMEX_COST
+
+
+def auto_ratio(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> float:
+    """The step ratio (IMEX over SSP-RK3) above which ``auto`` picks IMEX: twice the break-even, whose cost
+    ratio is :data:`IMEX_COST_FUSED` where SSP-RK3 would run the fused loop, else :data:`IMEX_COST`."""
+    explicit = replace(num, scheme="ssprk3", sink="explicit")
+    fused = start_program(grid, phys, explicit, dtype) is not None
+    return 2.0 * (IMEX_COST_FUSED if fused else IMEX_COST)
 
 
 def choose_scheme(U: Any, grid: Grid, phys: Physics, num: Numerics) -> str:
-    """``imex`` or ``ssprk3``: IMEX where its step exceeds the explicit one by IMEX_AUTO_RATIO."""
+    """``imex`` or ``ssprk3``: IMEX where its step exceeds the explicit one by :func:`auto_ratio`."""
     lim = [float(v) for v in limits(U, grid, phys, num)]
     explicit = min(lim)
-    return "imex" if min(lim[0], lim[3]) > IMEX_AUTO_RATIO * explicit else "ssprk3"
+    ratio = auto_ratio(grid, phys, num, U[0].dtype)
+    return "imex" if min(lim[0], lim[3]) > ratio * explicit else "ssprk3"
 
 
 def binding_limit(lim: Any, scheme: str) -> str:
