@@ -93,7 +93,7 @@ def test_auto_scheme_weighs_the_cost_of_the_explicit_step() -> None:
     the CPU; measured costs, stepping.IMEX_COST*).  A 32³ box of 4 d at φ = 0.5 (Δx ≈ ℓ/2) has the IMEX step
     10.7× longer: SSP-RK3 with the fused loop, IMEX without it."""
     from ktgf.solver import fluxes
-    from ktgf.solver.stepping import IMEX_COST, IMEX_COST_FUSED, auto_ratio
+    from ktgf.solver.stepping import IMEX_COST, IMEX_COST_FUSED, Numerics, auto_ratio
 
     cfg = {**_base(), "time": {"end": 1.0, "scheme": "auto"}, "initial": {"solid_fraction": 0.5, "temperature": 1e-4},
            "grid": {"cells": [32, 32, 32], "length_d": 4.0}}
@@ -103,6 +103,8 @@ def test_auto_scheme_weighs_the_cost_of_the_explicit_step() -> None:
     if auto_ratio(box.grid, box.phys, box.num, jnp.float64) != 2.0 * IMEX_COST_FUSED:
         pytest.skip("the fused SSP-RK3 loop does not apply here (no C++ compiler, or not the CPU)")
     assert box.num.scheme == "ssprk3"
+    implicit = Numerics(scheme="imex", acoustics="implicit", sink="implicit")  # any numerics: SSP-RK3's is explicit
+    assert auto_ratio(box.grid, box.phys, implicit, jnp.float64) == 2.0 * IMEX_COST_FUSED
     saved = fluxes.CELL_PROGRAM
     try:
         fluxes.CELL_PROGRAM = False  # SSP-RK3 without the fused loop: its step costs a third of IMEX's

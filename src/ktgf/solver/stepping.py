@@ -458,7 +458,7 @@ IMEX_AUTO_RATIO = 2.0 * IMEX_COST
 def auto_ratio(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> float:
     """The step ratio (IMEX over SSP-RK3) above which ``auto`` picks IMEX: twice the break-even, whose cost
     ratio is :data:`IMEX_COST_FUSED` where SSP-RK3 would run the fused loop, else :data:`IMEX_COST`."""
-    explicit = replace(num, scheme="ssprk3", sink="explicit")
+    explicit = replace(num, scheme="ssprk3", sink="explicit", acoustics="explicit")
     fused = start_program(grid, phys, explicit, dtype) is not None
     return 2.0 * (IMEX_COST_FUSED if fused else IMEX_COST)
 
