@@ -701,8 +701,8 @@ inline void wait_for(const Progress* progress, int t, int nt, long p) {
 // writes U' of plane p, and it writes plane p only once its neighbours, whose ghost rows are its rows, have
 // computed plane p (wait_for; only then: a stage that writes elsewhere runs its threads unsynchronised); planes
 // 0 and 1, needed again at the end, are kept in their own slots.  U' may instead be written over U0, which is
-// read only at the cell being written (except by FROM_RATE's closures, which then wait too).  o.mode (StageMode) says what is
-// written; FROM_RATE rows of Uk are computed from U0 and L0 as they are read.  nlim > 0 (a step-start program
+// read only at the cell being written (except by FROM_RATE's closures, which then wait too).  o.mode
+// (StageMode) says what is written; FROM_RATE rows of Uk are computed from U0 and L0 as they are read.  nlim > 0 (a step-start program
 // fn): the maxima of its nlim limit terms over the cells also go to `maxima`, each thread reducing the rows it
 // evaluates (its ghost rows too: a maximum taken twice is the same).
 // Returns false (nothing computed) if the threads' rings do not fit in `capacity`.
@@ -878,8 +878,9 @@ ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& ty
   return ffi::Error::Success();
 }
 
-// KtgfCellLimits: the maxima over the cells of the `nlim` limit terms of a step-start cell program at Uk, from
-// which the step size is computed before the step's first stage.  It does not depend on the limiter or the
+// KtgfCellLimits: the maxima over the cells of the `nlim` terms of a step-start cell program at Uk (the step
+// limits' and the state check's) in a pass that writes nothing per cell: the check of a call's last state (the
+// first stage of each step reduces the same terms as it sweeps).  It does not depend on the limiter or the
 // Riemann solver; Python calls the one of the stage library of the step.
 ffi::Error cell_limits_entry(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state, int64_t program, int32_t nlim,
                              ffi::Result<ffi::AnyBuffer> maxima) {
@@ -915,7 +916,8 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
     return ffi::Error::InvalidArgument("stage kernel: mode must be 0 (update), 1 (rate) or 2 (from rate)");
   const size_t nstate = mode == RATE ? 5 : 10;
   if (state.size() != nstate)
-    return ffi::Error::InvalidArgument(mode == RATE ? "stage kernel: state = U0 x5" : "stage kernel: state = (U0 x5, Uk x5)");
+    return ffi::Error::InvalidArgument(mode == RATE ? "stage kernel: state = U0 x5"
+                                                    : "stage kernel: state = (U0 x5, Uk x5)");
   ffi::DataType type;
   if (auto err = same_fields(state, nstate, type); err.failure()) return err;
   if (auto err = check_variant("KtgfSsprkStageCells", type, limiter, riemann, true); err.failure()) return err;

@@ -242,10 +242,10 @@ def _register(program: Any, limiter: str, riemann: str) -> None:
 
 def cell_limits(Uk: Any, program: Any, leaf: Any, grid: Any, limiter: str, riemann: str) -> Any:
     """The maxima over the cells of the terms (:data:`.stepping.START_TERMS`: step limits, then state status) of
-    the step-start cell program ``program`` (:func:`.cell_program.for_physics` with ``limits``) at the state Uk:
-    the closures, step-limit and state-check reductions of a step's start in one pass that writes nothing per
-    cell, so that the step size is known before the first stage.  ``limiter``, ``riemann``: those of the stage that follows, whose library
-    this call uses (the pass does not depend on them)."""
+    the step-start cell program ``program`` (:func:`.cell_program.for_physics` with ``limits``) at the state Uk,
+    in one pass that writes nothing per cell: the check of the last state of an ``advance`` call (each step's
+    first stage, :func:`rate_cells`, reduces the same terms as it sweeps).  ``limiter``, ``riemann``: those of the
+    stages, whose library this call uses (the pass does not depend on them)."""
     _register(program, limiter, riemann)
     dtype = Uk[0].dtype
     call = jax.ffi.ffi_call(_target(LIMITS_TARGET, dtype, limiter, riemann, "stage"),
@@ -271,6 +271,8 @@ STAGE_MODES = {"update": 0, "rate": 1, "from_rate": 2}
 
 def _stage_cells(state: list, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any, limiter: str,
                  riemann: str, mode: str, aliases: dict | None) -> tuple:
+    """One ``KtgfSsprkStageCells`` call in ``mode`` (:data:`STAGE_MODES`): (U' or L, the maxima; empty but in
+    mode rate)."""
     _register(program, limiter, riemann)
     dtype = state[0].dtype
     stage = variant(dtype, limiter, riemann, "stage")

@@ -449,15 +449,13 @@ IMEX_COST = 3.0
 #: device, a 3D periodic grid), measured at stop 27 (RET, φ = 0.5, Δx = ℓ, float64, steady state, ms of CPU per
 #: step): 7.6 against 0.8 at 16³, 50.5 against 5.9 at 32³, 430.8 against 46.9 at 64³ (9.5, 8.6, 9.2×).
 IMEX_COST_FUSED = 9.0
-#: ``auto`` picks IMEX when its step is more than this many times the explicit one: the
-#: break-even IMEX_COST times two, a margin for its compilation (≈ 4× that of SSP-RK3, measured;
-#: 10× against the fused loop: 6.8 s against 0.6–0.7 s at 32³).
-IMEX_AUTO_RATIO = 2.0 * IMEX_COST
 
 
 def auto_ratio(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> float:
     """The step ratio (IMEX over SSP-RK3) above which ``auto`` picks IMEX: twice the break-even, whose cost
-    ratio is :data:`IMEX_COST_FUSED` where SSP-RK3 would run the fused loop, else :data:`IMEX_COST`."""
+    ratio is :data:`IMEX_COST_FUSED` where SSP-RK3 would run the fused loop, else :data:`IMEX_COST`.  The factor
+    two is a margin for IMEX's compilation (≈ 4× that of SSP-RK3, measured; 10× against the fused loop: 6.8 s
+    against 0.6–0.7 s at 32³)."""
     explicit = replace(num, scheme="ssprk3", sink="explicit", acoustics="explicit")
     fused = start_program(grid, phys, explicit, dtype) is not None
     return 2.0 * (IMEX_COST_FUSED if fused else IMEX_COST)
