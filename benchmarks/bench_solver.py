@@ -85,6 +85,55 @@ def hlo_counts(fn, *args) -> dict[str, int]:
             "power": len(re.findall(r" power\(", text)), "bytes": float((cost or {}).get("bytes accessed", 0.0))}
 
 
+def steady_ms(compiled, U, steps: int, far: float, grid, phys, num) -> tuple[float, float]:
+    """Marginal wall and CPU ms per step of ``compiled`` (``advance``): a call of 5 x ``steps`` steps less one of
+    ``steps``, over 4 ``steps`` (what a run, which advances in chunks of hundreds of steps, sees)."""
+    import jax
+
+    w, c = [], []
+    for s in (steps, 5 * steps):
+        t0, c0 = time.perf_counter(), time.process_time()
+        jax.block_until_ready(compiled(U, 0.0, far, s, grid, phys, num))
+        w.append(time.perf_counter() - t0)
+        c.append(time.process_time() - c0)
+    return (w[1] - w[0]) / (4 * steps) * 1e3, (c[1] - c[0]) / (4 * steps) * 1e3
+
+
+def pairs(n_pairs: int, steps: int, model_name: str, U64: np.ndarray, grid, phys, far: float) -> None:
+    """SSP-RK3, float32 against float64, in ``n_pairs`` interleaved pairs (the order alternates), each with a
+    NumPy reference pass: on a machine whose speed drifts by tens of per cent within minutes, the ratios of
+    a pair are what one can compare; prints the median and the quartiles of each figure over the pairs."""
+    import jax
+    import jax.numpy as jnp
+
+    from ktgf.solver.stepping import Numerics, advance
+
+    num = Numerics(scheme="ssprk3")
+    args = {p: jnp.asarray(U64, dtype=getattr(jnp, p)) for p in ("float64", "float32")}
+    compiled = {p: jax.jit(lambda *a: advance.__wrapped__(*a)).lower(U, 0.0, far, steps, grid, phys, num).compile()
+                for p, U in args.items()}
+    for p, c in compiled.items():  # first calls: buffers, threads
+        jax.block_until_ready(c(args[p], 0.0, far, steps, grid, phys, num))
+    rows = []
+    for k in range(n_pairs):
+        order = ("float64", "float32") if k % 2 == 0 else ("float32", "float64")
+        ms = {p: steady_ms(compiled[p], args[p], steps, far, grid, phys, num) for p in order}
+        reference = numpy_reference(phys.model, U64, phys.material_density, phys.restitution)
+        rows.append((ms["float64"][0], ms["float32"][0], ms["float64"][1], ms["float32"][1], reference * 1e3))
+    a = np.array(rows)
+    quart = lambda x: np.percentile(x, [25, 50, 75])  # noqa: E731
+    for label, x in (("float64 ms/step wall", a[:, 0]), ("float32 ms/step wall", a[:, 1]),
+                     ("float64 ms/step CPU", a[:, 2]), ("float32 ms/step CPU", a[:, 3]),
+                     ("NumPy reference pass ms", a[:, 4]),
+                     ("float64 M cell-steps/s", grid.size / a[:, 0] / 1e3),
+                     ("float64 rate / NumPy reference", a[:, 4] / a[:, 0]),
+                     ("float32 rate / NumPy reference", a[:, 4] / a[:, 1]),
+                     ("float32/float64 rate, wall", a[:, 0] / a[:, 1]), ("float32/float64 rate, CPU", a[:, 2] / a[:, 3])):
+        q = quart(x)
+        print(f"[{model_name}] pairs ({n_pairs}, steady state, {steps} -> {5 * steps} steps): {label}: median {q[1]:.3f} "
+              f"(quartiles {q[0]:.3f}, {q[2]:.3f}; range {x.min():.3f} .. {x.max():.3f})", flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--cells", type=int, default=64)
@@ -94,6 +143,8 @@ def main() -> None:
     ap.add_argument("--schemes", default="ssprk3,imex")
     ap.add_argument("--models", default="ret,proposed")
     ap.add_argument("--precisions", default="float64,float32,mixed")
+    ap.add_argument("--pairs", type=int, default=0,
+                    help="instead: SSP-RK3 float32 against float64 in this many interleaved pairs (median, quartiles)")
     ap.add_argument("--ab", action="store_true",
                     help="time main's code path (REFERENCE) and a candidate (CANDIDATE) in the same process, interleaved")
     args = ap.parse_args()
@@ -129,6 +180,9 @@ def main() -> None:
         lim = np.asarray(limits(jnp.asarray(U64), grid, phys, Numerics()))
         print(f"[{model_name}] step limits [s]: cfl {lim[0]:.3g}, viscous {lim[1]:.3g}, conductive {lim[2]:.3g}, "
               f"cooling {lim[3]:.3g}")
+        if args.pairs:
+            pairs(args.pairs, args.steps, model_name, U64, grid, phys, far)
+            continue
         Ut = tuple(jnp.asarray(U64))
         for name, switches in ((("new", CANDIDATE), ("reference", REFERENCE)) if args.ab else (("default", {}),)):
             with fluxes_switches(switches):
