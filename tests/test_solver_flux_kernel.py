@@ -239,6 +239,30 @@ def test_fused_stage_does_not_depend_on_the_threads(tmp_path) -> None:
     assert len(digests) == 1
 
 
+_WAIT_SCRIPT = """
+import ctypes
+from ktgf.solver import flux_kernel
+flux_kernel._library(flux_kernel.DEFAULT)
+getenv = ctypes.CDLL(None).getenv
+getenv.restype = ctypes.c_char_p
+print(getenv(b"OMP_WAIT_POLICY").decode(), getenv(b"GOMP_SPINCOUNT").decode())
+"""
+
+
+@pytest.mark.parametrize("user", [{}, {"GOMP_SPINCOUNT": "100", "OMP_WAIT_POLICY": "ACTIVE"}])
+def test_openmp_threads_spin_briefly_then_sleep_unless_told_otherwise(tmp_path, user: dict) -> None:
+    """libgomp reads its wait settings from the environment (the C one) once, when it loads: the kernel's
+    library sets them before it loads, passive with a short spin (flux_kernel.SPIN_COUNT), and a user's
+    settings win."""
+    script = tmp_path / "wait.py"
+    script.write_text(_WAIT_SCRIPT)
+    env = {k: v for k, v in os.environ.items() if k not in ("GOMP_SPINCOUNT", "OMP_WAIT_POLICY")} | user
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    expected = [user.get("OMP_WAIT_POLICY", "PASSIVE"), user.get("GOMP_SPINCOUNT", str(flux_kernel.SPIN_COUNT))]
+    assert run.stdout.split() == expected
+
+
 @pytest.mark.parametrize(("stop", "accepted", "budget"), [(0.362, 3, 10), (0.362, 3, 4), (0.345, 0, 10), (0.345, 0, 1)])
 def test_fused_loop_returns_the_last_good_state(stop: float, accepted: int, budget: int) -> None:
     """The fused loop writes each step over the one before and checks a step's state in the next step's

@@ -52,6 +52,8 @@ TARGET = "ktgf_flux_divergence"
 STAGE_TARGET = "ktgf_ssprk_stage"
 CELLS_TARGET = "ktgf_ssprk_stage_cells"
 LIMITS_TARGET = "ktgf_cell_limits"
+#: Spins (``pause`` instructions, 3000 take 80 us on this machine) an idle OpenMP thread waits before it sleeps.
+SPIN_COUNT = 3000
 FLAGS = ("-O3", "-march=native", "-fopenmp", "-ffp-contract=off", "-fno-math-errno", "-shared", "-fPIC", "-std=c++17")
 #: What a library computes, in the order of the KTGF_KIND values of flux_kernel.cc: the viscous flux
 #: divergence (:func:`flux_divergence` with ``viscous``), the inviscid one (the explicit part of the IMEX
@@ -131,8 +133,12 @@ def _library(v: Variant) -> Any:
     RuntimeError or OSError if it cannot be built or loaded."""
     lib = _loaded.get(v)
     if lib is None:
-        # Idle OpenMP threads must sleep, not spin: between calls XLA's own threads need the cores.
+        # Idle OpenMP threads must sleep, not spin: between calls XLA's own threads need the cores.  But they
+        # spin briefly first (GOMP_SPINCOUNT, 80 us here): a step calls the kernel three times with almost
+        # nothing in between, and waking a sleeping thread for each call cost 0.1-0.2 ms per step (docs/solver.md,
+        # "Waking the threads").  Both are read once, when libgomp loads: set before the library is.
         os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+        os.environ.setdefault("GOMP_SPINCOUNT", str(SPIN_COUNT))
         lib = ctypes.cdll.LoadLibrary(str(build(v)))
         for entry, base in ENTRIES[v.kind].items():
             jax.ffi.register_ffi_target(target(base, v), jax.ffi.pycapsule(getattr(lib, entry)), platform="cpu")
