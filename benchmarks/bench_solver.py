@@ -128,10 +128,12 @@ def pairs(n_pairs: int, steps: int, model_name: str, U64: np.ndarray, grid, phys
                      ("float64 M cell-steps/s", grid.size / a[:, 0] / 1e3),
                      ("float64 rate / NumPy reference", a[:, 4] / a[:, 0]),
                      ("float32 rate / NumPy reference", a[:, 4] / a[:, 1]),
-                     ("float32/float64 rate, wall", a[:, 0] / a[:, 1]), ("float32/float64 rate, CPU", a[:, 2] / a[:, 3])):
+                     ("float32/float64 rate, wall", a[:, 0] / a[:, 1]),
+                     ("float32/float64 rate, CPU", a[:, 2] / a[:, 3])):
         q = quart(x)
-        print(f"[{model_name}] pairs ({n_pairs}, steady state, {steps} -> {5 * steps} steps): {label}: median {q[1]:.3f} "
-              f"(quartiles {q[0]:.3f}, {q[2]:.3f}; range {x.min():.3f} .. {x.max():.3f})", flush=True)
+        print(f"[{model_name}] pairs ({n_pairs}, steady state, {steps} -> {5 * steps} steps): {label}: "
+              f"median {q[1]:.3f} (quartiles {q[0]:.3f}, {q[2]:.3f}; range {x.min():.3f} .. {x.max():.3f})",
+              flush=True)
 
 
 def main() -> None:

@@ -135,7 +135,7 @@ def _library(v: Variant) -> Any:
     if lib is None:
         # Idle OpenMP threads must sleep, not spin: between calls XLA's own threads need the cores.  But they
         # spin briefly first (GOMP_SPINCOUNT, 80 us here): a step calls the kernel three times with almost
-        # nothing in between, and waking a sleeping thread for each call cost 0.1-0.2 ms per step (docs/solver.md,
+        # nothing in between, and waking a sleeping thread for each call cost about 0.2 ms per step (docs/solver.md,
         # "Waking the threads").  Both are read once, when libgomp loads: set before the library is.
         os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
         os.environ.setdefault("GOMP_SPINCOUNT", str(SPIN_COUNT))
