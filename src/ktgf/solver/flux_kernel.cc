@@ -878,18 +878,19 @@ ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& ty
   return ffi::Error::Success();
 }
 
-// KtgfCellLimits: the maxima over the cells of the `nlim` terms of a step-start cell program at Uk (the step
+// KtgfCellLimits: the maxima over the cells of the terms (as many as `maxima` holds) of a step-start cell program at Uk (the step
 // limits' and the state check's) in a pass that writes nothing per cell: the check of a call's last state (the
 // first stage of each step reduces the same terms as it sweeps).  It does not depend on the limiter or the
 // Riemann solver; Python calls the one of the stage library of the step.
-ffi::Error cell_limits_entry(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state, int64_t program, int32_t nlim,
+ffi::Error cell_limits_entry(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state, int64_t program,
                              ffi::Result<ffi::AnyBuffer> maxima) {
   if (state.size() != 5) return ffi::Error::InvalidArgument("cell limits kernel: state = Uk x5");
   ffi::DataType type;
   if (auto err = same_fields(state, 5, type); err.failure()) return err;
   if (auto err = check_variant("KtgfCellLimits", type, KTGF_LIMITER, KTGF_RIEMANN, true); err.failure()) return err;
-  if (nlim < 0 || long(maxima->element_count()) != nlim || maxima->element_type() != type)
-    return ffi::Error::InvalidArgument("cell limits kernel: maxima must be nlim values of the state precision");
+  if (maxima->element_type() != type)
+    return ffi::Error::InvalidArgument("cell limits kernel: maxima must be of the state precision");
+  const int nlim = int(maxima->element_count());
   CellProgram p{nullptr, 0};
   if (auto err = find_program(program, type, p); err.failure()) return err;
   long n[3];
@@ -902,10 +903,11 @@ ffi::Error cell_limits_entry(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs stat
 
 // KtgfSsprkStageCells: one SSP-RK3 stage whose cell fields the cell program computes as the sweep goes
 // (sweep_fused); `ring` its per-thread planes (ring_elements).  `mode` (StageMode): UPDATE, state (U0, Uk);
-// RATE, state U0, writes L(U0) and the maxima of the program's `nlim` limit terms (a step-start program);
+// RATE, state U0, writes L(U0) and the maxima of the program's limit terms (a step-start program; as many as
+// `maxima` holds, which is empty in the other modes);
 // FROM_RATE, state (U0, L0).  U' may alias Uk (L0) or U0 (see sweep_fused).
 ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state,
-                             int32_t limiter, int32_t riemann, int64_t program, int32_t mode, int32_t nlim,
+                             int32_t limiter, int32_t riemann, int64_t program, int32_t mode,
                              ffi::Result<ffi::AnyBuffer> u0, ffi::Result<ffi::AnyBuffer> u1,
                              ffi::Result<ffi::AnyBuffer> u2, ffi::Result<ffi::AnyBuffer> u3,
                              ffi::Result<ffi::AnyBuffer> u4, ffi::Result<ffi::AnyBuffer> maxima,
@@ -921,10 +923,10 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
   ffi::DataType type;
   if (auto err = same_fields(state, nstate, type); err.failure()) return err;
   if (auto err = check_variant("KtgfSsprkStageCells", type, limiter, riemann, true); err.failure()) return err;
-  if (nlim < 0 || (mode != RATE && nlim != 0) || long(maxima->element_count()) != nlim ||
-      maxima->element_type() != type)
-    return ffi::Error::InvalidArgument("stage kernel: maxima must be nlim values of the state precision (nlim = 0 "
-                                       "unless mode = 1)");
+  const int nlim = int(maxima->element_count());
+  if ((mode != RATE && nlim != 0) || maxima->element_type() != type)
+    return ffi::Error::InvalidArgument("stage kernel: maxima must be of the state precision (and empty unless "
+                                       "mode = 1)");
   CellProgram p{nullptr, 0};
   if (auto err = find_program(program, type, p); err.failure()) return err;
   long n[3];
@@ -1009,13 +1011,12 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStageCells, ssprk_stage_cells,
                                   .Attr<int32_t>("riemann")
                                   .Attr<int64_t>("program")
                                   .Attr<int32_t>("mode")
-                                  .Attr<int32_t>("nlim")
                                   .Ret<ffi::AnyBuffer>()  // U' density (RATE: L)
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_x
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_y
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_z
                                   .Ret<ffi::AnyBuffer>()  // ... E
-                                  .Ret<ffi::AnyBuffer>()  // maxima of the nlim limit terms (RATE)
+                                  .Ret<ffi::AnyBuffer>()  // maxima of the program's limit terms (RATE; else empty)
                                   .Ret<ffi::AnyBuffer>());  // the planes of the fused sweep (workspace, KtgfRingElements)
 
 XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfCellLimits, cell_limits_entry,
@@ -1023,8 +1024,7 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfCellLimits, cell_limits_entry,
                                   .Arg<ffi::Buffer<ffi::F64>>()  // the cell program's parameters
                                   .RemainingArgs()               // Uk (5)
                                   .Attr<int64_t>("program")
-                                  .Attr<int32_t>("nlim")
-                                  .Ret<ffi::AnyBuffer>());  // maxima of the nlim limit terms
+                                  .Ret<ffi::AnyBuffer>());  // maxima of the program's limit terms
 
 // Registers the cell program `fn` (state precision `bits`, 32 or 64) under `key` in this library; returns 0, or
 // 1 (nothing registered) if this library is built for the other precision.

@@ -256,7 +256,7 @@ def cell_limits(Uk: Any, program: Any, leaf: Any, grid: Any, limiter: str, riema
     dtype = Uk[0].dtype
     call = jax.ffi.ffi_call(_target(LIMITS_TARGET, dtype, limiter, riemann, "stage"),
                             jax.ShapeDtypeStruct((program.nlim,), dtype))
-    return call(leaf, *(jnp.asarray(f, dtype) for f in Uk), program=np.int64(program.key), nlim=np.int32(program.nlim))
+    return call(leaf, *(jnp.asarray(f, dtype) for f in Uk), program=np.int64(program.key))
 
 
 def _stage_params(a: Any, dt: Any, grid: Any, rho_s: Any, dtype: Any) -> Any:
@@ -288,7 +288,7 @@ def _stage_cells(state: list, program: Any, leaf: Any, a: Any, dt: Any, grid: An
                             input_output_aliases=aliases)
     params = _stage_params(a, dt, grid, rho_s, dtype)
     out = call(params, leaf, *state, **_schemes(limiter, riemann), program=np.int64(program.key),
-               mode=np.int32(STAGE_MODES[mode]), nlim=np.int32(maxima.shape[0]))
+               mode=np.int32(STAGE_MODES[mode]))
     return tuple(out[:5]), out[5]
 
 
