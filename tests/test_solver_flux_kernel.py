@@ -218,6 +218,46 @@ print(hashlib.sha256(np.asarray(out[0]).tobytes()).hexdigest())
 """
 
 
+def test_row_length_is_fixed_for_rows_of_16_to_1024_cells_in_multiples_of_8() -> None:
+    """Which grids get a library for their row length (the last axis), and what each variant is called."""
+    rows = {n: flux_kernel.row_length(Grid((4, 4, n), (4 * D, 4 * D, n * D))) for n in (8, 10, 16, 20, 24, 64, 1024,
+                                                                                       1032)}
+    assert rows == {8: 0, 10: 0, 16: 16, 20: 0, 24: 24, 64: 64, 1024: 1024, 1032: 0}
+    v = flux_kernel.variant(jnp.float32, "vanleer", "hll", "stage", Grid((4, 4, 64), (4 * D,) * 3))
+    assert (v.row, v.suffix, str(v)) == (64, "__f32_vanleer_hll_stage_r64", "float32 vanleer/hll stage, rows of 64")
+    assert "-DKTGF_ROW=64" in v.macros and "-DKTGF_ROW=0" in flux_kernel.DEFAULT.macros
+    with pytest.raises(ValueError, match="rows of 1 cells"):
+        flux_kernel.Variant("float64", "vanleer", "hll", "stage", 1)
+
+@pytest.mark.parametrize("dtype", [jnp.float64, jnp.float32])
+def test_a_library_for_the_row_length_gives_the_same_bits(monkeypatch, dtype) -> None:
+    """A grid with rows of 16 cells runs the libraries built for that row length (:func:`.flux_kernel.row_length`:
+    every stencil offset a constant); they do the operations of the library for any row length in the same
+    order, so three fused SSP-RK3 steps (and, float64, a flux divergence) are bit for bit that library's, and
+    match the JAX path."""
+    grid = Grid((4, 6, 16), (4 * D, 6 * 1.1 * D, 16 * 0.9 * D))
+    phys = for_case(_physics("ret"), "cooling", grid)
+    U = _state(grid, phys, dtype, amplitude=0.2)
+    num = Numerics(scheme="ssprk3")
+    rhs = (lambda: jax.jit(lambda U: explicit_rhs(U, grid, phys, num, viscous=True))(U)) if dtype == jnp.float64 \
+        else (lambda: ())
+
+    def run(row: int):
+        monkeypatch.setattr(flux_kernel, "row_length", lambda g: row)
+        stage = flux_kernel.variant(dtype, num.limiter, num.riemann, "stage", grid)
+        hlo = _with_kernel(True, lambda: jax.jit(lambda U: advance.__wrapped__(U, 0.0, 1e30, 3, grid, phys, num))
+                           .lower(U).as_text())
+        assert flux_kernel.target(flux_kernel.CELLS_TARGET, stage) in hlo, row  # this library runs
+        return _with_kernel(True, lambda: _steps(U, grid, phys, num)), _with_kernel(True, rhs)
+
+    (fixed, fixed_rhs), (any_row, any_rhs) = run(16), run(0)
+    ref = _with_kernel(False, lambda: _steps(U, grid, phys, num))
+    assert int(fixed[2]) == 3 and int(fixed[3]) == 0
+    assert all(np.array_equal(np.asarray(a), np.asarray(b)) for a, b in zip(fixed[0], any_row[0], strict=True))
+    assert all(np.array_equal(np.asarray(a), np.asarray(b)) for a, b in zip(fixed_rhs, any_rhs, strict=True))
+    assert _close(fixed[0], ref[0]) < RTOL[dtype]
+    assert _close(fixed[0], U) > 100 * RTOL[dtype]
+
 def test_fused_stage_does_not_depend_on_the_threads(tmp_path) -> None:
     """Every cell does the same operations whatever the threads' split of the rows (and which thread computes
     a ghost row): six steps with 1, 2 and 3 OpenMP threads are bit for bit the same.  41 rows: 20/21 and
@@ -467,7 +507,8 @@ def test_a_library_refuses_a_call_of_another_variant(monkeypatch) -> None:
 
     want = divergence(jnp.float64, "vanleer", "hll", True)
     target = flux_kernel._target
-    monkeypatch.setattr(flux_kernel, "_target", lambda base, *args: target(base, jnp.float64, "vanleer", "hll", "rhs"))
+    monkeypatch.setattr(flux_kernel, "_target",
+                        lambda base, *args: target(base, jnp.float64, "vanleer", "hll", "rhs", args[-1]))
     got = divergence(jnp.float64, "vanleer", "hll", True)
     assert _close(got[0], want[0]) == 0.0 and float(jnp.max(jnp.abs(got[1] - want[1]))) == 0.0
     others = [(jnp.float64, "minmod", "hll", True, "float64 minmod/hll viscous"),
@@ -478,6 +519,13 @@ def test_a_library_refuses_a_call_of_another_variant(monkeypatch) -> None:
         with pytest.raises(jax.errors.JaxRuntimeError,
                            match=f"built for float64 vanleer/hll viscous, the call asks for {asked}"):
             jax.block_until_ready(divergence(dtype, limiter, riemann, viscous))
+    # A library built for rows of 16 cells refuses this grid's rows of 10.
+    assert grid.cells[-1] == 10
+    rows16 = flux_kernel.Variant("float64", "vanleer", "hll", "rhs", 16)
+    flux_kernel._library(rows16)
+    monkeypatch.setattr(flux_kernel, "_target", lambda base, *args: flux_kernel.target(base, rows16))
+    with pytest.raises(jax.errors.JaxRuntimeError, match="built for rows of 16 cells, the call's grid has rows of 10"):
+        jax.block_until_ready(divergence(jnp.float64, "vanleer", "hll", True))
 
 
 def test_two_processes_build_a_variant_once(tmp_path) -> None:
