@@ -729,14 +729,14 @@ inline void wait_for(const Progress* progress, int t, int nt, long p) {
 // computed plane p (wait_for; only then: a stage that writes elsewhere runs its threads unsynchronised); planes
 // 0 and 1, needed again at the end, are kept in their own slots.  U' may instead be written over U0, which is
 // read only at the cell being written (except by FROM_RATE's closures, which then wait too).  o.mode
-// (StageMode) says what is written; FROM_RATE rows of Uk are computed from U0 and L0 as they are read.  nlim > 0 (a step-start program
-// fn): the maxima of its nlim limit terms over the cells also go to `maxima`, each thread reducing the rows it
-// evaluates (its ghost rows too: a maximum taken twice is the same).
+// (StageMode) says what is written; FROM_RATE rows of Uk are computed from U0 and L0 as they are read.
+// nlim > 0 (a step-start program fn): the maxima of its nlim limit terms over the cells also go to `maxima`,
+// each thread reducing the rows it evaluates (its ghost rows too: a maximum taken twice is the same).
 // Returns false (nothing computed) if the threads' rings do not fit in `capacity`.
 template <class T, int LIM, int RIE>
 bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const Stage<T>& o, T* ring_all,
                  long capacity, int nlim = 0, T* maxima = nullptr) {
-  const long n0 = kg.n[0], n1 = kg.n[1], n2 = row_cells(kg), m2 = n2 + 2 * GHOST;
+  const long n0 = kg.n[0], n1 = kg.n[1], n2 = row_cells(kg), m2 = row_stride(kg);
   bool fits = true;
   for (int q = 0; q < nlim; ++q) maxima[q] = -std::numeric_limits<T>::infinity();
   const int threads = fused_threads(kg.n);
@@ -761,8 +761,7 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
       const long jlo = n1 * t / nt, jhi = n1 * (t + 1) / nt, nj = jhi - jlo;
       const long m1 = nj + 2 * GHOST, plane = m1 * m2, slots = RING + 2;
       T* ring = ring_all + t * per;
-      Consts<T> k = kg;
-      k.stride[1] = m2;  // rows of the ring (planes are reached through the tables)
+      const Consts<T>& k = kg;  // the ring's rows have the padded row stride (planes are reached through the tables)
       RowBuffers<T> r(nj, n2);  // nj >= MIN_ROWS: fused_threads
       // FROM_RATE: a row of Uk = U0 + dt L0; nlim > 0: a row of the limit terms and the thread's maxima.
       std::vector<T> uk_row(o.mode == FROM_RATE ? 5 * n2 : 0), terms(size_t(nlim) * n2);
@@ -905,10 +904,10 @@ ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& ty
   return ffi::Error::Success();
 }
 
-// KtgfCellLimits: the maxima over the cells of the terms (as many as `maxima` holds) of a step-start cell program at Uk (the step
-// limits' and the state check's) in a pass that writes nothing per cell: the check of a call's last state (the
-// first stage of each step reduces the same terms as it sweeps).  It does not depend on the limiter or the
-// Riemann solver; Python calls the one of the stage library of the step.
+// KtgfCellLimits: the maxima over the cells of the terms (as many as `maxima` holds) of a step-start cell
+// program at Uk (the step limits' and the state check's) in a pass that writes nothing per cell: the check of a
+// call's last state (the first stage of each step reduces the same terms as it sweeps).  It does not depend on
+// the limiter or the Riemann solver; Python calls the one of the stage library of the step.
 ffi::Error cell_limits_entry(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state, int64_t program,
                              ffi::Result<ffi::AnyBuffer> maxima) {
   if (state.size() != 5) return ffi::Error::InvalidArgument("cell limits kernel: state = Uk x5");
