@@ -25,12 +25,12 @@ def write_uniform_shear(path: Path, phi, e, T, eta, p, rel_sigma: float = 0.01, 
 
 def synthetic_shear(path: Path, model, phi, e: float = 0.9, rel_sigma: float = 0.01) -> Path:
     """Uniform-shear data of ``model`` at solid fractions ``phi`` (closed forms of model.md §9)."""
-    from ktgf.couette.uniform_shear import uniform_shear
+    from ktgf.shear.steady import steady_shear
 
     phi = np.asarray(phi, dtype=float)
     ee = np.full_like(phi, e)
     r = model.reduced(phi, ee)
-    return write_uniform_shear(path, phi, ee, uniform_shear(model, phi, ee).temperature_ratio, r.eta, r.p, rel_sigma)
+    return write_uniform_shear(path, phi, ee, steady_shear(model, phi, ee).T, r.eta, r.p, rel_sigma)
 
 
 def couette_header(e=0.9, phi=0.5, H=20.0, U=10.0, tau=0.65518, p=2.6588, drop: str = "") -> str:

@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 
 from _calibration_synthetic import synthetic_shear
 from ktgf import get_model
-from ktgf.calibration.data import file_hash
+from ktgf.data import file_hash
 from ktgf.cli import app
 
 runner = CliRunner()
@@ -78,9 +78,9 @@ def test_shear_with_model_file_predicts_the_synthetic_data(fitted):
     assert r.exit_code == 0, r.output
     rows = json.loads(r.stdout)
     assert {row["model"] for row in rows} == {"proposed-calibrated"}
-    from ktgf.couette.uniform_shear import shear_state
+    from ktgf.shear.steady import steady_shear
 
-    ref = shear_state(get_model("proposed", **TRUE), np.array([0.55, 0.6]), 0.9)
+    ref = steady_shear(get_model("proposed", **TRUE), np.array([0.55, 0.6]), 0.9)
     np.testing.assert_allclose([row["eta_over_eta0"] for row in rows], ref.eta_over_eta0, rtol=1e-6)
     np.testing.assert_allclose([row["T"] for row in rows], ref.T, rtol=1e-6)
 
@@ -210,7 +210,7 @@ def test_couette_calibration_round_trip_walls_through_compare(tmp_path, data_dir
     """Calibrate φ' and β on synthetic Couette data; `couette compare` with the file then uses its walls and reproduces the data."""
     from _calibration_synthetic import synthetic_couette
 
-    from ktgf.calibration.data import read_couette
+    from ktgf.data import read_couette
 
     case = read_couette(data_dir / "dem_couette_e0.9_phi0.50.csv").case
     data = synthetic_couette(tmp_path / "c.csv", get_model("proposed", beta=2.0), 0.2, case, 60)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from _calibration_synthetic import couette_header, with_header, write_uniform_shear
-from ktgf.calibration.data import read_couette, read_data, read_uniform_shear
+from ktgf.data import read_couette, read_data, read_uniform_shear
 from ktgf.errors import InputError
 
 
@@ -39,9 +39,9 @@ def test_shared_couette_file_case_from_header(data_dir):
     # header: first occupied bins at y = -+9.25 with ux = -3.1147, 3.1598
     assert d.slip_y == 9.25
     assert d.slip_speed() == pytest.approx(0.5 * (3.11474 + 3.1598), abs=1e-4)
-    from ktgf.report.dem import read_table
+    from ktgf.data import read_table
 
-    t = read_table(data_dir / "dem_couette_e0.9_phi0.50.csv")
+    t = read_table(data_dir / "dem_couette_e0.9_phi0.50.csv").as_dict()
     sem = {y: s for y, s in zip(t["y"], t["ux_sem"])}
     assert d.slip_sigma() == pytest.approx(0.5 * math.hypot(sem[-9.25], sem[9.25]), rel=1e-12)
     assert sem[-9.25] == 0.00944467

@@ -61,7 +61,7 @@ TRUTH = {"specularity": 0.2, "beta": 2.0}
 @pytest.fixture(scope="module")
 def synthetic_couette(tmp_path_factory, data_dir):
     """Couette data of proposed (β = 2) with JJ walls φ' = 0.2 in the shared file's case, from the Dataset route."""
-    from ktgf.calibration.data import read_couette
+    from ktgf.data import read_couette
 
     case = read_couette(data_dir / "dem_couette_e0.9_phi0.50.csv").case
     return synthetic_couette_file(tmp_path_factory.mktemp("syn") / "couette.csv", get_model("proposed", beta=TRUTH["beta"]),

@@ -185,7 +185,7 @@ def test_cli_compare_four_models_with_dem(tmp_path, dem_file):
 def test_uniform_shear_closed_forms_against_dem_uniform_shear(data_dir):
     """dem_uniform_shear.csv (Lees–Edwards DEM, e = 0.9): at φ = 0.3 every model is within 10 % in T, η*, p*
     (physical validation; at φ = 0.5 the models underpredict p* and η* by 11–22 %, reported, not asserted)."""
-    from ktgf.couette.compare import compare_uniform_shear
+    from ktgf.shear.dem import compare_uniform_shear
 
     f = data_dir / "dem_uniform_shear.csv"
     if not f.exists():

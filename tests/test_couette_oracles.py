@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from ktgf.closures import PAPER_MODELS, get_model
-from ktgf.couette import AnnularCell, PlanarCell, Wall, uniform_shear
+from ktgf.couette import AnnularCell, PlanarCell, Wall
+from ktgf.shear.steady import steady_shear
 from ktgf.couette.run import Material, run
 
 # oracles.md, "Uniform simple shear, RET with CS χ": (φ, e, γ̇/ν0, |P_xy|/p, θ/(γ̇d)²)
@@ -25,10 +26,10 @@ NO_SLIP_ADIABATIC = Wall.of_type("no-slip-adiabatic")
 
 @pytest.mark.parametrize("phi,e,a,ratio,temp", USF_TABLE)
 def test_uniform_shear_closed_forms_match_oracle_table(phi, e, a, ratio, temp):
-    r = uniform_shear(get_model("ret"), phi, e)
-    assert float(r.shear_rate_ratio) == pytest.approx(a, rel=3e-5)
-    assert float(r.stress_ratio) == pytest.approx(ratio, rel=3e-5)
-    assert float(r.temperature_ratio) == pytest.approx(temp, rel=3e-5)
+    r = steady_shear(get_model("ret"), phi, e)
+    assert float(r.astar) == pytest.approx(a, rel=3e-5)
+    assert float(r.tau_over_p) == pytest.approx(ratio, rel=3e-5)
+    assert float(r.T) == pytest.approx(temp, rel=3e-5)
 
 
 @pytest.mark.parametrize("phi,e,a,ratio,temp", USF_TABLE)
@@ -50,7 +51,7 @@ def test_uniform_shear_every_model(name):
     """Same check for every model against the closed form evaluated from its coefficients."""
     phi, e, H, U = 0.45, 0.8, 0.02, 1.0
     ds = run(name, PlanarCell(H, U), NO_SLIP_ADIABATIC, NO_SLIP_ADIABATIC, phi, Material(D, RHO, e), n_cells=20)
-    expect = float(uniform_shear(get_model(name), phi, e).temperature_ratio)
+    expect = float(steady_shear(get_model(name), phi, e).T)
     np.testing.assert_allclose(ds["theta"].values / (U / H * D) ** 2, expect, rtol=1e-8)
 
 

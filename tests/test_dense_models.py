@@ -13,7 +13,8 @@ from ktgf import get_model
 from ktgf.cli import app
 from ktgf.closures.dissipation import CorrelationLength, NoDissipationCorrection, ekt_j
 from ktgf.closures.rdf import CarnahanStarling, ChialvoSundaresan, JammingPowerLaw
-from ktgf.couette.uniform_shear import ETA0_DEM, SHEAR_PER_ASTAR, load_uniform_shear, shear_state, uniform_shear
+from ktgf.data import uniform_shear_records
+from ktgf.shear.steady import ETA0_DEM, SHEAR_PER_ASTAR, steady_shear
 
 jax = pytest.importorskip("jax")
 runner = CliRunner()
@@ -87,7 +88,7 @@ def test_ekt_uniform_shear_dilute_limit_is_standard():
     base = get_model("ret")
     ekt = base.replace(dissipation=CorrelationLength(c=3.0))
     phi = np.array([1e-4, 1e-3, 0.01])
-    s0, s1 = shear_state(base, phi, 0.8), shear_state(ekt, phi, 0.8)
+    s0, s1 = steady_shear(base, phi, 0.8), steady_shear(ekt, phi, 0.8)
     np.testing.assert_array_equal(s1.L_over_d, 1.0)
     np.testing.assert_array_equal(s0.T, s1.T)
 
@@ -97,7 +98,7 @@ def test_ekt_uniform_shear_solves_the_energy_balance_consistently(c):
     """a*² η* (L/d) = (3/2) ζ0* with L/d = max(1, Λ s), s = dγ̇/√θ evaluated at the returned state."""
     m = get_model("ret").replace(dissipation=CorrelationLength(c=c))
     phi = np.array([0.3, 0.45, 0.5, 0.55, 0.6])
-    s = shear_state(m, phi, 0.7)
+    s = steady_shear(m, phi, 0.7)
     shear = 1.0 / np.sqrt(s.T)  # dγ̇/√θ
     np.testing.assert_allclose(shear, SHEAR_PER_ASTAR * phi * s.astar, rtol=1e-12)
     r = m.reduced(phi, 0.7, shear=shear)  # ζ0* with the correlation length at this state
@@ -120,17 +121,17 @@ def test_shear_state_matches_model_md_closed_forms(name):
     m = get_model(name)
     phi = np.array([0.1, 0.3, 0.5, 0.6])
     r = m.reduced(phi, 0.8)
-    s = shear_state(m, phi, 0.8)
+    s = steady_shear(m, phi, 0.8)
     np.testing.assert_allclose(s.T, 25 * math.pi * r.eta / (13824 * phi**2 * r.zeta0), rtol=1e-13)
-    np.testing.assert_allclose(s.stress_ratio, np.sqrt(1.5 * r.eta * r.zeta0) / r.p, rtol=1e-13)
+    np.testing.assert_allclose(s.tau_over_p, np.sqrt(1.5 * r.eta * r.zeta0) / r.p, rtol=1e-13)
     np.testing.assert_allclose(s.astar, np.sqrt(1.5 * r.zeta0 / r.eta), rtol=1e-13)
-    us = uniform_shear(m, phi, 0.8)
-    np.testing.assert_allclose(us.temperature_ratio, s.T, rtol=1e-13)
+    us = steady_shear(m, phi, 0.8)
+    np.testing.assert_allclose(us.T, s.T, rtol=1e-13)
 
 
 def test_column_definitions_agree_with_the_dem_file_header(data_dir):
     """The DEM's own columns obey our conversions: eta_star/eta_over_eta0 = 5/(16√π), T = 25π/(9216 φ² a*²)."""
-    rows = load_uniform_shear(data_dir / "dem_uniform_shear.csv")
+    rows = uniform_shear_records(data_dir / "dem_uniform_shear.csv")
     np.testing.assert_allclose(rows["eta_star"] / rows["eta_over_eta0"], ETA0_DEM, rtol=2e-4)
     np.testing.assert_allclose(25 * math.pi / (9216 * rows["phi"] ** 2 * rows["astar"] ** 2), rows["T"], rtol=1e-3)
 
@@ -139,7 +140,7 @@ def test_cli_shear_json_matches_library():
     result = runner.invoke(app, ["shear", "--model", "proposed", "--phi", "0.3,0.5", "--e", "0.9", "--format", "json"])
     assert result.exit_code == 0, result.output
     rows = json.loads(result.output)
-    s = shear_state(get_model("proposed"), np.array([0.3, 0.5]), 0.9)
+    s = steady_shear(get_model("proposed"), np.array([0.3, 0.5]), 0.9)
     assert [r["phi"] for r in rows] == [0.3, 0.5]
     for i, r in enumerate(rows):
         for col in ("T", "eta_star", "eta_over_eta0", "p_over_nT"):
@@ -175,9 +176,10 @@ def test_cli_shear_errors_exit_2_with_one_line(args, fragment):
 # --- the recommended dense model ---------------------------------------------------------------
 def test_dense_fit_reproduces_the_registered_parameter(data_dir):
     """Fit on dem_uniform_shear.csv (e = 0.9, φ = 0.3, 0.5): the registered β is that fit."""
-    from ktgf.closures.dense import DENSE_BETA, fit_rdf_option
+    from ktgf.calibration.registry_fits import fit_rdf_option
+    from ktgf.closures.dense import DENSE_BETA
 
-    rows = load_uniform_shear(data_dir / "dem_uniform_shear.csv")
+    rows = uniform_shear_records(data_dir / "dem_uniform_shear.csv")
     beta, sol = fit_rdf_option(get_model("ret"), rows, "beta")
     assert beta == pytest.approx(DENSE_BETA, abs=1e-3)
     assert get_model("dense").rdf.beta == DENSE_BETA
@@ -199,10 +201,10 @@ def test_dense_predicts_the_couette_wall_stresses_within_15_percent(data_dir):
 
 def test_dense_within_ten_percent_of_every_shared_uniform_shear_point(data_dir):
     """Goal of issue 9: η* and p/(nT) within 10 % — fitted rows (e = 0.9) and the held-out e = 0.7 row."""
-    from ktgf.closures.dense import relative_errors
+    from ktgf.calibration.registry_fits import relative_errors
 
-    fitted = load_uniform_shear(data_dir / "dem_uniform_shear.csv")
-    held_out = load_uniform_shear(data_dir / "dem_uniform_shear_friction.csv", where={"mu": 0.0})
+    fitted = uniform_shear_records(data_dir / "dem_uniform_shear.csv")
+    held_out = uniform_shear_records(data_dir / "dem_uniform_shear_friction.csv", where={"mu": 0.0})
     assert held_out.size == 1 and held_out["e"][0] == 0.7
     m = get_model("dense")
     for rows in (fitted, held_out):
@@ -216,12 +218,12 @@ def test_load_uniform_shear_errors(tmp_path):
     from ktgf import InputError
 
     with pytest.raises(InputError, match="does not exist"):
-        load_uniform_shear(tmp_path / "none.csv")
+        uniform_shear_records(tmp_path / "none.csv")
     bad = tmp_path / "bad.csv"
     bad.write_text("# header\nphi,e,T\n0.3,0.9,1.0\n")
     with pytest.raises(InputError, match="missing column"):
-        load_uniform_shear(bad)
+        uniform_shear_records(bad)
     nan = tmp_path / "nan.csv"
     nan.write_text("phi,e,T,eta_over_eta0,p_over_nT\n0.3,0.9,nan,1,1\n")
     with pytest.raises(InputError, match="NaN"):
-        load_uniform_shear(nan)
+        uniform_shear_records(nan)

@@ -13,10 +13,12 @@ from ktgf.calibration.model_file import dumps, load_model_file, part_choice_opti
 from ktgf.cli import app
 from ktgf.closures.friction import WaltonRestitution
 from ktgf.closures.friction.model_slot import Friction
-from ktgf.closures.friction_dem import DEM_FILE, read_friction_dem
-from ktgf.closures.friction_shear import frictional_uniform_shear, model_uniform_shear, recommended_parts
+from ktgf.data import FRICTION_SHEAR as DEM_FILE, read_friction_shear
+from ktgf.shear.compositions import frictional_uniform_shear, recommended_parts
+from ktgf.shear.steady import steady_shear
 from ktgf.closures.dissipation import CorrelationLength
-from ktgf.closures.friction.calibrated import FRICTIONAL_C, fit_correlation_constant
+from ktgf.calibration.registry_fits import fit_correlation_constant
+from ktgf.closures.friction.calibrated import FRICTIONAL_C
 from ktgf.closures.rdf import ChialvoSundaresan
 from ktgf.errors import InputError
 
@@ -39,7 +41,7 @@ def test_frictional_model_at_mu_zero_is_the_frictionless_model_bit_for_bit():
         assert _same_bits(fr.reduced(PHI, e, shear=np.full(PHI.size, 3.0)), FRICTIONLESS.reduced(PHI, e, shear=np.full(PHI.size, 3.0)))
         assert _same_bits(fr.coefficients(PHI, e, 0.01, d=1e-3, rho_s=2500.0),
                           FRICTIONLESS.coefficients(PHI, e, 0.01, d=1e-3, rho_s=2500.0))
-    a, b = model_uniform_shear(fr, PHI, 0.7), model_uniform_shear(FRICTIONLESS, PHI, 0.7)
+    a, b = steady_shear(fr, PHI, 0.7), steady_shear(FRICTIONLESS, PHI, 0.7)
     assert _same_bits(a._replace(Trot_over_T=0), b._replace(Trot_over_T=0))
     assert np.all(a.Trot_over_T == 0.0) and np.all(np.isnan(b.Trot_over_T))  # no rotation excited / not modelled
     # and without the EKT part (its c is the one fitted number) the frictionless core is RET + CS13 χ
@@ -77,9 +79,9 @@ def test_mu_is_routed_to_the_friction_part_and_the_jamming_fraction():
 
 
 def test_registered_model_is_the_documented_composition():
-    """``frictional`` = the parts of friction_shear.recommended_parts (docs/friction.md §6 numbers)."""
+    """``frictional`` = the parts of ktgf.shear.compositions.recommended_parts (docs/friction.md §6 numbers)."""
     rows = [(0.4, 0.170, 0.539, 0.630, 0.497), (0.5, 0.184, 2.393, 0.599, 0.497)]  # docs/friction.md §6 table
-    s = model_uniform_shear(get_model("frictional", mu=0.5), [r[0] for r in rows], 0.7)
+    s = steady_shear(get_model("frictional", mu=0.5), [r[0] for r in rows], 0.7)
     parts = frictional_uniform_shear(recommended_parts(), [r[0] for r in rows], 0.7, 0.5)
     for a, b in zip(s, parts):
         np.testing.assert_allclose(a, b, rtol=1e-12)
@@ -146,7 +148,7 @@ def test_shear_cli_mu_prints_the_dem_columns():
     r = runner.invoke(app, ["shear", "--model", "frictional", "--mu", "0.5", "--phi", "0.4,0.5", "--e", "0.7", "--format", "json"])
     assert r.exit_code == 0, r.output
     rows = json.loads(r.stdout)
-    want = model_uniform_shear(get_model("frictional", mu=0.5), [0.4, 0.5], 0.7)
+    want = steady_shear(get_model("frictional", mu=0.5), [0.4, 0.5], 0.7)
     for i, row in enumerate(rows):
         for col in ("phi", "T", "Trot_over_T", "p_star", "tau_over_p", "p_over_nT"):
             assert row[col] == pytest.approx(float(getattr(want, col)[i]), rel=1e-12), col
@@ -208,7 +210,7 @@ def test_friction_part_is_hashable_and_a_value():
 
 def test_the_fitted_constant_is_the_registered_one(data_dir):
     """c of ``frictional`` is solved from T at μ = 0.5, φ = 0.5 of the shared file (the one fitted number)."""
-    c = fit_correlation_constant(read_friction_dem(data_dir / DEM_FILE))
+    c = fit_correlation_constant(read_friction_shear(data_dir / DEM_FILE))
     assert c == pytest.approx(FRICTIONAL_C, abs=1e-4)
     assert get_model("frictional").dissipation.c == FRICTIONAL_C
 
@@ -216,10 +218,10 @@ def test_the_fitted_constant_is_the_registered_one(data_dir):
 def test_dem_rows_within_15_percent_and_the_no_fit_variant_is_not(data_dir):
     """The issue's goal on the shared file: T, p*, τ/p within 15 % at μ = 0.5 (T at φ = 0.5 is the fit, the other
     five are predictions); without the fitted EKT part the φ = 0.5 row misses it (T −17 %, p* −23 %)."""
-    rows = [r for r in read_friction_dem(data_dir / DEM_FILE) if r["mu"] == 0.5]
+    rows = [r for r in read_friction_shear(data_dir / DEM_FILE) if r["mu"] == 0.5]
 
     def errs(m):
-        s = model_uniform_shear(m, [r["phi"] for r in rows], 0.7)
+        s = steady_shear(m, [r["phi"] for r in rows], 0.7)
         return np.array([[getattr(s, q)[i] / r[q] - 1 for q in ("T", "p_star", "tau_over_p")] for i, r in enumerate(rows)])
 
     fitted, plain = errs(get_model("frictional", mu=0.5)), errs(get_model("frictional", mu=0.5, dissipation="none"))

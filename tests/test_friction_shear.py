@@ -19,17 +19,16 @@ from ktgf.closures.friction import (
     SrivastavaSundaresanViscosity,
     TanhBlend,
 )
-from ktgf.closures.friction_dem import (
-    DEM_FILE,
+from ktgf.data import FRICTION_SHEAR as DEM_FILE, read_friction_shear
+from ktgf.shear.dem import (
     comparison_markdown,
     compositions,
     jamming_sensitivity_markdown,
     compare_with_dem,
     fit_row,
     fit_tangential_restitution,
-    read_friction_dem,
 )
-from ktgf.closures.friction_shear import FrictionalShearParts, frictional_uniform_shear
+from ktgf.shear.compositions import FrictionalShearParts, frictional_uniform_shear
 from ktgf.closures.rdf import ChialvoSundaresan
 from ktgf.errors import InputError
 
@@ -106,7 +105,7 @@ def test_bad_input_is_one_line():
 
 @pytest.fixture(scope="module")
 def dem_rows(data_dir):
-    return read_friction_dem(data_dir / DEM_FILE)
+    return read_friction_shear(data_dir / DEM_FILE)
 
 
 def test_fit_uses_only_the_fit_row(dem_rows):
@@ -134,7 +133,7 @@ def test_docs_table_is_current(dem_rows):
     m = re.search(r"<!-- friction-table-start -->\n(.*?)<!-- friction-table-end -->", text, re.S)
     assert m, "docs/friction.md lacks the generated comparison table markers"
     assert m.group(1) == comparison_markdown(dem_rows), (
-        "docs/friction.md comparison table is stale: regenerate it with ktgf.closures.friction_dem.comparison_markdown"
+        "docs/friction.md comparison table is stale: regenerate it with ktgf.shear.dem.comparison_markdown"
     )
 
 
@@ -179,7 +178,7 @@ def test_docs_jamming_sensitivity_is_current(dem_rows):
 
 
 def test_recommended_parts_reduce_to_the_frictionless_chialvo_sundaresan_model():
-    from ktgf.closures.friction_shear import recommended_parts
+    from ktgf.shear.compositions import recommended_parts
 
     phi = np.array([0.3, 0.5])
     from ktgf.closures.dissipation import CorrelationLength

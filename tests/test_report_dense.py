@@ -16,7 +16,7 @@ import xarray as xr
 from ktgf import get_model
 from ktgf.closures import models as registry
 from ktgf.report import ReportSettings, check_report, dense, framework
-from ktgf.report.dem import read_table
+from ktgf.data import read_table
 
 
 def test_section_models_default_and_dense_when_registered(monkeypatch):
@@ -44,8 +44,8 @@ def _ctx(tmp_path, data_dir, **kw):
 
 def test_dem_points_reproduce_the_files_own_columns(tmp_path, data_dir):
     pts = dense.dem_points(_ctx(tmp_path, data_dir))
-    main = read_table(data_dir / "dem_uniform_shear.csv")
-    fric = read_table(data_dir / "dem_uniform_shear_friction.csv")
+    main = read_table(data_dir / "dem_uniform_shear.csv").as_dict()
+    fric = read_table(data_dir / "dem_uniform_shear_friction.csv").as_dict()
     np.testing.assert_allclose(pts["eta_star"][:2], main["eta_star"], rtol=2e-4)
     assert pts["e"][2] == 0.7 and pts["p_star"][2] == pytest.approx(fric["p_star"][0], rel=2e-4)
 

@@ -11,9 +11,9 @@ import pytest
 import xarray as xr
 
 from ktgf import get_model
-from ktgf.closures.friction_dem import DEM_FILE, read_friction_dem
+from ktgf.data import FRICTION_SHEAR as DEM_FILE, read_friction_shear
 from ktgf.closures.rdf import ChialvoSundaresan
-from ktgf.couette.uniform_shear import uniform_shear
+from ktgf.shear.steady import steady_shear
 from ktgf.report import ReportSettings, framework
 from ktgf.report import friction as section
 
@@ -34,10 +34,10 @@ def test_friction_section_outputs_and_errors(tmp_path, data_dir):
     with xr.open_dataset(ctx.out / fig.data) as ds:
         # μ = 0 curve of the frictional model = RET with the CS13 χ (closed form T of model.md §9)
         phi = ds.phi.values[:3]
-        ref = uniform_shear(get_model("ret").replace(rdf=ChialvoSundaresan()), phi, 0.7).temperature_ratio
+        ref = steady_shear(get_model("ret").replace(rdf=ChialvoSundaresan()), phi, 0.7).T
         np.testing.assert_allclose(ds["T"].sel(model="frictional", mu=0.0).values[:3], ref, rtol=1e-12)
         assert np.isnan(ds["T"].sel(model="frictional", mu=0.5).values[-1])  # φ = 0.6 is beyond φ_c(0.5) = 0.565
-    rows = read_friction_dem(data_dir / DEM_FILE)
+    rows = read_friction_shear(data_dir / DEM_FILE)
     (table,) = res.tables
     assert [r[1] for r in table.rows] == [r["T"] for r in rows]  # the DEM column is the file's
     errs = res.numbers["friction_errors"]["frictional"]

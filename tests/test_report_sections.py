@@ -18,7 +18,7 @@ from ktgf import get_model
 from ktgf.hcs import stability_map
 from ktgf.hcs.haff import haff_temperature
 from ktgf.report import ReportSettings, build_report, check_report, cooling_gas, couette, framework, locate_data_dir
-from ktgf.report.dem import COUETTE, HCS_COOLING, read_table
+from ktgf.data import COUETTE, HCS_COOLING, read_table
 from ktgf.report.hcs import compare_pair, cooling_comparison, dispersion, ret_proposed_sentence
 
 
@@ -68,7 +68,7 @@ def test_eigenvalue_threshold_matches_closed_form() -> None:
 
 
 def test_ret_cooling_rate_matches_the_dem_files_enskog_column(dem_dir) -> None:
-    t = read_table(dem_dir / HCS_COOLING)
+    t = read_table(dem_dir / HCS_COOLING).as_dict()
     cmp = cooling_comparison(("ret",), t)
     # ratio_early = A_DEM/A_E with A_E = ζ0 of RET with CS χ (data README) → A_RET/A_DEM − 1 = 1/ratio_early − 1
     np.testing.assert_allclose(cmp.error_early.sel(model="ret"), 1.0 / t["ratio_early"] - 1.0, atol=3e-4)
@@ -95,7 +95,7 @@ def _enable(monkeypatch, key: str, module, fake) -> None:
 
 
 def test_couette_section_errors_of_a_known_solution(monkeypatch, tmp_path, dem_dir, quick_report) -> None:
-    dem = read_table(dem_dir / COUETTE)
+    dem = read_table(dem_dir / COUETTE).as_dict()
     calls = []
     shift = 0.05  # the manufactured velocity is the DEM's plus 5 % of U: RMS(u − u_DEM)/U = 0.05 exactly
 

@@ -9,7 +9,7 @@ import pytest
 from scipy.linalg import expm
 
 from ktgf.closures import get_model, list_models
-from ktgf.couette.uniform_shear import uniform_shear
+from ktgf.shear.steady import steady_shear
 from ktgf.errors import InputError
 from ktgf.shear import kelvin_evolution, shear_base_state, shear_matrix, shear_modes
 
@@ -55,8 +55,8 @@ def test_shear_waves_decay_at_the_viscous_rate(name):
 
 def _stress_ratio_and_pressure(model, phi):
     """μ = |P_xy|/p and f_p = p/(ρ_s γ̇² d²) = φ p* T of the closed form (model.md §9)."""
-    us = uniform_shear(model, phi, E)
-    return us.stress_ratio, phi * model.reduced(phi, E).p * us.temperature_ratio
+    us = steady_shear(model, phi, E)
+    return us.tau_over_p, phi * model.reduced(phi, E).p * us.T
 
 
 @pytest.mark.parametrize("name", MODELS)

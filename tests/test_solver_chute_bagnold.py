@@ -20,7 +20,7 @@ from _chute_case import bagnold_case
 from ktgf.closures import get_model
 from ktgf.couette.chute import solve_chute
 from ktgf.couette.run import Material
-from ktgf.couette.uniform_shear import uniform_shear
+from ktgf.shear.steady import steady_shear
 
 MAT = Material(d=1e-3, rho_s=2500.0, e=0.9)
 ANGLE = 18.0
@@ -38,7 +38,7 @@ def _series(angle: float, depths: list[float]) -> list:
 
 def test_angle_admits_a_uniform_shear_interior():
     """tan 18° lies inside RET's uniform-shear stress-ratio range at e = 0.9 (tan 25° does not)."""
-    ratios = [float(uniform_shear(get_model("ret"), p, MAT.e).stress_ratio) for p in np.linspace(0.002, 0.6, 120)]
+    ratios = [float(steady_shear(get_model("ret"), p, MAT.e).tau_over_p) for p in np.linspace(0.002, 0.6, 120)]
     assert min(ratios) < math.tan(math.radians(ANGLE)) < max(ratios)
     assert max(ratios) < math.tan(math.radians(25.0))
 

@@ -1,7 +1,7 @@
 """Dense sheared flows in the 3D solver (φ up to 0.55, model "dense", IMEX) run to a detected steady
 state and agree with the closed form (uniform shear) and the 1D Couette solver.
 
-Oracles from outside the 3D solver: the closed-form uniform shear of :mod:`ktgf.couette.uniform_shear`
+Oracles from outside the 3D solver: the closed-form uniform shear of :mod:`ktgf.shear.steady`
 (θ, η, p of the energy balance ηγ̇² = (3/2)ρθζ0, model.md §9) and the steady profile of the 1D
 Couette solver :func:`ktgf.couette.run.run` (same model, walls, inventory and gap).  The runs start
 off the steady state (θ three times the steady one; uniform φ, θ in the Couette cell), so the

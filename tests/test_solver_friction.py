@@ -2,7 +2,7 @@
 
 Oracles from outside the 3D solver: the frictional Haff law of :mod:`ktgf.hcs.haff` (the HCS
 dissipation of the friction part), the closed-form frictional uniform shear of ``ktgf shear --mu``
-(:func:`ktgf.closures.friction_shear.model_uniform_shear`), and the frictionless solver itself
+(:func:`ktgf.shear.steady.steady_shear`), and the frictionless solver itself
 (μ = 0 and a frictional stress that vanishes must give the same bits).
 """
 
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from ktgf.closures import get_model
-from ktgf.closures.friction_shear import model_uniform_shear
+from ktgf.shear.steady import steady_shear
 from ktgf.closures.models import Model
 from ktgf.errors import InputError
 from ktgf.hcs.haff import cooling_time, haff_temperature
@@ -120,7 +120,7 @@ CASES = [({}, 0.4), ({}, 0.5), ({"stress": "schaeffer", "jj_phi_min": 0.45}, 0.5
 def _closed_form(m: Model, phi: float) -> tuple[float, float, float]:
     """(θ [m²/s²], τ [Pa], p [Pa]) of ``ktgf shear --mu`` (the DEM file's definitions times the scales)."""
     scale = RHO_S * D**2 * RATE**2
-    s = model_uniform_shear(m, phi, E, stress_scale=scale if m.friction.has_stress else None)
+    s = steady_shear(m, np.atleast_1d(phi), E, stress_scale=scale if m.friction.has_stress else None)
     p = float(s.p_star[0]) * scale
     return float(s.T[0]) * (RATE * D) ** 2, float(s.tau_over_p[0]) * p, p
 

@@ -1,7 +1,7 @@
 """Lees–Edwards boundaries and the uniform-shear case of the 3D solver.
 
 Oracles from outside the solver: an analytic shearing-periodic field (its ghost-cell images),
-the closed-form uniform shear of :mod:`ktgf.couette.uniform_shear` (θ, η, p of the energy
+the closed-form uniform shear of :mod:`ktgf.shear.steady` (θ, η, p of the energy
 balance ηγ̇² = (3/2)ρθζ0, model.md §9), and exact conservation of mass.
 """
 

@@ -184,11 +184,11 @@ def test_shear_mode_temperature_is_the_closed_form_or_refused() -> None:
     a value that differs is refused in one line naming the field, a missing one elsewhere too."""
     import tomllib
 
-    from ktgf.couette.uniform_shear import uniform_shear
+    from ktgf.shear.steady import steady_shear
     from ktgf.errors import InputError
     from ktgf.solver.config import initial_temperature, parse_config
 
-    theta = float(uniform_shear(get_model(MODEL), PHI, E).temperature_ratio) * (RATE * D) ** 2
+    theta = float(steady_shear(get_model(MODEL), PHI, E).T) * (RATE * D) ** 2
     cfg = parse_config(tomllib.loads(_config([0, 1])))
     assert cfg.initial.temperature is None
     assert initial_temperature(cfg) == pytest.approx(theta, rel=1e-12)

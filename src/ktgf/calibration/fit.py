@@ -25,7 +25,7 @@ import numpy as np
 
 from ..closures.models import Model
 from ..errors import ConvergenceError, InputError
-from .data import CouetteData, UniformShearData
+from ..data import CouetteData, UniformShearData
 from .residuals import DEFAULT_SPECULARITY, WALL_PARAMETERS, make_terms, model_at
 
 #: Bounds of the common options (φ_c, φ_f, β, a, RDF exponent); other float options default to (0, ∞)
@@ -135,7 +135,7 @@ class _Stop(Exception):
 def calibrate(model: Model, datasets: Sequence[Any], names: Sequence[str], *, start: dict[str, float] | None = None,
               bounds: dict[str, tuple[float, float]] | None = None, weights: str = "sigma", errors: str | None = None,
               walls: dict[str, float] | None = None, n_cells: int = 200, max_evaluations: int = 100) -> FitResult:
-    """Fit parameters ``names`` of ``model`` to ``datasets`` (from :func:`ktgf.calibration.data.read_data`).
+    """Fit parameters ``names`` of ``model`` to ``datasets`` (from :func:`ktgf.data.read_data`).
 
     Parameters
     ----------

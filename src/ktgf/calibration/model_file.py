@@ -204,7 +204,7 @@ def fit_text(result: Any, *, command: str = "", start_file: ModelFile | None = N
 
     from .. import __version__
     from ..closures.models import get_model
-    from .data import file_hash
+    from ..data import file_hash
 
     reference = get_model(result.base)
     if start_file is not None and start_file.rdf:  # options are written relative to the swapped part's defaults

@@ -66,7 +66,7 @@ def calibrate_cmd(
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Fit chosen parameters of a model to DEM data (least squares, exact gradients) and write a model file."""
-    from ..calibration.data import read_data
+    from ..data import read_data
     from ..calibration.fit import calibrate
     from ..calibration.model_file import fit_text, load_model_file, write_model_file
     from ..closures import get_model

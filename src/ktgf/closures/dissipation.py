@@ -22,7 +22,7 @@ with any theory.
 Where it applies: the factor needs the local shear measure s = d γ̇/√θ.  With ``shear=None``
 (homogeneous cooling, the HCS stability analysis, the 3D solver, the Couette solver) s = 0 and
 L = d: the standard theory, exactly.  The uniform-shear closed forms
-(:mod:`ktgf.couette.uniform_shear`) solve the energy balance with L consistently.
+(:mod:`ktgf.shear.steady`) solve the energy balance with L consistently.
 """
 
 from __future__ import annotations

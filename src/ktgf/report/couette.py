@@ -35,7 +35,7 @@ import xarray as xr
 
 from ..closures.models import get_model
 from ..io import run_metadata
-from .dem import COUETTE, read_table
+from ..data import COUETTE, read_table
 from .framework import Section, SectionContext, closest, join_labels, model_inputs, optional_entry, register_section
 from .overlap import overlap_sentence
 from .settings import ReportSettings
@@ -134,7 +134,7 @@ def plot_profiles(ds: xr.Dataset, out: Any) -> Any:
 def run(ctx: SectionContext) -> None:
     s = ctx.settings
     path = ctx.data_file(COUETTE)
-    dem = read_table(path) if path is not None else None
+    dem = read_table(path).as_dict() if path is not None else None
     sols = {}
     for n in s.models:
         ctx.step(f"solving the Couette cell with {get_model(n).label}")
@@ -203,5 +203,5 @@ def discuss(nb: dict[str, Any]) -> list[str]:
 
 SECTION = register_section(Section(
     "couette", "3. Couette shear cell", run, inputs, order=30, data_files=(COUETTE,),
-    modules=(ENTRY_POINT[0], "ktgf.report.dem"), available=available, discuss=discuss,
+    modules=(ENTRY_POINT[0], "ktgf.data"), available=available, discuss=discuss,
 ))

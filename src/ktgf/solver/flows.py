@@ -3,7 +3,7 @@
 ==================  ======================================================================
 ``cooling``         periodic box cooling freely (the homogeneous cooling state, model.md §8)
 ``uniform-shear``   Lees–Edwards box sheared at rate γ̇ (:mod:`.boundaries`); its steady
-                    homogeneous state is the closed form :func:`ktgf.couette.uniform_shear`
+                    homogeneous state is the closed form :func:`ktgf.shear.steady.steady_shear`
 ``couette``         planar Couette cell: Johnson–Jackson walls on one axis moving at ∓U/2
                     along the flow direction; its steady state is the 1D Couette solver's
                     (:func:`ktgf.couette.run.run`, same model, same walls, same inventory)
@@ -255,18 +255,18 @@ def steady_change(kind: str, history: dict[str, list]) -> float | None:
 def uniform_shear_reference(phys: Physics, phi: float, rate: float) -> dict[str, float]:
     """Steady θ [m²/s²], η [Pa s] and p [Pa] of uniform shear at φ and γ̇ from the closed form.
 
-    θ = T(γ̇d)² with T = θ/(γ̇d)² of :func:`ktgf.couette.uniform_shear` (the energy balance
+    θ = T(γ̇d)² with T = θ/(γ̇d)² of :func:`ktgf.shear.steady.steady_shear` (the energy balance
     ηγ̇² = (3/2)ρθζ0), then η = η0(θ)η*(φ) and p = ρ_sφθp*(φ) (model.md §1, §9).
     """
-    from ..couette.uniform_shear import uniform_shear
+    from ..shear.steady import steady_shear
 
     model, e, d, rho_s = phys.model, float(phys.restitution), float(phys.diameter), float(phys.material_density)
     if model.friction.has_stress:  # the frictional stress too: ``ktgf shear --mu`` (ktgf.solver.friction)
         from .friction import frictional_shear_reference
 
         return frictional_shear_reference(phys, phi, rate)
-    state = uniform_shear(model, phi, e)
-    theta = float(state.temperature_ratio) * (rate * d) ** 2
+    state = steady_shear(model, phi, e)
+    theta = float(state.T) * (rate * d) ** 2
     r = model.reduced(phi, e)
     return {"theta": theta, "eta": float(eta0(theta, d, rho_s) * r.eta), "p": float(rho_s * phi * theta * r.p)}
 
@@ -367,7 +367,7 @@ def verification(kind: str, history: dict[str, list], phys: Physics, grid: Grid,
     got = {"theta": history["theta_mean"][-1], "eta": history["viscosity"][-1], "p": history["pressure"][-1]}
     err = {k: abs(got[k] - ref[k]) / abs(ref[k]) for k in ref}
     return {
-        "reference": "closed-form uniform shear ktgf.couette.uniform_shear (model.md §9), same model",
+        "reference": "closed-form uniform shear ktgf.shear.steady (model.md §9), same model",
         "case": kind,
         "model": phys.model.name,
         "solid_fraction": phi0,

@@ -35,6 +35,7 @@ from collections import namedtuple
 from typing import Any
 
 import jax
+import numpy as np
 import jax.numpy as jnp
 
 from ..closures.coefficients import Reduced
@@ -114,11 +115,11 @@ def explicit_part(r: Any) -> Any:
 
 def frictional_shear_reference(phys: Physics, phi: float, rate: float) -> dict[str, float]:
     """Steady θ [m²/s²], η = τ/γ̇ [Pa s] and p [Pa] of uniform shear with a frictional stress: the closed
-    form of ``ktgf shear --mu`` (:func:`ktgf.closures.friction_shear.model_uniform_shear`, unregularised)."""
-    from ..closures.friction_shear import model_uniform_shear
+    form of ``ktgf shear --mu`` (:func:`ktgf.shear.steady.steady_shear`, unregularised)."""
+    from ..shear.steady import steady_shear
 
     d, rho_s = float(phys.diameter), float(phys.material_density)
     scale = rho_s * (d * rate) ** 2
-    s = model_uniform_shear(phys.model, phi, float(phys.restitution), stress_scale=scale)
+    s = steady_shear(phys.model, np.atleast_1d(np.asarray(phi, dtype=float)), float(phys.restitution), stress_scale=scale)
     p = float(s.p_star[0]) * scale
     return {"theta": float(s.T[0]) * (rate * d) ** 2, "eta": float(s.tau_over_p[0]) * p / rate, "p": p}

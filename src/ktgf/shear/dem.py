@@ -1,47 +1,69 @@
-"""Frictional closures against ``dem_uniform_shear_friction.csv``: the comparison table of ``docs/friction.md``.
+"""Homogeneous shear against the DEM: the comparison tables of ``docs/friction.md`` and the report.
 
-What is fitted (one number per composition, at most): the tangential restitution β of the rough-sphere
-dissipation, to the rotational temperature T_rot/T of the row μ = 0.5, φ = 0.4 (:func:`fit_tangential_restitution`);
-and, for the registered ``frictional`` model, the EKT correlation-length constant c to T of the row μ = 0.5,
-φ = 0.5 (:func:`ktgf.closures.friction.calibrated.fit_correlation_constant`).  Everything else is predicted:
-the other columns of those rows, the other μ = 0.5 row and the frictionless row (μ = 0).  The remaining
-compositions have no fitted parameter at all.
+Frictionless: :func:`compare_uniform_shear` — the closed forms of every model against a
+uniform-shear file (``dem_uniform_shear*.csv``).  Frictional (``dem_uniform_shear_friction*.csv``):
+:func:`compositions` lists the compared compositions and what each fits.  At most one number per
+composition is fitted: the tangential restitution β of the rough-sphere dissipation, to the rotational
+temperature T_rot/T of the row μ = 0.5, φ = 0.4 (:func:`fit_tangential_restitution`); and, for the
+registered ``frictional`` model, the EKT correlation-length constant c to T of the row μ = 0.5, φ = 0.5
+(:func:`ktgf.calibration.registry_fits.fit_correlation_constant`).  Everything else is predicted.
 """
 
 from __future__ import annotations
 
-import csv
 import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .friction import (
+from ..closures import PAPER_MODELS
+from ..closures.friction import (
     ChialvoSundaresanRestitution,
     DenseInertialTemperature,
     FrictionalChialvoSundaresan,
     LinearDilatancy,
     MuIRheology,
+    RoughSphereRestitution,
+    WaltonRestitution,
 )
-from .friction import RoughSphereRestitution, WaltonRestitution
-from .friction_shear import FrictionalShearParts, frictional_uniform_shear, mu_i_uniform_shear
-from .friction.calibrated import FRICTIONAL_C
-from .models import get_model
+from ..closures.friction.calibrated import FRICTIONAL_C
+from ..closures.models import get_model
+from ..data import uniform_shear_records
+from .compositions import FrictionalShearParts, frictional_uniform_shear, mu_i_uniform_shear
+from .steady import steady_shear
 
-DEM_FILE = "dem_uniform_shear_friction.csv"
+def compare_uniform_shear(path: str | Path, models=PAPER_MODELS) -> list[dict[str, Any]]:
+    """Uniform-shear closed forms (model.md §9) against ``dem_uniform_shear.csv`` (γ̇ = 1, d = m = 1).
+
+    Rows per (model, φ): T = θ/(γ̇d)² of the energy balance, η* = η/η0 and p* = p/(nT) of the
+    model at the DEM's (φ, e), with the DEM values and relative differences.  The DEM states have
+    a* = γ̇/ν0 ≈ 0.19–0.29, beyond strict Navier–Stokes order (README).
+    """
+    data = uniform_shear_records(path)
+
+    rows = []
+    for name in models:
+        m = get_model(name)
+        for rec in data:
+            phi, e = float(rec["phi"]), float(rec["e"])
+            s = steady_shear(m, phi, e)
+            T, eta, p = float(s.T), float(s.eta_over_eta0), float(s.p_over_nT)
+            rows.append({
+                "model": m.label or m.name, "phi": phi, "e": e,
+                "T": T, "T_dem": float(rec["T"]), "dT": T / float(rec["T"]) - 1,
+                "eta*": eta, "eta*_dem": float(rec["eta_over_eta0"]), "deta*": eta / float(rec["eta_over_eta0"]) - 1,
+                "p*": p, "p*_dem": float(rec["p_over_nT"]), "dp*": p / float(rec["p_over_nT"]) - 1,
+            })
+    return rows
+
+
+
 COMPARED = ("T", "p_star", "tau_over_p", "Trot_over_T")
 #: The quantities of the issue's goal (within 15 % at μ = 0.5), summarised per model.
 SCORED = ("T", "p_star", "tau_over_p")
 #: The row the rough-sphere β is fitted to (μ, φ).
 FIT_ROW = (0.5, 0.4)
-
-
-def read_friction_dem(path: str | Path) -> list[dict[str, float]]:
-    """Rows of ``dem_uniform_shear_friction.csv`` (comment lines start with #) as dicts of floats."""
-    with open(path, newline="") as fh:
-        lines = [ln for ln in fh if not ln.startswith("#")]
-    return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(lines)]
 
 
 def fit_row(rows: list[dict[str, float]]) -> dict[str, float]:
@@ -97,7 +119,7 @@ def compare_with_dem(parts: Any, rows: list[dict[str, float]]) -> list[dict[str,
         pred = predict(parts, row)
         rec: dict[str, float] = {"mu": row["mu"], "phi": row["phi"]}
         for q in COMPARED:
-            value = float(np.asarray(getattr(pred, q))[0])
+            value = float(np.asarray(getattr(pred, q)).ravel()[0])
             rec[q], rec[q + "_dem"] = value, row[q]
             rec[q + "_err"] = value / row[q] - 1.0 if row[q] != 0.0 else math.nan
         out.append(rec)

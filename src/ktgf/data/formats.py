@@ -1,26 +1,24 @@
-"""Readers of the shared particle-data formats (``shared/data/README.md``), with checked inputs.
+"""Typed readers of the shared DEM formats (``data/dem/README.md``), one per kind of flow.
 
-Two formats are read:
-
-uniform shear (``dem_uniform_shear.csv``; the frictionless ``mu = 0`` rows of ``dem_uniform_shear_friction.csv``)
-    '#' header lines stating the units (``d = m = 1``, ``gdot = 1``), then CSV with columns
-    ``phi, e, T, dT, eta_over_eta0, deta_over_eta0, p_over_nT, dp_over_nT`` (``d*`` = standard
-    error).  Observables: ``T`` = θ/(γ̇d)², ``eta_over_eta0`` = η/η0 and ``p_over_nT`` = p/(nT).
+uniform shear (``dem_uniform_shear*.csv``; the frictionless ``mu = 0`` rows of ``dem_uniform_shear_friction*.csv``)
+    columns ``phi, e, T, dT, eta_over_eta0, deta_over_eta0, p_over_nT, dp_over_nT`` (``d*`` = standard
+    error): ``T`` = θ/(γ̇d)², ``eta_over_eta0`` = η/η0, ``p_over_nT`` = p/(nT) (:func:`read_uniform_shear`).
+frictional uniform shear (``dem_uniform_shear_friction*.csv``)
+    columns ``mu, phi, e, T, Trot_over_T, p_star, tau_over_p, ...`` with standard errors (:func:`read_friction_shear`).
 Couette profile (``dem_couette_e0.9_phi0.50.csv``)
-    '#' header holding the case — restitution e, mean solid fraction, wall-centre distance H,
-    wall speed U, wall shear stress τ and wall normal stress p_yy with their errors — then CSV
-    with columns ``y, phi, ux, theta`` (and ``*_sem``).  The continuum cell is the slab between
-    the planes tangent to the wall spheres: gap H − d (README).
+    a header holding the case — restitution e, mean solid fraction, wall-centre distance H, wall
+    speed U, wall shear stress τ and wall normal stress p_yy with their errors — then columns
+    ``y, phi, ux, theta`` (and ``*_sem``).  The continuum cell is the slab between the planes
+    tangent to the wall spheres: gap H − d (:func:`read_couette`).
+homogeneous cooling (``dem_hcs_cooling.csv``)
+    columns ``phi, e, A_main, A_early, ratio_main, ratio_early, p_over_nT`` (:func:`read_cooling`).
 
-Every problem with a file (missing, no units statement or other units, a missing column or
-header field, NaN) raises :class:`~ktgf.errors.InputError` with one line naming the file and
-the field.
+:func:`read_data` tells the format from the columns.  Every problem raises
+:class:`~ktgf.errors.InputError` with one line naming the file and the field.
 """
 
 from __future__ import annotations
 
-import hashlib
-import io
 import math
 import re
 from dataclasses import dataclass, field
@@ -29,78 +27,18 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from .table import Table, check_units, read_table
 
 #: DEM units (README): d = 1, m = 1, so ρ_s = 6/π.
 RHO_S_DEM = 6.0 / math.pi
 #: Uniform-shear observables fitted, with the column of their standard error.
 SHEAR_OBSERVABLES = {"T": "dT", "eta_over_eta0": "deta_over_eta0", "p_over_nT": "dp_over_nT"}
+#: Columns every uniform-shear record array has (:func:`uniform_shear_records`).
+SHEAR_COLUMNS: tuple[str, ...] = ("phi", "e", "T", "eta_over_eta0", "p_over_nT")
+#: Columns of the frictional uniform-shear format that are read.
+FRICTION_COLUMNS: tuple[str, ...] = ("mu", "phi", "e", "T", "Trot_over_T", "p_star", "tau_over_p")
 COUETTE_COLUMNS = ("y", "phi", "ux", "theta")
-
-
-def file_hash(path: Path) -> str:
-    """SHA-256 of a file's bytes (the provenance of a calibration)."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-
-
-def _split(path: Path) -> tuple[list[str], list[str], np.ndarray]:
-    """Header lines (without '#'), column names and the float table of a DEM CSV file."""
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"data file {str(path)!r} does not exist")
-    lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
-    header = [ln[1:].strip() for ln in lines if ln.startswith("#")]
-    body = [ln for ln in lines if ln.strip() and not ln.startswith("#")]
-    if len(body) < 2:
-        raise InputError(f"data file {path.name}: no data rows after the column-title row")
-    names = [n.strip() for n in body[0].split(",")]
-    try:
-        table = np.genfromtxt(io.StringIO("\n".join(body[1:])), delimiter=",", dtype=float, ndmin=2)
-    except ValueError as exc:
-        raise InputError(f"data file {path.name}: rows are not a numeric table ({exc})") from None
-    if table.shape[1] != len(names):
-        raise InputError(f"data file {path.name}: {table.shape[1]} values per row but {len(names)} column titles")
-    return header, names, table
-
-
-def _columns(path: Path, names: list[str], table: np.ndarray, needed: tuple[str, ...], rows: np.ndarray | None = None) -> dict[str, np.ndarray]:
-    missing = [c for c in needed if c not in names]
-    if missing:
-        raise InputError(f"data file {Path(path).name}: missing column(s) {', '.join(missing)} (columns present: {', '.join(names)})")
-    out = {}
-    for c in needed:
-        v = table[:, names.index(c)] if rows is None else table[rows, names.index(c)]
-        bad = np.flatnonzero(~np.isfinite(v))
-        if bad.size:
-            raise InputError(f"data file {Path(path).name}: column {c} holds NaN or a non-number in data row {int(bad[0]) + 1}")
-        out[c] = v
-    return out
-
-
-_UNIT = r"\s*=\s*(?:m\s*=\s*)?([-+\d.eE]+)\s*([A-Za-z]*)"
-
-
-def _unit_is_one(text: str, symbol: str) -> bool:
-    """``symbol = 1`` (or ``d = m = 1``) stated without a unit word after the number."""
-    m = re.search(rf"(?<![A-Za-z_]){symbol}{_UNIT}", text)
-    if m is None:
-        return False
-    try:
-        return float(m.group(1)) == 1.0 and not m.group(2)
-    except ValueError:
-        return False
-
-
-def _check_units(path: Path, header: list[str], *, shear_rate: bool) -> None:
-    """The header must state d = m = 1 (and γ̇ = 1 for uniform shear): the units the model's reduced values are compared in."""
-    units = [ln for ln in header if ln.lower().lstrip().startswith("units")]
-    if not units:
-        raise InputError(f"data file {Path(path).name}: header states no units (expected a line 'units d = m = 1 ...')")
-    text = " ".join(units)
-    m_ok = _unit_is_one(text, "m") or re.search(r"(?<![A-Za-z_])d\s*=\s*m\s*=\s*1(?![\d.])", text) is not None
-    if not (_unit_is_one(text, "d") and m_ok):
-        raise InputError(f"data file {Path(path).name}: units {units[0]!r} do not match the shared format (d = m = 1)")
-    if shear_rate and not _unit_is_one(" ".join(header), "gdot"):
-        raise InputError(f"data file {Path(path).name}: header does not state the shear rate gdot = 1 the columns are scaled with")
+COOLING_COLUMNS: tuple[str, ...] = ("phi", "e", "A_main", "A_early", "ratio_main", "ratio_early", "p_over_nT")
 
 
 @dataclass(frozen=True)
@@ -128,19 +66,19 @@ class UniformShearData:
 def read_uniform_shear(path: str | Path) -> UniformShearData:
     """Read a uniform-shear DEM file (frictionless rows only: a ``mu`` column keeps ``mu = 0``)."""
     path = Path(path)
-    header, names, table = _split(path)
-    _check_units(path, header, shear_rate=True)
+    table = read_table(path)
+    check_units(table, shear_rate=True)
     rows = None
     notes: list[str] = []
-    if "mu" in names:
-        mu = table[:, names.index("mu")]
+    if table.has("mu"):
+        mu = table.column("mu")
         rows = np.flatnonzero(mu == 0.0)
         if rows.size == 0:
             raise InputError(f"data file {path.name}: no frictionless (mu = 0) rows; the kinetic theories describe smooth spheres")
         if rows.size < mu.size:
             notes.append(f"{path.name}: {mu.size - rows.size} frictional row(s) (mu > 0) left out")
     needed = ("phi", "e", *[c for pair in SHEAR_OBSERVABLES.items() for c in pair])
-    cols = _columns(path, names, table, needed, rows)
+    cols = table.columns(needed, rows)
     for k, s in SHEAR_OBSERVABLES.items():
         if np.any(cols[s] <= 0):
             raise InputError(f"data file {path.name}: column {s} (standard error of {k}) must be > 0")
@@ -222,13 +160,12 @@ COUETTE_HEADER = {
 }
 
 
-def read_couette_case(path: str | Path, header: list[str] | None = None) -> CouetteCase:
+def read_couette_case(path: str | Path | Table) -> CouetteCase:
     """The case (e, mean φ, gap, wall speed, wall stresses) from a DEM Couette file's header."""
-    path = Path(path)
-    if header is None:
-        header, _, _ = _split(path)
-    _check_units(path, header, shear_rate=False)
-    text = "\n".join(header)
+    table = path if isinstance(path, Table) else read_table(path)
+    path = table.path
+    check_units(table, shear_rate=False)
+    text = "\n".join(table.header)
     found: dict[str, tuple[float, ...]] = {}
     for name, (pattern, example) in COUETTE_HEADER.items():
         m = re.search(pattern, text)
@@ -246,18 +183,46 @@ def read_couette_case(path: str | Path, header: list[str] | None = None) -> Coue
 
 def read_couette(path: str | Path) -> CouetteData:
     """Read a DEM Couette file: its case from the header and the occupied bins (φ > 0.05, θ > 0)."""
-    path = Path(path)
-    header, names, table = _split(path)
-    case = read_couette_case(path, header)
-    cols = _columns(path, names, table, COUETTE_COLUMNS)
+    table = read_table(path)
+    path = table.path
+    case = read_couette_case(table)
+    cols = table.columns(COUETTE_COLUMNS)
     keep = (cols["phi"] > 0.05) & (cols["theta"] > 0)
     if keep.sum() < 3:
         raise InputError(f"data file {path.name}: fewer than 3 occupied bins (phi > 0.05, theta > 0)")
-    sem = _columns(path, names, table, ("ux_sem",))["ux_sem"][keep] if "ux_sem" in names else None
+    sem = table.column("ux_sem")[keep] if table.has("ux_sem") else None
     return CouetteData(path, case, cols["y"][keep], cols["phi"][keep], cols["ux"][keep], cols["theta"][keep], sem)
 
 
+def uniform_shear_records(path: str | Path, *, where: dict[str, float] | None = None) -> np.ndarray:
+    """Rows of a uniform-shear DEM file as a record array of every column (checked finite).
+
+    ``where`` keeps only rows whose columns equal the given values (e.g. ``{"mu": 0.0}`` for the
+    frictionless row of ``dem_uniform_shear_friction.csv``).
+    """
+    table = read_table(path)
+    keep = np.ones(table.values.shape[0], dtype=bool)
+    for key, value in (where or {}).items():
+        keep &= table.column(key) == value
+    cols = table.columns(tuple(dict.fromkeys((*SHEAR_COLUMNS, *table.names))), np.flatnonzero(keep))
+    return np.rec.fromarrays(list(cols.values()), names=list(cols))
+
+
+def read_friction_shear(path: str | Path) -> list[dict[str, float]]:
+    """Rows of a frictional uniform-shear file (``dem_uniform_shear_friction*.csv``) as dicts of floats."""
+    table = read_table(path)
+    check_units(table, shear_rate=True)
+    table.columns(FRICTION_COLUMNS)
+    return table.records()
+
+
+def read_cooling(path: str | Path) -> dict[str, np.ndarray]:
+    """Columns of a homogeneous-cooling file (``dem_hcs_cooling.csv``) by title (the needed ones checked finite)."""
+    table = read_table(path)
+    table.columns(COOLING_COLUMNS)
+    return table.as_dict()
+
+
 def read_data(path: str | Path) -> UniformShearData | CouetteData:
-    """Read a shared-format file, telling the format from its columns (``y`` → Couette profile)."""
-    _, names, _ = _split(Path(path))
-    return read_couette(path) if "y" in names else read_uniform_shear(path)
+    """Read a file of a calibration format, telling it from its columns (``y`` → Couette profile, else uniform shear)."""
+    return read_couette(path) if read_table(path).has("y") else read_uniform_shear(path)
