@@ -202,7 +202,7 @@ def fit_text(result: Any, *, command: str = "", start_file: ModelFile | None = N
     """Model-file text of a calibration (:class:`~ktgf.calibration.fit.FitResult`), with its provenance."""
     import datetime
 
-    from .. import __version__
+    from .._version import __version__
     from ..closures.models import get_model
     from ..data import file_hash
 

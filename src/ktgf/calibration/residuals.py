@@ -18,7 +18,7 @@ Couette
     differences, O(h²)) factorised once, and ∂R/∂p, ∂y/∂(X, p) by central differences of the
     residual and of the observables y (the Couette residual is NumPy code, not JAX).  No re-solve
     per parameter; the error is O(h²) ≈ 1e-8 relative, checked against finite differences of
-    re-solved cells in ``tests/test_calibration_gradients.py``.
+    re-solved cells in ``tests/calibration/test_calibration_gradients.py``.
 """
 
 from __future__ import annotations
@@ -59,7 +59,7 @@ def shear_prediction(model: Model, data: UniformShearData, *, traced: bool = Fal
     NumPy; with ``traced=True`` (options that are JAX tracers, inside ``jax.jacfwd``) JAX, without
     range checks (a tracer has no value to check; the same values are checked concretely elsewhere).
     """
-    from ..shear.steady import steady_shear
+    from ..shear.steady import steady_temperature
 
     if traced:
         import jax.numpy as xp
@@ -67,7 +67,7 @@ def shear_prediction(model: Model, data: UniformShearData, *, traced: bool = Fal
         xp = np
     phi, e = xp.asarray(data.phi), xp.asarray(data.e)
     r = model.reduced(phi, e, check=False)
-    T = steady_shear(model, phi, e, check=not traced).T
+    T = steady_temperature(model, phi, e, check=not traced)
     return xp.concatenate([T, r.eta, r.p])
 
 

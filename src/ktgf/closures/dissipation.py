@@ -58,7 +58,7 @@ def ekt_j(e: Any, G: Any) -> Any:
     """J(e, G) of extended kinetic theory (Jenkins & Berzi 2010), G = φχ.
 
     Equal to the Garzó–Dufty (1999) shear viscosity without the Sonine correction divided by
-    (8/(5√π)) ρ_s d φ G √T (the Enskog value at e = 1; ``tests/test_dense_models.py``).
+    (8/(5√π)) ρ_s d φ G √T (the Enskog value at e = 1; ``tests/closures/test_dense_models.py``).
     """
     num = (5.0 + 2.0 * (1.0 + e) * (3.0 * e - 1.0) * G) * (5.0 + 4.0 * (1.0 + e) * G)
     den = (24.0 - 6.0 * (1.0 - e) ** 2 - 5.0 * (1.0 - e**2)) * G**2

@@ -66,7 +66,7 @@ from .equations import N_VARS, Problem
 from .geometry import stretched_nodes
 from .run import Material, to_dataset
 from .solver import newton, pseudo_transient
-from ..shear.steady import steady_shear
+from ..shear.steady import steady_temperature
 from .walls import Wall
 
 #: Default base: bumpy (fully diffuse) Johnson–Jackson wall.
@@ -210,7 +210,7 @@ def bagnold_start(problem: ChuteProblem) -> np.ndarray:
     x = problem.x
     e = min(problem.e, 0.999)
     phi = min(problem.mean_phi, 0.95 * problem.phi_max)
-    ratio = float(steady_shear(problem.model, phi, e).T)
+    ratio = float(steady_temperature(problem.model, phi, e))
     r = problem.model.reduced(phi, e)
     c = float(r.eta) * (5.0 * math.sqrt(math.pi) / 96.0) * math.sqrt(ratio)  # η/γ̇ with d = ρ_s = 1
     tau = problem.gravity[0] * phi * (x[-1] - x)

@@ -63,7 +63,7 @@ import numpy as np
 
 from ..closures import get_model
 from ..closures.coefficients import Dimensional
-from .steady import steady_shear
+from .steady import steady_temperature
 from ..errors import InputError
 from ..validation import check_positive, check_range
 
@@ -110,7 +110,7 @@ def shear_base_state(model: Any, phi: float, e: float, shear_rate: float, *, d: 
     if model.dissipation.key != "none":
         raise InputError(f"model {model.name!r} has the shear-dependent dissipation {model.dissipation.key!r}; "
                          "the uniform-shear stability analysis supports dissipation 'none' only")
-    theta = float(steady_shear(model, phi, e).T) * (shear_rate * d) ** 2
+    theta = float(steady_temperature(model, phi, e)) * (shear_rate * d) ** 2
     c = model.coefficients(phi, e, theta, d=d, rho_s=rho_s)
     r = model.reduced(phi, e)
     h = _PHI_STEP * max(phi, 1e-3)

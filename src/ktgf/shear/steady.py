@@ -76,6 +76,16 @@ def _solve(model: Any, phi: Any, e: Any, check: bool = True) -> tuple[Any, Any, 
     return r, a, length, r.eta
 
 
+def steady_temperature(model: Model, phi: Any, e: Any, *, check: bool = True) -> Any:
+    """T = θ/(γ̇d)² of steady uniform shear (the energy balance alone: a frictional stress's work does not feed θ).
+
+    The same number as ``steady_shear(...).T`` without a dense-temperature floor, for callers that need the
+    temperature scale of a flow (Couette and chute starts, 3D base states, stability) and no stress scale.
+    """
+    _, a, _, _ = _solve(model, phi, e, check)
+    return 25.0 * math.pi / (9216.0 * asarray(phi) ** 2 * a**2)
+
+
 def steady_shear(model: Model, phi: Any, e: Any, *, stress_scale: float | None = None,
                  dense_temperature: Any = None, check: bool = True) -> ShearState:
     """Steady uniform shear of ``model`` at solid fraction φ and restitution e < 1 (module docstring).
@@ -100,7 +110,7 @@ def steady_shear(model: Model, phi: Any, e: Any, *, stress_scale: float | None =
     r, a, length, eta = _solve(model, phi, e, check)
     phi = asarray(phi)
     xp = namespace(phi, a)
-    T = 25.0 * math.pi / (9216.0 * phi**2 * a**2)
+    T = 25.0 * math.pi / (9216.0 * phi**2 * a**2)  # as steady_temperature
     if dense_temperature is not None:
         T = xp.maximum(T, dense_temperature.temperature_ratio(phi, model.phi_max))
     p_star, p_over_nT, tau_over_p = phi * r.p * T, r.p + 0.0 * T, eta * a / r.p

@@ -258,15 +258,14 @@ def uniform_shear_reference(phys: Physics, phi: float, rate: float) -> dict[str,
     θ = T(γ̇d)² with T = θ/(γ̇d)² of :func:`ktgf.shear.steady.steady_shear` (the energy balance
     ηγ̇² = (3/2)ρθζ0), then η = η0(θ)η*(φ) and p = ρ_sφθp*(φ) (model.md §1, §9).
     """
-    from ..shear.steady import steady_shear
+    from ..shear.steady import steady_temperature
 
     model, e, d, rho_s = phys.model, float(phys.restitution), float(phys.diameter), float(phys.material_density)
     if model.friction.has_stress:  # the frictional stress too: ``ktgf shear --mu`` (ktgf.solver.friction)
         from .friction import frictional_shear_reference
 
         return frictional_shear_reference(phys, phi, rate)
-    state = steady_shear(model, phi, e)
-    theta = float(state.T) * (rate * d) ** 2
+    theta = float(steady_temperature(model, phi, e)) * (rate * d) ** 2
     r = model.reduced(phi, e)
     return {"theta": theta, "eta": float(eta0(theta, d, rho_s) * r.eta), "p": float(rho_s * phi * theta * r.p)}
 

@@ -48,7 +48,8 @@ from .friction import for_case
 from .grid import Grid
 from .initial import haff_time, perturb, random_velocity, shear_mode, single_mode, t_of_tau, tau_of_t, uniform_fields
 from .interrupt import STOP, Interrupted, fault_hook
-from .io import load_checkpoint, save_checkpoint, save_slices, write_vti
+from ..plotting.fields import save_slices
+from .io import load_checkpoint, save_checkpoint, write_vti
 from .physics import Physics
 from .sequencing import mean_temperature, start_from_run
 from .state import PRIMITIVE_NAMES, conservative, primitive
