@@ -37,6 +37,10 @@ def test_wheel_carries_license_and_metadata(wheel: Path) -> None:
         lic = next(n for n in names if n.endswith("/licenses/LICENSE"))
         assert z.read(lic) == (ROOT / "LICENSE").read_bytes()
     assert "ktgf/py.typed" in names
+    # the DEM reference files and their README ship inside the package (ktgf.data)
+    from ktgf.data import DEM_FILES
+
+    assert {f"ktgf/data/dem/{f}" for f in (*DEM_FILES, "README.md")} <= set(names)
     assert meta["License-Expression"] == "BSD-3-Clause"
     assert meta["License-File"] == "LICENSE"
     assert "BSD" in (ROOT / "LICENSE").read_text().splitlines()[0]
@@ -66,7 +70,8 @@ def test_citation_and_changelog_present() -> None:
 
 @pytest.mark.slow
 def test_wheel_installs_into_fresh_venv(wheel: Path, tmp_path: Path) -> None:
-    """`pip install ktgf-*.whl` (with its dependencies) in a new venv, then import and run the CLI (~70 s)."""
+    """`pip install ktgf-*.whl` (with its dependencies) in a new venv, then import and run the CLI, and
+    ``ktgf reproduce --quick`` outside any checkout: a complete report with every DEM comparison (~3 min)."""
     env_dir = tmp_path / "venv"
     venv.create(env_dir, with_pip=True)
     py = env_dir / "bin" / "python"
@@ -79,3 +84,14 @@ def test_wheel_installs_into_fresh_venv(wheel: Path, tmp_path: Path) -> None:
     assert out.split() == [version, "ret"]
     cli = subprocess.run([str(env_dir / "bin" / "ktgf"), "--version"], check=True, capture_output=True, text=True, env=env, cwd=tmp_path)
     assert cli.stdout.strip() == f"ktgf {version}"
+    # no checkout, no $KTGF_DATA: the report compares with the DEM files shipped in the wheel
+    env.pop("KTGF_DATA", None)
+    rep = subprocess.run([str(env_dir / "bin" / "ktgf"), "reproduce", "--quick", "--out", str(tmp_path / "report")],
+                         capture_output=True, text=True, env=env, cwd=tmp_path, timeout=1800)
+    assert rep.returncode == 0, rep.stdout[-2000:] + rep.stderr[-2000:]
+    page = (tmp_path / "report" / "index.html").read_text()
+    assert "Not available in this build" not in page and "particle simulations are left out" not in page
+    assert "shipped with ktgf" in page
+    for name in ("dem_hcs_cooling.csv", "dem_uniform_shear.csv", "dem_uniform_shear_friction.csv",
+                 "dem_couette_e0.9_phi0.50.csv"):
+        assert name in page and f"{name} not found" not in page

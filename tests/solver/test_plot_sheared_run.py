@@ -15,7 +15,8 @@ def _timeseries(example: str, tmp_path: Path) -> tuple[Path, float]:
     pytest.importorskip("jax")
     from ktgf.io import write_netcdf
     from ktgf.solver.config import load_config
-    from ktgf.solver.flows import PROFILES, gradient_axis, shear_rate
+    from ktgf.solver.flows import PROFILES
+    from ktgf.solver.kinematics import gradient_axis, shear_rate
     from ktgf.solver.run import PER_AXIS, Simulation
 
     sim = Simulation(load_config(EXAMPLES / example), directory=tmp_path / "run")

@@ -23,7 +23,7 @@ from ktgf.solver.friction import cell_coefficients, for_case
 from ktgf.solver.grid import Grid
 from ktgf.solver.physics import Physics
 from ktgf.solver.state import conservative_fields, primitive_fields
-from ktgf.solver.stepping import kernel_stage_inputs
+from ktgf.solver.cell_terms import kernel_stage_inputs
 
 D, RHO_S = 1e-3, 2500.0
 #: float64: the program does XLA's operations in XLA's order; XLA's fusion rounds a few differently

@@ -37,9 +37,10 @@ from ktgf.closures.models import list_models
 from ktgf.solver.friction import cell_coefficients, for_case
 from ktgf.solver.sources import cooling_source
 from ktgf.solver.state import primitive_fields
-from ktgf.solver.stepping import (LIMIT_TERMS, START_TERMS, STATUS_TERMS, Numerics, advance, explicit_rhs,
-                                  kernel_stage_inputs, kernel_step_limits, limit_terms, ssprk3_step, start_program,
-                                  state_status, status_of_maxima, status_terms, step_limits)
+from ktgf.solver.cell_terms import (LIMIT_TERMS, START_TERMS, STATUS_TERMS, kernel_stage_inputs, limit_terms,
+                                    status_terms)
+from ktgf.solver.stepping import (Numerics, advance, explicit_rhs, kernel_step_limits, ssprk3_step, start_program,
+                                  state_status, status_of_maxima, step_limits)
 
 D, RHO_S = 1e-3, 2500.0
 #: float64: the kernel does the operations of the JAX path in the same order; XLA's fusion may round

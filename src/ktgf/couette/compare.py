@@ -24,7 +24,7 @@ import numpy as np
 
 from ..data import CouetteCase, CouetteData, read_couette
 from ..closures import PAPER_MODELS, get_model
-from ..errors import ConvergenceError, InputError
+from ..errors import ConvergenceError
 from .geometry import PlanarCell
 from .run import Material, run
 from .walls import Wall

@@ -41,6 +41,7 @@ import jax.numpy as jnp
 from ..closures.coefficients import Reduced
 from .fluxes import pad_fields
 from .grid import Grid
+from .kinematics import shear_rate, velocity_gradients
 from .physics import Physics
 
 
@@ -54,7 +55,6 @@ def for_case(phys: Physics, kind: str, grid: Grid) -> Physics:
     """The physics of a case: the HCS dissipation for ``cooling``, and the case's shear-rate scale."""
     import dataclasses
 
-    from .flows import shear_rate
 
     return dataclasses.replace(phys, hcs=kind == "cooling", shear_rate_scale=abs(float(shear_rate(grid))))
 
@@ -68,9 +68,8 @@ def needs_rate(phys: Physics) -> bool:
 def strain_invariants(u: Any, grid: Grid, t: Any = 0.0) -> tuple[Any, Any]:
     """(S:S, ∇·u) at the cells, S the deviatoric strain rate, by central differences of the padded u
     (Lees–Edwards images at time t; extrapolated ghosts at walls)."""
-    from .flows import _gradients
 
-    g = _gradients(pad_fields(tuple(u), grid, t, velocity=0), grid)
+    g = velocity_gradients(pad_fields(tuple(u), grid, t, velocity=0), grid)
     divu = g[0][0] + g[1][1] + g[2][2]
     dd = sum(0.25 * (g[b][j] + g[j][b]) ** 2 for b in range(3) for j in range(3))
     return dd - divu * divu / 3.0, divu
