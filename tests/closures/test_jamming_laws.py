@@ -1,8 +1,9 @@
 """φ_J(μ) laws (ktgf.closures.jamming): printed end points, Maxwell-counting limits, and parts moved to φ_J.
 
 Oracles from outside the code: the mean-field volume function φ = Z/(Z + 2√3) of Song, Wang & Makse
-(Nature 453, 629 (2008)) gives their random close and random loose packing 0.634 and 0.536 at the
-isostatic contact numbers 2D = 6 and D + 1 = 4 (Maxwell counting, D = 3); Silbert (Soft Matter 6, 2918
+(Nature 453, 629 (2008)) gives random close and random loose packing 63.4 % and 53.6 % (printed so in
+the abstract of their "Jamming II") at the isostatic contact numbers 2D = 6 and D + 1 = 4 (Maxwell
+counting, D = 3); Silbert (Soft Matter 6, 2918
 (2010), abstract) has z_c^μ "from approximately six to four" and φ_c^μ decreasing with μ; every RDF
 family keeps its published divergence exponent when moved to φ_J(μ) and stays Carnahan–Starling
 below freezing.
@@ -35,7 +36,8 @@ MUS = np.array([0.0, 1e-3, 0.01, 0.1, 0.3, 0.5, 1.0, 10.0, 1e3])
 
 
 def test_song_wang_makse_end_points_are_their_printed_rcp_and_rlp() -> None:
-    # φ = Z/(Z + 2√3): Z = 6 → 0.634 (RCP), Z = 4 → 0.536 (RLP), to the three decimals they print
+    # "4/(4 + 2√3) or 53.6% and 6/(6 + 2√3) or 63.4%, defining RLP and RCP" (abstract of "Jamming II:
+    # Edwards' statistical mechanics of random packings of hard spheres", Wang, Song, Jin & Makse)
     assert packing_fraction_of_coordination(6.0) == pytest.approx(0.634, abs=5e-4)
     assert packing_fraction_of_coordination(4.0) == pytest.approx(0.536, abs=5e-4)
     law = CoordinationJamming()

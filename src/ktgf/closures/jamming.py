@@ -22,9 +22,11 @@ Laws (:data:`JAMMING_LAWS`, :func:`get_jamming_law`); each has ``phi_c(mu)`` and
         Z_J(μ) = Z_∞ + (Z_0 − Z_∞)/(1 + μ/μ_Z),     φ_J(μ) = Z_J/(Z_J + 2√3)                  (1)
 
     Its end points follow from the two integers alone: φ_J(0) = 6/(6 + 2√3) = 0.63397 and
-    φ_J(∞) = 4/(4 + 2√3) = 0.53590 (the random close and random loose packing 0.634 and 0.536 of
-    Song et al.).  Only μ_Z is a number to be chosen or calibrated (default 0.1, our choice, as μ_J of
-    the interpolation: not a literature fit).
+    φ_J(∞) = 4/(4 + 2√3) = 0.53590, printed as "4/(4 + 2√3) or 53.6% and 6/(6 + 2√3) or 63.4%,
+    defining RLP and RCP" in the abstract of "Jamming II: Edwards' statistical mechanics of random
+    packings of hard spheres" (Wang, Song, Jin & Makse; the abstract as stored at arxivlens.com, read
+    for this module).  Only μ_Z is a number to be chosen or calibrated (default 0.1, our choice, as μ_J
+    of the interpolation: not a literature fit).
 ``tabulated``
     :class:`TabulatedJamming`: linear interpolation through (μ_i, φ_i) pairs that the user takes from
     a table of DEM jamming points (constant beyond the last point).  No default table is shipped: we
