@@ -1,0 +1,73 @@
+"""Reproduce the measured tables of docs/dense_physics.md (comparisons only: nothing here is fitted).
+
+Run from the repository root:  python docs/dense_physics_check.py [DATA_DIR]   (default ../shared/data)
+
+1. The contact value χ that each DEM uniform-shear point implies, χ_DEM = (p/(nT) − 1)/(2(1 + e)φ)
+   (the Enskog/RET equation of state p/(nT) = 1 + 2(1 + e)φχ, model.md §3), against RDFs with their
+   published constants.
+2. Uniform shear of RET with the Chialvo–Sundaresan RDF (published a = 0.58, exponent 1.5, φ_c = 0.64;
+   no parameter fitted) and of the registered `dense`, against the frictionless DEM (e = 0.9).
+3. The jamming laws φ_J(μ) at the shared friction coefficient μ = 0.5 with their default μ scales,
+   and the μ scale each would need for φ_J(0.5) = 0.58 (mu_scale_for), beside the densest flowing DEM
+   state at μ = 0.5 (φ = 0.57).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ktgf import get_model
+from ktgf.closures.friction.jamming import JammingFraction
+from ktgf.closures.jamming import CoordinationJamming, mu_scale_for
+from ktgf.closures.rdf import CarnahanStarling, ChialvoSundaresan, Torquato
+from ktgf.couette.uniform_shear import load_uniform_shear, shear_state
+
+data = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parents[2] / "shared" / "data"
+COLS = ["phi", "e", "T", "eta_over_eta0", "p_over_nT"]
+smooth = np.sort(np.concatenate([load_uniform_shear(data / name)[COLS] for name in
+                                 ("dem_uniform_shear.csv", "dem_uniform_shear_extra.csv")]), order="phi")
+rough = np.concatenate([load_uniform_shear(data / name, where={"mu": 0.5}) for name in
+                        ("dem_uniform_shear_friction.csv", "dem_uniform_shear_friction_extra.csv")])
+rough = np.sort(rough, order="phi")
+
+
+def implied_chi(rows: np.ndarray) -> np.ndarray:
+    return (rows["p_over_nT"] - 1.0) / (2.0 * (1.0 + rows["e"]) * rows["phi"])
+
+
+print("### χ implied by the DEM equation of state, against RDFs with published constants\n")
+rdfs = [("CS", CarnahanStarling()), ("Torquato φ_c 0.64", Torquato()), ("CS13 φ_c 0.64", ChialvoSundaresan()),
+        ("CS13 φ_c 0.634", ChialvoSundaresan(phi_c=0.634)), ("`dense` (β 4.052)", get_model("dense").rdf)]
+print("| μ | φ | e | χ_DEM | " + " | ".join(name for name, _ in rdfs) + " |")
+print("|---|---|---|---|" + "---|" * len(rdfs))
+for mu, rows in ((0.0, smooth), (0.5, rough)):
+    chi = implied_chi(rows)
+    for i, r in enumerate(rows):
+        cells = [f"{float(rdf.chi(r['phi'])):.2f}" if r["phi"] < rdf.phi_max else "—" for _, rdf in rdfs]
+        print(f"| {mu:g} | {r['phi']:g} | {r['e']:g} | {chi[i]:.2f} | " + " | ".join(cells) + " |")
+
+print("\n### Uniform shear against the frictionless DEM (e = 0.9): relative errors\n")
+ret_cs13 = dataclasses.replace(get_model("ret"), rdf=ChialvoSundaresan())
+models = [("RET + CS13 RDF (published constants)", ret_cs13), ("`dense`", get_model("dense")),
+          ("`proposed` (β 1.75)", get_model("proposed"))]
+print("| model | φ | err p/(nT) | err η* | err T |")
+print("|---|---|---|---|---|")
+for name, model in models:
+    ok = smooth["phi"] < model.phi_max
+    s = shear_state(model, smooth["phi"][ok], smooth["e"][ok])
+    for i, r in enumerate(smooth[ok]):
+        errs = [float(np.broadcast_to(m, s.phi.shape)[i]) / r[c] - 1.0
+                for m, c in ((s.p_over_nT, "p_over_nT"), (s.eta_over_eta0, "eta_over_eta0"), (s.T, "T"))]
+        print(f"| {name} | {r['phi']:g} | " + " | ".join(f"{100 * x:+.0f} %" for x in errs) + " |")
+
+print("\n### φ_J(μ = 0.5) of the jamming laws; the densest flowing DEM state at μ = 0.5 has φ = "
+      f"{rough['phi'].max():g}\n")
+print("| law | φ_J(0) | φ_J(0.5), default μ scale | μ scale for φ_J(0.5) = 0.58 |")
+print("|---|---|---|---|")
+for law in (JammingFraction(), CoordinationJamming()):
+    print(f"| {law.describe()} | {float(law.phi_c(0.0)):.4f} | {float(law.phi_c(0.5)):.4f} | "
+          f"{mu_scale_for(law, 0.5, 0.58):.3f} |")
