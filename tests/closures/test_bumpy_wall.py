@@ -1,4 +1,4 @@
-"""Bumpy wall of fixed spheres (ktgf.closures.bumpy_wall): exact geometry, exact limits, and a Monte Carlo of collisions.
+"""Bumpy wall of fixed spheres (ktgf.closures.bumpy_wall): exact geometry, exact limits, a Monte Carlo of collisions.
 
 Oracles: sphere-packing geometry (a sphere nested on three touching equal spheres sits √(2/3) d above their
 centres; between two it touches at 30° from the normal; a touching hexagonal layer has 2/√3 spheres per d²),
@@ -111,3 +111,20 @@ def test_bad_walls_are_refused_in_one_line(kwargs, text) -> None:
     assert text in str(err.value) and "\n" not in str(err.value)
     with pytest.raises(InputError, match="wall restitution coefficient restitution = 1.2 is out of range"):
         wall_fluxes(BumpyWall(), 0.5, 1.2)
+
+
+def test_jax_values_and_slip_derivative() -> None:
+    jax = pytest.importorskip("jax")
+    jax.config.update("jax_enable_x64", True)
+    import jax.numpy as jnp
+
+    wall = BumpyWall()
+    f_np = wall_fluxes(wall, SLIPS, 0.9)
+    f_jx = wall_fluxes(wall, jnp.asarray(SLIPS), 0.9)
+    for a, b in zip(f_np, f_jx):
+        assert np.asarray(b) == pytest.approx(a, rel=1e-13, abs=1e-15)
+    dfds = jax.grad(lambda s: wall_fluxes(wall, s, 0.9).shear_over_normal)(jnp.asarray(1.2))
+    h = 1e-5
+    fd = (wall_fluxes(wall, 1.2 + h, 0.9).shear_over_normal
+          - wall_fluxes(wall, 1.2 - h, 0.9).shear_over_normal) / (2 * h)
+    assert float(dfds) == pytest.approx(float(fd), rel=1e-8)

@@ -139,7 +139,8 @@ def _log_slope(chi, phi_j: float, gap: float) -> float:
 
 
 @pytest.mark.parametrize("rdf, exponent", FAMILIES, ids=lambda x: getattr(x, "key", str(x)))
-@pytest.mark.parametrize("law", [JammingFraction(), CoordinationJamming(mu_scale=0.3)], ids=["interpolation", "coordination"])
+@pytest.mark.parametrize("law", [JammingFraction(), CoordinationJamming(mu_scale=0.3)],
+                         ids=["interpolation", "coordination"])
 def test_rdf_moved_to_phi_j_diverges_there_with_its_published_exponent(rdf, exponent, law) -> None:
     mu = 0.5
     moved = at_jamming(rdf, mu, law)

@@ -34,7 +34,8 @@ D the collisional dissipation at the wall).  Only the ratios are needed by a con
 condition at a wall where the normal stress N and T are known: S/N = F(v/√T) and Q/(N√T) = G(v/√T, e_w);
 :func:`wall_fluxes` returns them.  Exact limits (tested): no slip gives S = 0 and Q = −D ≤ 0, with D = 0
 for e_w = 1; tiny wall spheres (d_w/d → 0) give the flat frictionless wall, S/N → 0 and
-Q/(N√T) → −(1 − e_w)√(2/π); a Monte Carlo of single collisions reproduces F and G.  NumPy only.
+Q/(N√T) → −(1 − e_w)√(2/π); a Monte Carlo of single collisions reproduces F and G.  :func:`wall_fluxes`
+takes NumPy or JAX slip ratios (``jax.grad`` gives dF/d(v/√T) for a Newton solve); the geometry is NumPy.
 """
 
 from __future__ import annotations
@@ -47,6 +48,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from scipy.special import ndtr
 
+from .._array import asarray, is_jax, like, namespace
 from ..validation import check_range
 
 #: In-plane directions of the six neighbours of a wall sphere (hexagonal layer; one row along ψ = 0).
@@ -132,12 +134,17 @@ class WallFluxes(NamedTuple):
     normal_scale: Any
 
 
-def _moments(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _moments(z: Any) -> tuple[Any, Any]:
     """E[w²; w < 0] and E[|w|³; w < 0] for w ~ N(z, 1): with y = −w ~ N(m, 1), m = −z,
     E[y²; y > 0] = (1 + m²)Φ(m) + m φ(m),  E[y³; y > 0] = (m³ + 3m)Φ(m) + (m² + 2)φ(m)."""
+    xp = namespace(z)
+    if is_jax(z):
+        from jax.scipy.special import ndtr as cdf_of
+    else:
+        cdf_of = ndtr
     m = -z
-    cdf = ndtr(m)
-    pdf = np.exp(-0.5 * m * m) / math.sqrt(2.0 * math.pi)
+    cdf = cdf_of(m)
+    pdf = xp.exp(-0.5 * m * m) / math.sqrt(2.0 * math.pi)
     return (1.0 + m * m) * cdf + m * pdf, (m**3 + 3.0 * m) * cdf + (m * m + 2.0) * pdf
 
 
@@ -159,18 +166,20 @@ def _nodes(wall: BumpyWall, n_psi: int, n_theta: int) -> tuple[np.ndarray, np.nd
     return kx.ravel(), np.cos(theta).ravel(), weight.ravel(), psi
 
 
-def wall_fluxes(wall: BumpyWall, slip_ratio: Any, restitution: float, *, n_psi: int = 24, n_theta: int = 24) -> WallFluxes:
-    """S/N, Q/(N√T) and D/(N√T) of the bumpy wall at slip ratio v/√T (array) and wall restitution e_w.
+def wall_fluxes(wall: BumpyWall, slip_ratio: Any, restitution: float, *, n_psi: int = 24,
+                n_theta: int = 24) -> WallFluxes:
+    """S/N, Q/(N√T) and D/(N√T) of the bumpy wall at slip ratio v/√T (NumPy or JAX array) and wall restitution e_w.
 
     Quadrature of the module's integrals (error below 1e-10 at the defaults for the shared wall, tested
     against doubled node counts).
     """
     check_range("wall restitution coefficient restitution", restitution, low=0.0, high=1.0, low_open=True)
-    s = np.asarray(slip_ratio, dtype=float)
+    s = asarray(slip_ratio)
     check_range("slip ratio v/sqrt(T)", s)
-    kx, cos_t, weight, _ = _nodes(wall, n_psi, n_theta)
+    xp = namespace(s)
+    kx, cos_t, weight = (like(x, s) for x in _nodes(wall, n_psi, n_theta)[:3])
     m2, m3 = _moments(s[..., None] * kx)
-    normal = np.sum(m2 * cos_t * weight, axis=-1)
-    shear = -np.sum(m2 * kx * weight, axis=-1)
-    dissipation = 0.5 * (1.0 - restitution) * np.sum(m3 * weight, axis=-1)
+    normal = xp.sum(m2 * cos_t * weight, axis=-1)
+    shear = -xp.sum(m2 * kx * weight, axis=-1)
+    dissipation = 0.5 * (1.0 - restitution) * xp.sum(m3 * weight, axis=-1)
     return WallFluxes(shear / normal, (s * shear - dissipation) / normal, dissipation / normal, normal)

@@ -111,7 +111,8 @@ class CoordinationJamming(FrictionPart):
     def __post_init__(self) -> None:
         check_range("contact number at jamming z_frictionless", self.z_frictionless, low=0.0, low_open=True)
         check_range("contact number at jamming z_infinite", self.z_infinite, low=0.0, high=self.z_frictionless,
-                    low_open=True, why="friction cannot raise the contact number at jamming: z_infinite <= z_frictionless")
+                    low_open=True,
+                    why="friction cannot raise the contact number at jamming: z_infinite <= z_frictionless")
         check_range("contact-number friction scale mu_scale", self.mu_scale, low=0.0, low_open=True)
 
     def coordination(self, mu: Any) -> Any:
@@ -250,7 +251,8 @@ def mu_scale_for(law: Any, mu: float, phi_j: float) -> float:
         a, b = law.phi_rlp, law.phi_rcp - law.phi_rlp
         lo, hi, x = law.phi_rlp, law.phi_rcp, float(phi_j)
     else:
-        raise InputError(f"mu_scale_for needs a one-parameter jamming law (interpolation, coordination), got {_describe(law)}")
+        raise InputError("mu_scale_for needs a one-parameter jamming law (interpolation, coordination), "
+                         f"got {_describe(law)}")
     check_range("target jamming fraction phi_j", phi_j, low=float(lo), high=float(hi), low_open=True, high_open=True,
                 why=f"between the limits of {_describe(law)}")
     return float(mu / (b / (x - a) - 1.0))
