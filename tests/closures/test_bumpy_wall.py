@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from ktgf.closures.bumpy_wall import BumpyWall, wall_fluxes
+from ktgf.closures.bumpy_wall import BumpyWall, wall_conditions, wall_fluxes
 from ktgf.errors import InputError
 
 SLIPS = np.array([0.0, 0.3, 1.0, 2.5])
@@ -128,3 +128,25 @@ def test_jax_values_and_slip_derivative() -> None:
     fd = (wall_fluxes(wall, 1.2 + h, 0.9).shear_over_normal
           - wall_fluxes(wall, 1.2 - h, 0.9).shear_over_normal) / (2 * h)
     assert float(dfds) == pytest.approx(float(fd), rel=1e-8)
+
+
+def test_large_slip_tends_to_the_geometric_drag_of_the_upstream_faces() -> None:
+    # v/√T → ∞: only faces with k_x < 0 are hit, at |w| ≈ v|k_x|, so S/N → ∫|k_x|³ dΩ / ∫ k_x² cos θ dΩ over them
+    wall = BumpyWall()
+    rng = np.random.default_rng(7)
+    k = rng.normal(size=(2_000_000, 3))
+    k /= np.linalg.norm(k, axis=1, keepdims=True)
+    k[:, 2] = np.abs(k[:, 2])
+    k = k[wall.accessible(k) & (k[:, 0] < 0.0)]
+    limit = np.mean(-k[:, 0] ** 3) / np.mean(k[:, 0] ** 2 * k[:, 2])
+    assert float(wall_fluxes(wall, 1e4, 0.9).shear_over_normal) == pytest.approx(limit, rel=5e-3)
+
+
+def test_dimensional_conditions_scale_with_the_normal_stress_and_the_thermal_speed() -> None:
+    wall = BumpyWall()
+    f = wall_fluxes(wall, 1.5, 0.8)
+    shear, flux = wall_conditions(wall, 250.0, 0.04, 0.3, 0.8)  # Pa, m²/s², m/s: v/√θ = 1.5
+    assert shear == pytest.approx(250.0 * float(f.shear_over_normal), rel=1e-14)
+    assert flux == pytest.approx(250.0 * 0.2 * float(f.energy_over_normal), rel=1e-14)
+    back, _ = wall_conditions(wall, 250.0, 0.04, -0.3, 0.8)
+    assert back == pytest.approx(-shear, rel=1e-14)

@@ -183,3 +183,17 @@ def wall_fluxes(wall: BumpyWall, slip_ratio: Any, restitution: float, *, n_psi: 
     shear = -xp.sum(m2 * kx * weight, axis=-1)
     dissipation = 0.5 * (1.0 - restitution) * xp.sum(m3 * weight, axis=-1)
     return WallFluxes(shear / normal, (s * shear - dissipation) / normal, dissipation / normal, normal)
+
+
+def wall_conditions(wall: BumpyWall, normal_stress: Any, temperature: Any, slip: Any,
+                    restitution: float) -> tuple[Any, Any]:
+    """(S, Q): shear stress of the flow on the wall along the slip, and flux of fluctuation energy into the flow.
+
+    ``normal_stress`` N [Pa] and ``temperature`` θ [m²/s²] at the wall, ``slip`` v [m/s] the mean velocity of
+    the flow relative to the wall (signed, along the wall).  S = N F(v/√θ) [Pa], Q = N √θ G(v/√θ) [W/m²];
+    the wall drags the flow with −S.  NumPy or JAX arrays (broadcast together).
+    """
+    xp = namespace(normal_stress, temperature, slip)
+    root = xp.sqrt(temperature)
+    f = wall_fluxes(wall, slip / root, restitution)
+    return normal_stress * f.shear_over_normal, normal_stress * root * f.energy_over_normal
