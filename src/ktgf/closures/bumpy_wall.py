@@ -17,7 +17,7 @@ Geometry (exact, :class:`BumpyWall`):
   of a sphere resting in the hollow (h = √(2/3) d = 0.8165 d for equal touching spheres).
 
 Kinetics (our derivation, :func:`wall_fluxes`; not the printed equations of Richman, Acta Mech. 75, 227
-(1988) or Jenkins & Askari (1991), which could not be read here — ``docs/dense_physics.md`` §5): the
+(1988) or Jenkins & Askari (1991), which could not be read here — ``docs/dense_physics.md`` §6): the
 flowing spheres that reach the wall have a Maxwellian velocity distribution of temperature T (per unit
 mass, θ) and mean velocity v x̂ relative to the wall (the slip), and their centres are spread uniformly,
 with a number density n_w, over the accessible caps (no extra correlation).  A collision with normal k
