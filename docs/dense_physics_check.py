@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ktgf import get_model
+from ktgf.closures.dissipation import CorrelationLength
 from ktgf.closures.friction.jamming import JammingFraction
 from ktgf.closures.jamming import CoordinationJamming, mu_scale_for
 from ktgf.closures.rdf import CarnahanStarling, ChialvoSundaresan, Torquato
@@ -52,17 +53,24 @@ for mu, rows in ((0.0, smooth), (0.5, rough)):
 
 print("\n### Uniform shear against the frictionless DEM (e = 0.9): relative errors\n")
 ret_cs13 = dataclasses.replace(get_model("ret"), rdf=ChialvoSundaresan())
-models = [("RET + CS13 RDF (published constants)", ret_cs13), ("`dense`", get_model("dense")),
-          ("`proposed` (β 1.75)", get_model("proposed"))]
-print("| model | φ | err p/(nT) | err η* | err T |")
-print("|---|---|---|---|---|")
+ret_cs13_ekt = dataclasses.replace(ret_cs13, dissipation=CorrelationLength())  # c = 1, the registry's default
+models = [("RET + CS13 RDF (published constants)", ret_cs13),
+          ("RET + CS13 RDF + EKT `jenkins-berzi-2010` (c = 1, default)", ret_cs13_ekt),
+          ("`dense`", get_model("dense")), ("`proposed` (β 1.75)", get_model("proposed"))]
+print("| model | φ | err p/(nT) | err η* | err T | err τ/p | L/d |")
+print("|---|---|---|---|---|---|---|")
 for name, model in models:
     ok = smooth["phi"] < model.phi_max
     s = shear_state(model, smooth["phi"][ok], smooth["e"][ok])
+    # DEM τ/p from its columns (γ̇ = d = m = 1): τ = η0 (η/η0), η0 = (5/16)√(T/π); p = (p/(nT)) n T, n = 6φ/π
+    dem_ratio = (smooth["eta_over_eta0"] * 5.0 / 16.0 * np.sqrt(smooth["T"] / np.pi)
+                 / (smooth["p_over_nT"] * 6.0 * smooth["phi"] / np.pi * smooth["T"]))
     for i, r in enumerate(smooth[ok]):
-        errs = [float(np.broadcast_to(m, s.phi.shape)[i]) / r[c] - 1.0
-                for m, c in ((s.p_over_nT, "p_over_nT"), (s.eta_over_eta0, "eta_over_eta0"), (s.T, "T"))]
-        print(f"| {name} | {r['phi']:g} | " + " | ".join(f"{100 * x:+.0f} %" for x in errs) + " |")
+        pick = [float(np.broadcast_to(m, s.phi.shape)[i]) for m in (s.p_over_nT, s.eta_over_eta0, s.T, s.stress_ratio)]
+        errs = [x / r[c] - 1.0 for x, c in zip(pick[:3], ("p_over_nT", "eta_over_eta0", "T"))]
+        errs.append(pick[3] / dem_ratio[ok][i] - 1.0)
+        length = float(np.broadcast_to(s.L_over_d, s.phi.shape)[i])
+        print(f"| {name} | {r['phi']:g} | " + " | ".join(f"{100 * x:+.0f} %" for x in errs) + f" | {length:.2f} |")
 
 print("\n### φ_J(μ = 0.5) of the jamming laws; the densest flowing DEM state at μ = 0.5 has φ = "
       f"{rough['phi'].max():g}\n")
