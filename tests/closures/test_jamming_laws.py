@@ -37,7 +37,7 @@ MUS = np.array([0.0, 1e-3, 0.01, 0.1, 0.3, 0.5, 1.0, 10.0, 1e3])
 
 def test_song_wang_makse_end_points_are_their_printed_rcp_and_rlp() -> None:
     # "4/(4 + 2√3) or 53.6% and 6/(6 + 2√3) or 63.4%, defining RLP and RCP" (abstract of "Jamming II:
-    # Edwards' statistical mechanics of random packings of hard spheres", Wang, Song, Jin & Makse)
+    # Edwards' statistical mechanics of random packings of hard spheres", Makse group, arXiv)
     assert packing_fraction_of_coordination(6.0) == pytest.approx(0.634, abs=5e-4)
     assert packing_fraction_of_coordination(4.0) == pytest.approx(0.536, abs=5e-4)
     law = CoordinationJamming()

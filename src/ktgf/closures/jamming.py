@@ -24,8 +24,8 @@ Laws (:data:`JAMMING_LAWS`, :func:`get_jamming_law`); each has ``phi_c(mu)`` and
     Its end points follow from the two integers alone: φ_J(0) = 6/(6 + 2√3) = 0.63397 and
     φ_J(∞) = 4/(4 + 2√3) = 0.53590, printed as "4/(4 + 2√3) or 53.6% and 6/(6 + 2√3) or 63.4%,
     defining RLP and RCP" in the abstract of "Jamming II: Edwards' statistical mechanics of random
-    packings of hard spheres" (Wang, Song, Jin & Makse; the abstract as stored at arxivlens.com, read
-    for this module).  Only μ_Z is a number to be chosen or calibrated (default 0.1, our choice, as μ_J
+    packings of hard spheres" (Makse group, arXiv; its abstract as stored at arxivlens.com, read for
+    this module; the Nature paper itself was not read).  Only μ_Z is a number to be chosen or calibrated (default 0.1, our choice, as μ_J
     of the interpolation: not a literature fit).
 ``tabulated``
     :class:`TabulatedJamming`: linear interpolation through (μ_i, φ_i) pairs that the user takes from
