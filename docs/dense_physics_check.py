@@ -10,6 +10,8 @@ Run from the repository root:  python docs/dense_physics_check.py [DATA_DIR]   (
 3. The jamming laws φ_J(μ) at the shared friction coefficient μ = 0.5 with their default μ scales,
    and the μ scale each would need for φ_J(0.5) = 0.58 (mu_scale_for), beside the densest flowing DEM
    state at μ = 0.5 (φ = 0.57).
+4. Jenkins & Zhang's closed form (as coded in SedFoam) against ktgf's Walton average: friction loss
+   e − e_eff, excess dissipation and T_rot/T.
 """
 
 from __future__ import annotations
@@ -22,7 +24,9 @@ import numpy as np
 
 from ktgf import get_model
 from ktgf.closures.dissipation import CorrelationLength
+from ktgf.closures.friction.collisions import WaltonRestitution
 from ktgf.closures.friction.jamming import JammingFraction
+from ktgf.closures.friction.jenkins_zhang import JenkinsZhangRestitution
 from ktgf.closures.jamming import CoordinationJamming, mu_scale_for
 from ktgf.closures.rdf import CarnahanStarling, ChialvoSundaresan, Torquato
 from ktgf.couette.uniform_shear import load_uniform_shear, shear_state
@@ -79,3 +83,16 @@ print("|---|---|---|---|")
 for law in (JammingFraction(), CoordinationJamming()):
     print(f"| {law.describe()} | {float(law.phi_c(0.0)):.4f} | {float(law.phi_c(0.5)):.4f} | "
           f"{mu_scale_for(law, 0.5, 0.58):.3f} |")
+
+print("\n### Jenkins–Zhang (SedFoam's code) against ktgf's Walton average: relative differences W/JZ − 1\n")
+print("| e | μ | β0 | e − e_eff (JZ) | friction loss | excess dissipation | T_rot/T (JZ) | T_rot/T (W) |")
+print("|---|---|---|---|---|---|---|---|")
+jz = JenkinsZhangRestitution()
+for e, mu, beta0 in ((0.9999, 0.001, 0.0), (0.9999, 0.003, 0.0), (0.9999, 0.001, 1.0), (0.9, 0.01, 0.0),
+                     (0.7, 0.01, 0.0), (0.7, 0.5, 1.0), (0.99, 1.0, 0.0)):
+    walton = WaltonRestitution(beta0=max(beta0, 1e-12))
+    loss_jz, loss_w = e - float(jz.effective_restitution(e, mu)), e - float(walton.effective_restitution(e, mu))
+    excess_jz, excess_w = float(jz.inelasticity(e, mu)) - (1 - e**2), float(walton.inelasticity(e, mu)) - (1 - e**2)
+    r_jz, r_w = float(jz.rotational_ratio(e, mu)), float(walton.rotational_ratio(e, mu))
+    print(f"| {e:g} | {mu:g} | {beta0:g} | {loss_jz:.5g} | {100 * (loss_w / loss_jz - 1):+.2f} % | "
+          f"{100 * (excess_w / excess_jz - 1):+.2f} % | {r_jz:.4g} | {r_w:.4g} |")
