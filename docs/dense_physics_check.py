@@ -12,6 +12,8 @@ Run from the repository root:  python docs/dense_physics_check.py [DATA_DIR]   (
    state at μ = 0.5 (φ = 0.57).
 4. Jenkins & Zhang's closed form (as coded in SedFoam) against ktgf's Walton average: friction loss
    e − e_eff, excess dissipation and T_rot/T.
+5. The three EKT correlation lengths L/d stored in SedFoam's history (re-typed, d = 1) beside ktgf's
+   `jenkins-berzi-2010` at c = 1, at the frictionless DEM states with the CS13 RDF.
 """
 
 from __future__ import annotations
@@ -96,3 +98,28 @@ for e, mu, beta0 in ((0.9999, 0.001, 0.0), (0.9999, 0.003, 0.0), (0.9999, 0.001,
     r_jz, r_w = float(jz.rotational_ratio(e, mu)), float(walton.rotational_ratio(e, mu))
     print(f"| {e:g} | {mu:g} | {beta0:g} | {loss_jz:.5g} | {100 * (loss_w / loss_jz - 1):+.2f} % | "
           f"{100 * (excess_w / excess_jz - 1):+.2f} % | {r_jz:.4g} | {r_w:.4g} |")
+
+
+def sedfoam_lengths(phi: np.ndarray, e: float, g0: np.ndarray) -> list[np.ndarray]:
+    """L/d of SedFoam's `extended_` branch in three stored versions (kineticTheoryModel.C), re-typed, d = 1."""
+    sqrt_pi = np.sqrt(np.pi)
+    first = np.maximum(1.0, 0.5 * (30.0 / (1.0 + np.pi / 12.0) * (1 - e) * phi**2 * g0) ** (1 / 3))
+    f2 = (4.0 / 5.0 * phi**2 * g0 * (1 + e) / sqrt_pi + sqrt_pi * g0 * (1 + e) * (3 * e - 1) * phi**2 / (15 * (3 - e))
+          + phi * sqrt_pi / (6 * (3 - e)))
+    f3 = 12.0 / sqrt_pi * (1 - e**2) * phi**2 * g0
+    second = np.maximum(1.0, (f3 / f2) ** (1 / 3) * (0.25 * (phi * g0) ** (1 / 3)) ** (2 / 3))
+    third = np.maximum(1.0, 0.5 * (30 * phi**2 * (1 - e) / (1 - np.pi * (1 + e) * (1 - 3 * e)
+                                                             / (1 - 0.25 * (1 - e) ** 2 - 5.0 / 24 * (1 - e**2))))
+                       ** (1 / 3) * (phi * g0) ** (2 / 9))
+    return [first, second, third]
+
+
+print("\n### EKT L/d at the frictionless DEM states (e = 0.9, CS13 RDF): SedFoam's three stored forms and ktgf's\n")
+dense_rows = smooth[smooth["phi"] >= 0.5]
+g0 = ChialvoSundaresan().chi(dense_rows["phi"])
+forms = sedfoam_lengths(dense_rows["phi"], 0.9, g0)
+ktgf_length = np.broadcast_to(shear_state(ret_cs13_ekt, dense_rows["phi"], dense_rows["e"]).L_over_d, dense_rows.shape)
+print("| φ | SedFoam, earlier | SedFoam, f3/f2 form | SedFoam, commit 079bc886 | ktgf `jenkins-berzi-2010`, c = 1 |")
+print("|---|---|---|---|---|")
+for i, r in enumerate(dense_rows):
+    print(f"| {r['phi']:g} | {forms[0][i]:.2f} | {forms[1][i]:.2f} | {forms[2][i]:.2f} | {ktgf_length[i]:.2f} |")
