@@ -1,6 +1,6 @@
 """Reproduce the measured tables of docs/dense_physics.md (comparisons only: nothing here is fitted).
 
-Run from the repository root:  python docs/dense_physics_check.py [DATA_DIR]   (default ../shared/data)
+Run from the repository root:  python docs/dense_physics_check.py [DATA_DIR]   (default: the data shipped with ktgf)
 
 1. The contact value χ that each DEM uniform-shear point implies, χ_DEM = (p/(nT) − 1)/(2(1 + e)φ)
    (the Enskog/RET equation of state p/(nT) = 1 + 2(1 + e)φχ, model.md §3), against RDFs with their
@@ -31,13 +31,14 @@ from ktgf.closures.friction.jamming import JammingFraction
 from ktgf.closures.friction.jenkins_zhang import JenkinsZhangRestitution
 from ktgf.closures.jamming import CoordinationJamming, mu_scale_for
 from ktgf.closures.rdf import CarnahanStarling, ChialvoSundaresan, Torquato
-from ktgf.couette.uniform_shear import load_uniform_shear, shear_state
+from ktgf.data import shipped_data_dir, uniform_shear_records
+from ktgf.shear.steady import steady_shear
 
-data = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parents[2] / "shared" / "data"
+data = Path(sys.argv[1]) if len(sys.argv) > 1 else shipped_data_dir()
 COLS = ["phi", "e", "T", "eta_over_eta0", "p_over_nT"]
-smooth = np.sort(np.concatenate([load_uniform_shear(data / name)[COLS] for name in
+smooth = np.sort(np.concatenate([uniform_shear_records(data / name)[COLS] for name in
                                  ("dem_uniform_shear.csv", "dem_uniform_shear_extra.csv")]), order="phi")
-rough = np.concatenate([load_uniform_shear(data / name, where={"mu": 0.5}) for name in
+rough = np.concatenate([uniform_shear_records(data / name, where={"mu": 0.5}) for name in
                         ("dem_uniform_shear_friction.csv", "dem_uniform_shear_friction_extra.csv")])
 rough = np.sort(rough, order="phi")
 
@@ -67,12 +68,12 @@ print("| model | φ | err p/(nT) | err η* | err T | err τ/p | L/d |")
 print("|---|---|---|---|---|---|---|")
 for name, model in models:
     ok = smooth["phi"] < model.phi_max
-    s = shear_state(model, smooth["phi"][ok], smooth["e"][ok])
+    s = steady_shear(model, smooth["phi"][ok], smooth["e"][ok])
     # DEM τ/p from its columns (γ̇ = d = m = 1): τ = η0 (η/η0), η0 = (5/16)√(T/π); p = (p/(nT)) n T, n = 6φ/π
     dem_ratio = (smooth["eta_over_eta0"] * 5.0 / 16.0 * np.sqrt(smooth["T"] / np.pi)
                  / (smooth["p_over_nT"] * 6.0 * smooth["phi"] / np.pi * smooth["T"]))
     for i, r in enumerate(smooth[ok]):
-        pick = [float(np.broadcast_to(m, s.phi.shape)[i]) for m in (s.p_over_nT, s.eta_over_eta0, s.T, s.stress_ratio)]
+        pick = [float(np.broadcast_to(m, s.phi.shape)[i]) for m in (s.p_over_nT, s.eta_over_eta0, s.T, s.tau_over_p)]
         errs = [x / r[c] - 1.0 for x, c in zip(pick[:3], ("p_over_nT", "eta_over_eta0", "T"))]
         errs.append(pick[3] / dem_ratio[ok][i] - 1.0)
         length = float(np.broadcast_to(s.L_over_d, s.phi.shape)[i])
@@ -118,7 +119,7 @@ print("\n### EKT L/d at the frictionless DEM states (e = 0.9, CS13 RDF): SedFoam
 dense_rows = smooth[smooth["phi"] >= 0.5]
 g0 = ChialvoSundaresan().chi(dense_rows["phi"])
 forms = sedfoam_lengths(dense_rows["phi"], 0.9, g0)
-ktgf_length = np.broadcast_to(shear_state(ret_cs13_ekt, dense_rows["phi"], dense_rows["e"]).L_over_d, dense_rows.shape)
+ktgf_length = np.broadcast_to(steady_shear(ret_cs13_ekt, dense_rows["phi"], dense_rows["e"]).L_over_d, dense_rows.shape)
 print("| φ | SedFoam, earlier | SedFoam, f3/f2 form | SedFoam, commit 079bc886 | ktgf `jenkins-berzi-2010`, c = 1 |")
 print("|---|---|---|---|---|")
 for i, r in enumerate(dense_rows):
