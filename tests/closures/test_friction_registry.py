@@ -14,7 +14,6 @@ from ktgf.cli import app
 from ktgf.closures.friction import WaltonRestitution
 from ktgf.closures.friction.model_slot import Friction
 from ktgf.data import FRICTION_SHEAR as DEM_FILE, read_friction_shear
-from ktgf.shear.compositions import frictional_uniform_shear, recommended_parts
 from ktgf.shear.steady import steady_shear
 from ktgf.closures.dissipation import CorrelationLength
 from ktgf.calibration.registry_fits import fit_correlation_constant
@@ -78,15 +77,28 @@ def test_mu_is_routed_to_the_friction_part_and_the_jamming_fraction():
     assert m.metadata()["friction"] == "coulomb" and '"friction"' in m.metadata()["model_options"]
 
 
-def test_registered_model_is_the_documented_composition():
-    """``frictional`` = the parts of ktgf.shear.compositions.recommended_parts (docs/friction.md §6 numbers)."""
-    rows = [(0.4, 0.170, 0.539, 0.630, 0.497), (0.5, 0.184, 2.393, 0.599, 0.497)]  # docs/friction.md §6 table
-    s = steady_shear(get_model("frictional", mu=0.5), [r[0] for r in rows], 0.7)
-    parts = frictional_uniform_shear(recommended_parts(), [r[0] for r in rows], 0.7, 0.5)
-    for a, b in zip(s, parts):
-        np.testing.assert_allclose(a, b, rtol=1e-12)
-    for i, (_, T, p, tau, rot) in enumerate(rows):
-        assert (s.T[i], s.p_star[i], s.tau_over_p[i], s.Trot_over_T[i]) == pytest.approx((T, p, tau, rot), abs=6e-4)
+def test_registered_model_is_its_documented_parts_checked_by_a_dilute_limit():
+    """``frictional`` (μ = 0.5, e = 0.7) against numbers that do not come from its own code path.
+
+    Analytic limit: as φ → 0 (χ → 1, L = d) uniform shear is the Boltzmann-limit closed form of
+    model.md §9 with ζ0* scaled by Walton's factor (1 − e_eff²)/(1 − e²):
+    φ²T → 25π η*/(13824 ζ0* F) and τ/p → √(3η*ζ0*F/2), p* → 1, where η*, ζ0* are the published φ = 0
+    RET values of oracles.md (e = 0.7) and F comes from Walton's rule, which
+    test_friction_collisions.py checks against a Monte Carlo of the collision rule.  Its RDF is the
+    published Chialvo–Sundaresan (2013) form, written out here, diverging at φ_c(0.5) = 0.565.
+    """
+    m = get_model("frictional", mu=0.5)
+    eta_star, zeta0_star = 1.147863, 0.212552  # oracles.md, RET at φ = 0, e = 0.7
+    factor = WaltonRestitution(beta0=1.0).inelasticity(0.7, 0.5) / (1 - 0.7**2)
+    assert factor > 1.1  # friction adds dissipation: the limit differs from the frictionless one
+    phi = 1e-7
+    s = steady_shear(m, [phi], 0.7)
+    assert s.L_over_d[0] == 1.0
+    assert phi**2 * s.T[0] == pytest.approx(25 * np.pi * eta_star / (13824 * zeta0_star * factor), rel=2e-5)
+    assert s.tau_over_p[0] == pytest.approx(np.sqrt(1.5 * eta_star * zeta0_star * factor), rel=2e-5)
+    assert s.p_over_nT[0] == pytest.approx(1.0, abs=1e-5)
+    x = np.array([0.1, 0.3, 0.45, 0.55])
+    np.testing.assert_allclose(m.rdf.chi(x), (1 - x / 2) / (1 - x) ** 3 + 0.58 * x**2 / (0.565 - x) ** 1.5, rtol=1e-12)
 
 
 @pytest.mark.parametrize(
