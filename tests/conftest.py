@@ -35,14 +35,19 @@ def pytest_collection_modifyitems(config, items) -> None:
     """
     bad = []
     for item in items:
-        labels = [m.name for m in item.iter_markers() if m.name in REFERENCE_LABELS]
+        labels = sorted(m.name for m in item.iter_markers() if m.name in REFERENCE_LABELS)
         if len(labels) != 1:
             bad.append(f"{item.nodeid} ({', '.join(labels) or 'no label'})")
     if bad:
         more = f"\n  ... and {len(bad) - LISTED} more" if len(bad) > LISTED else ""
-        raise pytest.UsageError(
-            f"{len(bad)} test(s) without exactly one reference label ({', '.join(REFERENCE_LABELS)}; "
-            "tests/README.md):\n  " + "\n  ".join(bad[:LISTED]) + more)
+        message = (f"{len(bad)} test(s) without exactly one reference label ({', '.join(REFERENCE_LABELS)}; "
+                   "tests/README.md):\n  " + "\n  ".join(bad[:LISTED]) + more)
+        # A collection error, not an exception (which pytest-xdist's workers turn into an INTERNALERROR):
+        # pytest shows it and stops ("Interrupted: 1 error during collection", also with --collect-only);
+        # xdist's workers hand it to the controller, which shows it once, and have nothing left to run.
+        config.hook.pytest_collectreport(
+            report=pytest.CollectReport("reference labels", "failed", message, result=[]))
+        items.clear()
 
 
 @pytest.fixture(scope="session")
