@@ -7,6 +7,7 @@ them) is a collection error listing their ids (at most 20), and nothing runs, wi
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import tomllib
@@ -50,8 +51,9 @@ def _suite(tmp_path: Path, **files: str) -> Path:
 
 
 def _pytest(folder: Path, *args: str) -> subprocess.CompletedProcess:
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTEST_")}  # not this run's worker or options
     return subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:randomly", *args],
-                          check=False, cwd=folder, capture_output=True, text=True, timeout=300)
+                          check=False, cwd=folder, env=env, capture_output=True, text=True, timeout=300)
 
 
 def test_labelled_tests_run(tmp_path):
