@@ -63,3 +63,14 @@ def test_one_parser_gives_one_line_errors(tmp_path) -> None:
     (tmp_path / "c.csv").write_text("# units d = m = 1; shear rate gdot = 1\nmu,phi,e,T\n0.5,0.4,0.7,0.1\n")
     with pytest.raises(InputError, match="missing column"):
         read_friction_shear(tmp_path / "c.csv")
+
+
+def test_a_shipped_file_is_read_by_its_bare_name(tmp_path, monkeypatch) -> None:
+    """``--data dem_uniform_shear.csv`` works from any folder; a file of that name in the folder wins."""
+    monkeypatch.chdir(tmp_path)
+    assert read_uniform_shear(UNIFORM_SHEAR).path == shipped(UNIFORM_SHEAR)
+    own = tmp_path / UNIFORM_SHEAR
+    own.write_text(shipped(UNIFORM_SHEAR).read_text().replace("0.3,0.9,864", "0.35,0.9,864"))
+    assert list(read_uniform_shear(UNIFORM_SHEAR).phi) == [0.35, 0.5]
+    with pytest.raises(InputError, match="usable by name: dem_couette"):
+        read_uniform_shear("dem_other.csv")

@@ -114,10 +114,9 @@ def compare_cmd(
         if mf.walls.get("specularity") is not None:
             walls[mf.model.name] = mf.walls
     if config is None:
-        if not dem.exists():
-            from ..errors import InputError
+        from ..data.table import resolve
 
-            raise InputError(f"no config given and the DEM file {str(dem)!r} does not exist")
+        dem = resolve(dem)  # a missing file: one line naming it and the shipped files
         rows, extra = compare_with_dem(dem, chosen, n_cells=n_cells, walls=walls)
         c = extra["case"]
         datasets = {m.label or m.name: extra["datasets"][m.name] for m in chosen if m.name in extra["datasets"]}

@@ -65,8 +65,8 @@ class UniformShearData:
 
 def read_uniform_shear(path: str | Path) -> UniformShearData:
     """Read a uniform-shear DEM file (frictionless rows only: a ``mu`` column keeps ``mu = 0``)."""
-    path = Path(path)
     table = read_table(path)
+    path = table.path
     check_units(table, shear_rate=True)
     rows = None
     notes: list[str] = []

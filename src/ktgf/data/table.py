@@ -19,8 +19,8 @@ from ..errors import InputError
 
 
 def file_hash(path: str | Path) -> str:
-    """SHA-256 of a file's bytes (the provenance of a calibration or a report section)."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    """SHA-256 of a data file's bytes (the provenance of a calibration or a report section)."""
+    return hashlib.sha256(resolve(path).read_bytes()).hexdigest()
 
 
 @dataclass(frozen=True)
@@ -67,11 +67,24 @@ class Table:
         return [dict(zip(self.names, map(float, row))) for row in self.values]
 
 
-def read_table(path: str | Path) -> Table:
-    """Read a DEM CSV file (``shared/data/README.md`` format) into a :class:`Table`."""
+def resolve(path: str | Path) -> Path:
+    """A data file's path: the path itself, or, for the bare name of a file shipped with ktgf that is not a file
+    in the working folder (``dem_uniform_shear.csv``), the shipped copy."""
+    from .files import shipped, shipped_data_dir
+
     path = Path(path)
+    if not path.is_file() and path.name == str(path) and shipped(path.name).is_file():
+        return shipped(path.name)
     if not path.is_file():
-        raise InputError(f"data file {str(path)!r} does not exist")
+        names = ", ".join(sorted(p.name for p in shipped_data_dir().glob("*.csv")))
+        raise InputError(f"data file {str(path)!r} does not exist (files shipped with ktgf, usable by name: {names})")
+    return path
+
+
+def read_table(path: str | Path) -> Table:
+    """Read a DEM CSV file (``data/dem/README.md`` format) into a :class:`Table`; a bare shipped name reads
+    the shipped copy (:func:`resolve`)."""
+    path = resolve(path)
     lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
     header = tuple(ln[1:].strip() for ln in lines if ln.startswith("#"))
     body = [ln for ln in lines if ln.strip() and not ln.startswith("#")]
