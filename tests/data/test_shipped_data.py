@@ -65,6 +65,7 @@ def test_one_parser_gives_one_line_errors(tmp_path) -> None:
         read_friction_shear(tmp_path / "c.csv")
 
 
+@pytest.mark.contract
 def test_a_shipped_file_is_read_by_its_bare_name(tmp_path, monkeypatch) -> None:
     """``--data dem_uniform_shear.csv`` works from any folder; a file of that name in the folder wins."""
     monkeypatch.chdir(tmp_path)
