@@ -24,6 +24,9 @@ BRACKETS = re.compile(r"\[[^\]\[]+\]")
 ROOT_CMD = typer.main.get_command(app)
 
 
+pytestmark = pytest.mark.contract
+
+
 def _flat(text: str) -> str:
     return " ".join(text.split())
 
