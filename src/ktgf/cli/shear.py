@@ -103,7 +103,31 @@ def shear(
     ms = [with_friction(m, mu) for m in ms]
     phis, es = parse_values(phi, "phi"), parse_values(e, "e")
     rows = [{"model": m.name, **row} for m in ms for row in shear_rows(m, phis, es, stress_scale)]
+    note = ""
+    fit = _fit_covariance(model_file)
+    if fit is not None:  # ±1σ from the model file's fitted covariance, on its model's rows (delta method)
+        from ..calibration.bands import SHEAR_BAND_COLUMNS, shear_bands
+
+        bands, method = shear_bands(ms[-1], fit[0], fit[1], phis, es, stress_scale=stress_scale)
+        own = [r for r in rows if r["model"] == ms[-1].name][-phis.size * es.size:]
+        for r in rows:
+            r.update({f"{k}_sd": float("nan") for k in SHEAR_BAND_COLUMNS})
+        for i, r in enumerate(own):
+            r.update({f"{k}_sd": float(bands[k][i]) for k in SHEAR_BAND_COLUMNS})
+        note = (f"*_sd: ±1 standard deviation from the covariance of {', '.join(fit[0])} in {model_file.name} "
+                f"(delta method, Jacobian by {method}); NaN for models without a fit")
     emit(rows, fmt, title=f"{', '.join(m.label or m.name for m in ms)}: Navier–Stokes uniform shear (d = m = 1, shear rate 1)")
+    if note:
+        typer.echo(note, err=fmt == OutputFormat.json)
+
+
+def _fit_covariance(model_file: Path | None) -> tuple[list[str], Any] | None:
+    """(names, covariance) of a model file's fit (None without a file or a fit)."""
+    if model_file is None:
+        return None
+    from ..calibration.model_file import load_model_file
+
+    return load_model_file(model_file).covariance()
 
 
 def register(app: typer.Typer, plot_app: typer.Typer) -> None:

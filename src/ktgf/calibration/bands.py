@@ -1,0 +1,117 @@
+"""Prediction bands: ±1σ of a predicted quantity from the fitted parameters' covariance (delta method).
+
+σ_y² = J C Jᵀ (diagonal), J = ∂y/∂p at the fitted values, C the covariance written by ``ktgf
+calibrate`` (:meth:`~ktgf.calibration.model_file.ModelFile.covariance`).  Linear in the parameters:
+a band is honest where the prediction is close to linear over ±σ of the parameters, and it holds
+only the parameters' uncertainty (not the model's own error, which cross-validation measures).
+
+uniform shear
+    J by ``jax.jacfwd`` of the closed forms (:func:`ktgf.couette.uniform_shear.shear_state`,
+    ``check=False``) with the fitted options as JAX values; central differences for a model whose
+    closures cannot be traced or that carries a frictional stress (NumPy-only), and the result says so.
+Couette cell
+    J by the implicit-function theorem of :class:`~ktgf.calibration.residuals.CouetteTerm` (the
+    solver is NumPy).  When the specularity is fitted to the DEM slip for each prediction
+    (``ktgf couette compare`` without walls in the model file) it follows the parameters: the
+    derivative is taken along u_slip = const, dy/dp − (∂y/∂φ')(∂u/∂φ')⁻¹ ∂u/∂p.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..errors import InputError
+
+#: Columns of ``ktgf shear`` that get a band (the others do not depend on fitted options).
+SHEAR_BAND_COLUMNS = ("T", "eta_star", "eta_over_eta0", "p_over_nT", "astar", "tau_over_p", "L_over_d", "p_star")
+
+
+def delta_sigma(J: np.ndarray, cov: np.ndarray) -> np.ndarray:
+    """√diag(J C Jᵀ) row by row (J: outputs × parameters)."""
+    J = np.asarray(J, dtype=float)
+    with np.errstate(invalid="ignore"):
+        var = np.einsum("ij,jk,ik->i", J, np.asarray(cov, dtype=float), J)
+    return np.sqrt(np.maximum(var, 0.0))
+
+
+def _shear_columns(model: Any, phi: Any, e: Any) -> Any:
+    """The banded columns of the uniform-shear state, stacked (NumPy or JAX, no range checks)."""
+    from .._array import namespace
+    from ..couette.uniform_shear import shear_state
+
+    s = shear_state(model, phi, e, check=False)
+    xp = namespace(s.T, s.eta_over_eta0)
+    cols = {"T": s.T, "eta_star": s.eta_star, "eta_over_eta0": s.eta_over_eta0, "p_over_nT": s.p_over_nT,
+            "astar": s.astar, "tau_over_p": s.stress_ratio, "L_over_d": s.L_over_d, "p_star": phi * s.p_over_nT * s.T}
+    return xp.stack([xp.broadcast_to(cols[k], xp.shape(phi)) * 1.0 for k in SHEAR_BAND_COLUMNS])
+
+
+def shear_jacobian(model: Any, names: Sequence[str], phi: np.ndarray, e: np.ndarray, *,
+                   stress_scale: float | None = None) -> tuple[np.ndarray, str]:
+    """∂(banded columns)/∂(options ``names``) at the model's values: array (columns, points, parameters), method."""
+    from .residuals import enable_x64, model_at, traced_model
+
+    values = {n: float(model.options()[n]) for n in names}
+    phi, e = np.asarray(phi, dtype=float), np.asarray(e, dtype=float)
+    if not model.friction.has_stress:
+        try:
+            import jax
+            import jax.numpy as jnp
+
+            enable_x64()
+
+            def f(x):
+                return _shear_columns(traced_model(model, dict(zip(names, x))), jnp.asarray(phi), jnp.asarray(e))
+
+            J = np.asarray(jax.jacfwd(f)(jnp.asarray([values[n] for n in names], dtype=jnp.float64)))
+            if np.all(np.isfinite(J)) or not np.all(np.isfinite(_shear_columns(model, phi, e))):
+                return J, "jax"
+        except Exception:  # noqa: BLE001  (a part that is not JAX code: central differences below, and say so)
+            pass
+    from ..cli.shear import shear_rows
+
+    def g(v: dict[str, float]) -> np.ndarray:
+        rows = shear_rows(model_at(model, v), phi, e, stress_scale)
+        return np.array([[r[k] for r in rows] for k in SHEAR_BAND_COLUMNS])
+
+    J = np.empty((len(SHEAR_BAND_COLUMNS), phi.size * e.size, len(names)))
+    for j, n in enumerate(names):
+        h = 1e-6 * max(abs(values[n]), 1e-2)
+        J[:, :, j] = (g({**values, n: values[n] + h}) - g({**values, n: values[n] - h})) / (2 * h)
+    return J, "central differences"
+
+
+def shear_bands(model: Any, names: Sequence[str], cov: np.ndarray, phi: np.ndarray, e: np.ndarray, *,
+                stress_scale: float | None = None) -> tuple[dict[str, np.ndarray], str]:
+    """±1σ of every banded column at every (φ, e) of the grid (φ outer, e inner, as ``ktgf shear``), and the method."""
+    phis, es = (a.ravel() for a in np.meshgrid(np.asarray(phi, float), np.asarray(e, float), indexing="ij"))
+    J, method = shear_jacobian(model, names, phis, es, stress_scale=stress_scale)
+    return {k: delta_sigma(J[i], cov) for i, k in enumerate(SHEAR_BAND_COLUMNS)}, method
+
+
+def couette_bands(model: Any, names: Sequence[str], cov: np.ndarray, dem: Any, *, specularity: float,
+                  wall_restitution: float | None = None, slip_fitted: bool, n_cells: int = 200) -> dict[str, float]:
+    """±1σ of the wall shear stress and wall pressure of a DEM Couette cell (module notes).
+
+    ``names`` may hold model options and the wall parameters; ``slip_fitted``: the specularity is
+    re-fitted to the DEM slip for every prediction (then it must not be among ``names``).
+    """
+    from .residuals import CouetteTerm
+
+    walls = {"specularity": specularity, "wall_restitution": dem.case.e if wall_restitution is None else wall_restitution}
+    if slip_fitted and "specularity" in names:
+        raise InputError("the specularity is both fitted in the model file and fitted to the DEM slip")
+    wrt = list(names) + (["specularity"] if slip_fitted else [])
+    term = CouetteTerm(dem, model, wrt, "relative", n_cells=n_cells, fixed={k: v for k, v in walls.items() if k not in wrt})
+    values = {n: float(walls[n]) if n in walls else float(model.options()[n]) for n in wrt}
+    J = term.jacobian(values) * term.scale[:, None]  # d(tau, p, slip)/d(parameters), unweighted
+    if slip_fitted:
+        du_ds = J[2, -1]
+        J = J[:, :-1] - np.outer(J[:, -1], J[2, :-1] / du_ds)
+    sig = delta_sigma(J[:2], cov)
+    return {"tau_wall": float(sig[0]), "p": float(sig[1])}
+
+
+__all__ = ["SHEAR_BAND_COLUMNS", "couette_bands", "delta_sigma", "shear_bands", "shear_jacobian"]
