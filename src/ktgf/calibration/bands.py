@@ -48,24 +48,48 @@ def _shear_columns(model: Any, phi: Any, e: Any) -> Any:
     return xp.stack([xp.broadcast_to(cols[k], xp.shape(phi)) * 1.0 for k in SHEAR_BAND_COLUMNS])
 
 
+#: ``jit(jacfwd(...))`` of the banded columns by (model, names, shape of the points): op-by-op
+#: ``jacfwd`` costs seconds per call, the compiled one ~1 ms after one trace and compilation (~2 s).
+_JACOBIANS: dict[tuple, Any] = {}
+_JACOBIANS_MAX = 16
+
+
+def _compiled_jacobian(model: Any, names: tuple[str, ...], shape: tuple[int, ...]) -> Any:
+    import jax
+
+    from .residuals import traced_model
+
+    key = (model, names, shape)
+    try:
+        fn = _JACOBIANS.get(key)
+    except TypeError:  # an unhashable option: no caching
+        key, fn = None, None
+    if fn is None:
+        def f(x, phi, e):
+            return _shear_columns(traced_model(model, dict(zip(names, x))), phi, e)
+
+        fn = jax.jit(jax.jacfwd(f))
+        if key is not None:
+            if len(_JACOBIANS) >= _JACOBIANS_MAX:
+                _JACOBIANS.pop(next(iter(_JACOBIANS)))
+            _JACOBIANS[key] = fn
+    return fn
+
+
 def shear_jacobian(model: Any, names: Sequence[str], phi: np.ndarray, e: np.ndarray, *,
                    stress_scale: float | None = None) -> tuple[np.ndarray, str]:
     """∂(banded columns)/∂(options ``names``) at the model's values: array (columns, points, parameters), method."""
-    from .residuals import enable_x64, model_at, traced_model
+    from .residuals import enable_x64, model_at
 
     values = {n: float(model.options()[n]) for n in names}
     phi, e = np.asarray(phi, dtype=float), np.asarray(e, dtype=float)
     if not model.friction.has_stress:
         try:
-            import jax
             import jax.numpy as jnp
 
             enable_x64()
-
-            def f(x):
-                return _shear_columns(traced_model(model, dict(zip(names, x))), jnp.asarray(phi), jnp.asarray(e))
-
-            J = np.asarray(jax.jacfwd(f)(jnp.asarray([values[n] for n in names], dtype=jnp.float64)))
+            fn = _compiled_jacobian(model, tuple(names), phi.shape)
+            J = np.asarray(fn(jnp.asarray([values[n] for n in names], dtype=jnp.float64), jnp.asarray(phi), jnp.asarray(e)))
             if np.all(np.isfinite(J)) or not np.all(np.isfinite(_shear_columns(model, phi, e))):
                 return J, "jax"
         except Exception:  # noqa: BLE001  (a part that is not JAX code: central differences below, and say so)
