@@ -107,9 +107,11 @@ def test_shear_prints_bands_for_the_model_file_rows(fitted):
     assert "delta method" in r.stderr
 
 
-@pytest.mark.slow
 def test_couette_band_matches_resolved_cells(data_dir):
-    """∂(τ_w, p_w)/∂β of the DEM cell with the specularity re-fitted to the slip: against re-solved, re-fitted cells."""
+    """∂(τ_w, p_w)/∂β of the DEM cell with the specularity re-fitted to the slip: against re-solved, re-fitted cells.
+
+    Holding the specularity fixed instead gives a derivative ~15 % smaller, so the tolerance separates the two.
+    """
     from ktgf.couette.compare import calibrate_specularity, wall_stresses
 
     dem = read_data(data_dir / "dem_couette_e0.9_phi0.50.csv")
@@ -124,6 +126,23 @@ def test_couette_band_matches_resolved_cells(data_dir):
         _, ds = calibrate_specularity(mb, dem, n_cells=n)
         out.append(wall_stresses(ds))
     d_tau, d_p = (np.array(out[0]) - np.array(out[1])) / (2 * h)
-    assert sd["tau_wall"] == pytest.approx(abs(d_tau), rel=0.03)
-    assert sd["p"] == pytest.approx(abs(d_p), rel=0.03)
+    assert sd["tau_wall"] == pytest.approx(abs(d_tau), rel=2e-3)
+    assert sd["p"] == pytest.approx(abs(d_p), rel=2e-3)
+    fixed = couette_bands(m, ["beta"], np.array([[1.0]]), dem, specularity=spec, slip_fitted=False, n_cells=n)
+    assert fixed["tau_wall"] != pytest.approx(sd["tau_wall"], rel=0.05)
     assert math.isfinite(sd["tau_wall"]) and sd["tau_wall"] > 0
+
+
+def test_couette_compare_prints_bands_for_the_model_file(fitted, data_dir, tmp_path):
+    dem = data_dir / "dem_couette_e0.9_phi0.50.csv"
+    r = runner.invoke(app, ["couette", "compare", "--dem", str(dem), "--model", "ret", "--model-file", str(fitted),
+                            "--cells", "60", "-o", str(tmp_path / "c.png"), "--format", "json"])
+    assert r.exit_code == 0, r.output
+    ret, own = json.loads(r.stdout)
+    assert ret["tau_wall_sd"] is None and ret["p_sd"] is None
+    names, C = load_model_file(fitted).covariance()
+    sd = couette_bands(load_model_file(fitted).model, names, C, read_data(dem), specularity=own["specularity"],
+                       slip_fitted=True, n_cells=60)
+    assert own["tau_wall_sd"] == pytest.approx(sd["tau_wall"], rel=1e-6) and own["tau_wall_sd"] > 0
+    assert own["p_sd"] == pytest.approx(sd["p"], rel=1e-6)
+    assert "specularity follows the parameters" in r.stderr

@@ -71,7 +71,7 @@ def detect_case(path: str | Path) -> str:
         return "couette"
     if "A_main" in names or "A_early" in names:
         return "homogeneous-cooling"
-    if "mu" in names and "p_star" in names:
+    if "mu" in names:
         return "frictional-shear"
     if "eta_over_eta0" in names or "p_over_nT" in names:
         return "uniform-shear"
