@@ -89,6 +89,9 @@ def shear(
     option: list[str] = typer.Option(
         None, "--option", "-O", help="Model option KEY=VALUE (repeatable, applied to every model), e.g. phi_f=0.46."
     ),
+    band_jacobian: str = typer.Option("jax", "--band-jacobian", help="How the +-1 sigma bands of a --model-file fit "
+                                      "differentiate the prediction: jax (exact; compiles once per process) or differences "
+                                      "(vectorised central differences, no JAX: faster for one command)."),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Steady uniform (Lees–Edwards) shear from the closed forms of docs/model.md §9 (frictional: docs/friction.md).
@@ -97,6 +100,8 @@ def shear(
     rate 1, rho_s = 6/pi): T = θ/(γ̇d)², Trot_over_T (NaN/null where the model has no rotation), p_star =
     p/(rho_s d² γ̇²), tau_over_p = |P_xy|/p, p_over_nT = p/(nT), eta_star = η d²/√(mT), eta_over_eta0 = η/η0,
     astar = γ̇/ν0 and L_over_d (extended-kinetic-theory correlation length, 1 without that option).
+    With a --model-file holding a fit, *_sd columns give +-1 standard deviation of the --model-file model's values
+    from the fitted covariance (delta method; docs/calibration.md).
     """
     options = parse_options(option)
     ms = [m.with_options(**options) if options else m for m in resolve_models(model, model_file)]
@@ -108,7 +113,7 @@ def shear(
     if fit is not None:  # ±1σ from the model file's fitted covariance, on its model's rows (delta method)
         from ..calibration.bands import SHEAR_BAND_COLUMNS, shear_bands
 
-        bands, method = shear_bands(ms[-1], fit[0], fit[1], phis, es, stress_scale=stress_scale)
+        bands, method = shear_bands(ms[-1], fit[0], fit[1], phis, es, stress_scale=stress_scale, method=band_jacobian)
         own = [r for r in rows if r["model"] == ms[-1].name][-phis.size * es.size:]
         for r in rows:
             r.update({f"{k}_sd": float("nan") for k in SHEAR_BAND_COLUMNS})
