@@ -164,3 +164,14 @@ def test_fewer_points_than_parameters_is_one_line_exit_2(tmp_path):
     g = model_data(tmp_path / "t.csv", get_model("proposed"), [0.5, 0.55])
     with pytest.raises(InputError, match=r"cross-validation: leaving out t.csv phi=0.5 e=0.9 leaves 3 data point"):
         cross_validate(get_model("dense"), [read_data(g)], ["phi_f", "phi_c", "beta", "junction_width"])
+
+
+def test_a_parameter_lost_in_a_three_way_direction_is_named(data_dir):
+    """dense's φ_f, φ_c, β on the shared frictionless files: no pair beyond 0.95 with φ_f, yet φ_f is not determined."""
+    data = [read_data(data_dir / "dem_uniform_shear.csv"), read_data(data_dir / "dem_uniform_shear_extra.csv")]
+    fit = calibrate(get_model("dense"), data, ["phi_f", "phi_c", "beta"])
+    assert max(abs(fit.correlation[0, 1]), abs(fit.correlation[0, 2])) < CORRELATION_WARNING
+    se = fit.stderr[0]
+    assert se > 0.62 - 0.2
+    assert any(w.startswith(f"the data do not determine phi_f (standard error {se:.3g}, range 0.2 to 0.62)")
+               for w in fit.identifiability.warnings)

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Sequence
 
 import numpy as np
@@ -309,10 +309,15 @@ def calibrate(model: Model, datasets: Sequence[Any], names: Sequence[str], *, st
     with np.errstate(all="ignore"):
         sd = np.sqrt(np.diag(cov))
         corr = cov / np.outer(sd, sd)  # scale-free: the same for stated and scaled errors
-    ident = identifiability(J, names, corr)
     if errors == "scaled":
         cov = cov * float(r @ r) / (m - n)
     se = np.sqrt(np.diag(cov))
+    ident = identifiability(J, names, corr)
+    wide = [f"{p.name} (standard error {s_:.3g}, range {p.lower:g} to {p.upper:g})" for p, s_ in zip(params, se)
+            if math.isfinite(p.upper - p.lower) and math.isfinite(s_) and s_ > p.upper - p.lower]
+    if wide:  # a direction shared by three or more parameters escapes the pairwise test; its errors show it
+        ident = replace(ident, warnings=ident.warnings + ("the data do not determine " + "; ".join(wide)
+                                                          + ": the standard error exceeds the whole range",))
     if not np.all(np.isfinite(se)):
         message += "; the data do not determine every fitted parameter (J^T J is singular: infinite standard errors)"
     notes = sorted({t.method_note for t in terms if getattr(t, "method_note", "")})

@@ -165,6 +165,9 @@ def _emit_cross_validation(cv, fmt: OutputFormat) -> None:
     emit(rows, fmt, title=f"leave-one-state-out cross-validation of {', '.join(cv.full.names)}: error = model/data - 1 "
                           "of the state left out (in_sample_error: the fit on all states)")
     emit(cv.per_quantity(), fmt, title="cross-validated |error| per quantity")
+    emit([{"states": len(cv.refits), "values": len(cv.rows), "mean_abs_error": cv.mean_abs_error,
+           "mean_abs_in_sample_error": cv.mean_abs_in_sample_error, "seconds": cv.seconds}], fmt,
+         title="cross-validated mean |model/data - 1| (the number to quote)")
     if fmt == OutputFormat.table:
         typer.echo(f"cross-validated mean |model/data - 1| over {len(cv.refits)} states and {len(cv.rows)} values: "
                    f"{100 * cv.mean_abs_error:.2f} % (in sample: {100 * cv.mean_abs_in_sample_error:.2f} %); "
