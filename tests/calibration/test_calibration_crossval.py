@@ -175,3 +175,21 @@ def test_a_parameter_lost_in_a_three_way_direction_is_named(data_dir):
     assert se > 0.62 - 0.2
     assert any(w.startswith(f"the data do not determine phi_f (standard error {se:.3g}, range 0.2 to 0.62)")
                for w in fit.identifiability.warnings)
+
+
+def test_left_out_couette_file_is_predicted_by_the_fit_on_the_rest(data_dir):
+    """Couette file left out: β refitted on the shear file alone (a separate fit), specularity kept (and said so)."""
+    from ktgf.calibration.residuals import CouetteTerm
+
+    shear, couette = read_data(data_dir / "dem_uniform_shear.csv"), read_data(data_dir / "dem_couette_e0.9_phi0.50.csv")
+    cv = cross_validate(get_model("proposed"), [shear, couette], ["specularity", "beta"], n_cells=60)
+    alone = calibrate(get_model("proposed"), [shear], ["beta"], start={"beta": cv.full.value_dict()["beta"]}, errors="stated")
+    refit = next(r for r in cv.refits if r["state"].startswith("dem_couette"))
+    assert refit["beta"] == pytest.approx(alone.value_dict()["beta"], rel=1e-5)
+    assert refit["specularity"] == cv.full.value_dict()["specularity"]
+    assert any("do not depend on specularity" in n and "dem_couette" in n for n in cv.notes)
+    term = CouetteTerm(couette, get_model("proposed"), ["specularity", "beta"], "sigma", n_cells=60)
+    pred = term.predict({"specularity": refit["specularity"], "beta": refit["beta"]})
+    rows = {r["quantity"]: r for r in cv.rows if r["file"] == couette.path.name}
+    assert rows["tau_wall"]["error"] == pytest.approx(pred[0] / couette.tau_wall - 1, abs=1e-6)
+    assert rows["p_wall"]["error"] == pytest.approx(pred[1] / couette.p_wall - 1, abs=1e-6)

@@ -148,6 +148,8 @@ def calibrate_cmd(
     for w in ident.warnings:
         typer.echo(f"Warning: {w}", err=True)
     if cv is not None:
+        for n in cv.notes:
+            typer.echo(f"Warning: cross-validation: {n}", err=True)
         for r in cv.refits:
             if not r["success"]:
                 typer.echo(f"Warning: refit without {r['state']} did not converge: {r['message']}", err=True)
