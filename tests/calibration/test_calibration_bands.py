@@ -83,7 +83,7 @@ def test_older_model_file_without_covariance_rebuilds_it(fitted, tmp_path):
     f = tmp_path / "old.toml"
     f.write_text(text)
     fit = tomllib.loads(fitted.read_text())["fit"]
-    names, c = load_model_file(f).covariance()
+    _, c = load_model_file(f).covariance()
     np.testing.assert_allclose(c, np.array(fit["covariance"]), rtol=1e-10)
 
 

@@ -128,8 +128,8 @@ def test_identifiability_of_constructed_jacobians():
     assert "do not depend on y" in dead.warnings[0]
     corr = np.array([[1.0, -0.97], [-0.97, 1.0]])
     near = identifiability(np.column_stack([a, b]), ["x", "y"], corr)
-    assert near.warnings == (f"parameters x and y are -0.9700 correlated (|corr| > {CORRELATION_WARNING:g}): "
-                             "the data determine mainly one combination of them",)
+    assert near.warnings == ((f"parameters x and y are -0.9700 correlated (|corr| > {CORRELATION_WARNING:g}): "
+                              "the data determine mainly one combination of them"),)
 
 
 def test_degenerate_pair_is_named_with_its_correlation(tmp_path):

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import json
+
 import numpy as np
 import pytest
 from typer.testing import CliRunner

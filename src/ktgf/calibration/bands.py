@@ -120,7 +120,7 @@ def shear_jacobian(model: Any, names: Sequence[str], phi: np.ndarray, e: np.ndar
             with np.errstate(all="ignore"):
                 if np.all(np.isfinite(J)) or not np.all(np.isfinite(_shear_columns(model, phi, e))):
                     return J, method
-        except Exception:  # noqa: BLE001  (a part that is not JAX or array code: central differences below, and say so)
+        except Exception:  # noqa: BLE001, S110  (a part that is not JAX or array code: central differences below, and say so)
             pass
     from ..cli.shear import shear_rows
 

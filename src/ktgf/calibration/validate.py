@@ -295,4 +295,4 @@ def validate(model: Any, paths: Sequence[str | Path], *, sources: Sequence[FitSo
     return Validation(model.name, [{k: r[k] for k in order} for r in rows], tuple(sources), notes)
 
 
-__all__ = ["CASES", "FitSource", "REGISTERED_FITS", "Validation", "data_files", "detect_case", "fit_sources", "validate"]
+__all__ = ["CASES", "REGISTERED_FITS", "FitSource", "Validation", "data_files", "detect_case", "fit_sources", "validate"]
