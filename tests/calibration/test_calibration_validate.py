@@ -151,3 +151,21 @@ def test_model_file_from_another_version_with_unknown_options(tmp_path, data_dir
                      "field 'model.options.phi_j_scale': model 'dense' has no such option (file written by ktgf 9.9.0, this is ktgf")
     with pytest.raises(InputError):
         validate(get_model("dense"), [tmp_path])  # a folder without .csv files
+
+
+def test_a_state_the_model_refuses_keeps_its_rows(data_dir, tmp_path):
+    """dense diverges at φ_c = 0.64: a state at 0.65 is in the table with NaN and the refusal, the others are answered."""
+    lines = (data_dir / "dem_uniform_shear.csv").read_text().splitlines()
+    f = tmp_path / "dense_beyond.csv"
+    f.write_text("\n".join([*lines, "0.65" + lines[-1][lines[-1].index(","):]]) + "\n")
+    res = validate(get_model("dense"), [f])
+    beyond = [r for r in res.rows if r["state"].startswith("phi=0.65")]
+    assert len(beyond) == 3 and all(np.isnan(r["model"]) and "out of range" in r["note"] for r in beyond)
+    assert all(np.isfinite(r["model"]) for r in res.rows if not r["state"].startswith("phi=0.65"))
+
+
+def test_couette_file_with_a_broken_header_is_bad_input(data_dir, tmp_path):
+    text = (data_dir / "dem_couette_e0.9_phi0.50.csv").read_text()
+    f = tmp_path / "c.csv"
+    f.write_text(text.replace("wall shear stress tau", "wall stress"))
+    _one_line_exit_2(["validate", "--model", "dense", "--data", str(f)], "header field tau not found")

@@ -125,20 +125,25 @@ def _row(case: str, path: Path, state: str, key: tuple, quantity: str, model: fl
 
 
 def _uniform_shear(model: Any, path: Path) -> list[dict[str, Any]]:
-    from .data import read_uniform_shear
+    from .data import UniformShearData, read_uniform_shear
     from .residuals import shear_prediction
 
     d = read_uniform_shear(path)
     m0 = _at_mu(model, 0.0)
-    pred = np.asarray(shear_prediction(m0, d), dtype=float)
     obs, sig = d.observed()
     n = len(d.phi)
     rows = []
-    for i in range(n):
+    for i in range(n):  # state by state: a state the model refuses keeps its rows, with the refusal
+        one = UniformShearData(d.path, d.phi[i:i + 1], d.e[i:i + 1], {}, {})
+        try:
+            m0.check(one.phi, one.e)  # refuse before evaluating (shear_prediction evaluates χ unchecked first)
+            pred, note = np.asarray(shear_prediction(m0, one), dtype=float), ""
+        except InputError as exc:
+            pred, note = np.full(len(d.values), np.nan), str(exc)
         for q, name in enumerate(d.values):
             k = q * n + i
             rows.append(_row("uniform-shear", path, f"phi={d.phi[i]:g} e={d.e[i]:g}", (0.0, float(d.phi[i]), float(d.e[i])),
-                             name, pred[k], obs[k], sig[k]))
+                             name, pred[q], obs[k], sig[k], note))
     return rows
 
 
@@ -152,6 +157,8 @@ def _frictional_shear(model: Any, path: Path, header: list[str], names: list[str
         mu, phi, e = (float(cols[c][i]) for c in ("mu", "phi", "e"))
         state, key = f"mu={mu:g} phi={phi:g} e={e:g}", (mu, phi, e)
         m = _at_mu(model, mu)
+        # a frictional stress is in Pa: in DEM units (d = m = gdot = 1) its scale rho_s d^2 gdot^2 is 6/pi
+        note = "frictional stress with stress scale rho_s d^2 gdot^2 = 6/pi (DEM units)" if m.friction.has_stress else ""
         try:
             s = model_uniform_shear(m, np.array([phi]), e, stress_scale=RHO_S_DEM if m.friction.has_stress else None)
         except InputError as exc:  # e.g. φ beyond the model's packing limit: the model gives no answer there
@@ -162,7 +169,7 @@ def _frictional_shear(model: Any, path: Path, header: list[str], names: list[str
             v = float(np.asarray(getattr(s, q))[0])
             if math.isnan(v):  # T_rot/T of a model without rotation: nothing to compare
                 continue
-            rows.append(_row("frictional-shear", path, state, key, q, v, cols[q][i], cols[s_][i]))
+            rows.append(_row("frictional-shear", path, state, key, q, v, cols[q][i], cols[s_][i], note))
     return rows
 
 
@@ -170,9 +177,12 @@ def _couette(model: Any, path: Path, walls: dict[str, float] | None, n_cells: in
     from ..couette.compare import compare_with_dem
     from .data import read_couette
 
-    d = read_couette(path)
+    d = read_couette(path)  # a file error is bad input (exit 2); a model that gives no answer is a note
     m0 = _at_mu(model, 0.0)
-    (r,), _ = compare_with_dem(path, [m0], n_cells=n_cells, walls={m0.name: walls} if walls else None)
+    try:
+        (r,), _ = compare_with_dem(path, [m0], n_cells=n_cells, walls={m0.name: walls} if walls else None)
+    except (ConvergenceError, InputError) as exc:
+        raise _NoAnswer(f"{path.name}: no Couette prediction: {exc}") from None
     how = (f"walls from the model file (specularity {r['specularity']:.4g})" if walls else
            f"JJ walls, specularity {r['specularity']:.4g} fitted to the DEM slip")
     note = how + ("" if r["valid"] else f"; profile INVALID (max phi {r['max_phi']:.3g}) {r['message']}".rstrip())
@@ -180,6 +190,10 @@ def _couette(model: Any, path: Path, walls: dict[str, float] | None, n_cells: in
     key = ("couette",)
     return [_row("couette", path, state, key, "tau_wall", r["tau_wall"], d.case.tau_wall, d.case.tau_wall_sigma, note),
             _row("couette", path, state, key, "p_wall", r["p"], d.case.p_wall, d.case.p_wall_sigma, note)]
+
+
+class _NoAnswer(Exception):
+    """The model gives no answer for a file's case (solver failure, a state it refuses): a note, not an error."""
 
 
 def _hcs(model: Any, path: Path, header: list[str], names: list[str], table: np.ndarray) -> list[dict[str, Any]]:
@@ -279,8 +293,8 @@ def validate(model: Any, paths: Sequence[str | Path], *, sources: Sequence[FitSo
         elif case == "couette":
             try:
                 new = _couette(model, path, walls, n_cells)
-            except ConvergenceError as exc:
-                notes.append(f"{path.name}: the Couette solve failed: {exc}")
+            except _NoAnswer as exc:
+                notes.append(str(exc))
                 new = []
         else:
             new = _hcs(model, path, header, names, table)
