@@ -109,7 +109,7 @@ def test_markdown_and_table_formats(data_dir):
     assert r.stdout.startswith("| file | case | state | quantity | model | dem | dem_sigma | error | role | note |")
     r = runner.invoke(app, ["validate", "--model", "ret", "--data", str(data_dir / "dem_hcs_cooling.csv")])
     assert r.exit_code == 0, r.output
-    assert "no fit provenance for model 'ret'" in r.stdout
+    assert "no fit recorded for model 'ret'" in r.stdout
 
 
 # -- bad input: one line naming it, exit 2 -------------------------------------------------------

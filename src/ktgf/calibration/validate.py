@@ -304,7 +304,8 @@ def validate(model: Any, paths: Sequence[str | Path], *, sources: Sequence[FitSo
             r["role"] = "fitted" if fitted is not None and key in fitted else "predicted"
         rows += new
     if not sources:
-        notes.append(f"no fit provenance for model {model.name!r}: every row is marked predicted")
+        notes.append(f"no fit recorded for model {model.name!r} (published parameters, or a model file without "
+                     "[[provenance.data]]): every row is marked predicted")
     order = ("file", "case", "state", "quantity", "model", "dem", "dem_sigma", "error", "role", "note")
     return Validation(model.name, [{k: r[k] for k in order} for r in rows], tuple(sources), notes)
 
