@@ -6,7 +6,7 @@ boxes of 0.7 L⊥ (16³), 1.5 L⊥ (32³) and 1.3 L∥ (32³), τ = 16, IMEX.
 
 Prints per run: wall and CPU time, the first (compiling) chunk's wall time, steps, wall time per
 step, binding step limit, the end/start ratios of K⊥/θ and of the density variance, and the
-verdict of tests/test_solver_paper.py (which uses the same :data:`CASES`, :func:`paper_config` and
+verdict of tests/solver/test_solver_paper.py (which uses the same :data:`CASES`, :func:`paper_config` and
 :func:`verdict`); then the totals and the load average before and after (the machine is shared:
 CPU time is the figure that does not depend on the other users).
 """

@@ -43,7 +43,7 @@ from _chute_case import bagnold_case  # noqa: E402
 from ktgf.closures import get_model  # noqa: E402
 from ktgf.couette.chute import solve_chute  # noqa: E402
 from ktgf.couette.run import Material  # noqa: E402
-from ktgf.couette.uniform_shear import uniform_shear  # noqa: E402
+from ktgf.shear.steady import steady_shear  # noqa: E402
 
 MAT = Material(d=1e-3, rho_s=2500.0, e=0.9)
 MEAN_PHI = 0.3
@@ -59,7 +59,7 @@ def bagnold_shape_error(y: np.ndarray, u: np.ndarray, H: float, lo: float = 0.25
 
 def oned(angle: float) -> None:
     model = get_model("ret")
-    ratios = [float(uniform_shear(model, p, MAT.e).stress_ratio) for p in np.linspace(0.002, 0.6, 300)]
+    ratios = [float(steady_shear(model, p, MAT.e).tau_over_p) for p in np.linspace(0.002, 0.6, 300)]
     print(f"RET e = {MAT.e}: uniform-shear |P_xy|/p spans {min(ratios):.4f} … {max(ratios):.4f}, i.e. a local "
           f"Bagnold balance exists for {math.degrees(math.atan(min(ratios))):.2f}° … "
           f"{math.degrees(math.atan(max(ratios))):.2f}°; tan {angle:g}° = {math.tan(math.radians(angle)):.4f}")

@@ -1,7 +1,7 @@
 """Convergence map of the frictional Couette cell from the naive start (docs/friction.md §8).
 
 Frictional particles (model ``frictional``, frictional stress Schaeffer or Srivastava–Sundaresan) between
-Johnson–Jackson walls with a wall friction angle δ_w; the cell of ``tests/test_friction_couette.py``
+Johnson–Jackson walls with a wall friction angle δ_w; the cell of ``tests/couette/test_friction_couette.py``
 (20 d planar, 80 cells, e = 0.7, φ' = 0.2, e_w = 0.85, ρ_s V² = 2500 Pa).  Prints one markdown row per case:
 converged?, solver path, wall and CPU seconds, max φ, the validity verdict, and the machine load.
 

@@ -16,14 +16,16 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ktgf import PAPER_MODELS, get_model
-from ktgf.closures.dense import DENSE_BETA, fit_rdf_option, relative_errors
+from ktgf.calibration.registry_fits import fit_rdf_option, relative_errors
+from ktgf.closures.dense import DENSE_BETA
 from ktgf.closures.dissipation import CorrelationLength
 from ktgf.closures.rdf import JammingPowerLaw, ViscosityDivergence
-from ktgf.couette.uniform_shear import load_uniform_shear, shear_state
+from ktgf.data import uniform_shear_records
+from ktgf.shear.steady import steady_shear
 
 data = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parents[2] / "shared" / "data"
-fit_rows = load_uniform_shear(data / "dem_uniform_shear.csv")
-held_rows = load_uniform_shear(data / "dem_uniform_shear_friction.csv", where={"mu": 0.0})
+fit_rows = uniform_shear_records(data / "dem_uniform_shear.csv")
+held_rows = uniform_shear_records(data / "dem_uniform_shear_friction.csv", where={"mu": 0.0})
 COLS = ["phi", "e", "T", "eta_over_eta0", "p_over_nT"]
 rows = np.concatenate([fit_rows[COLS], held_rows[COLS]])
 role = ["fit"] * fit_rows.size + ["held out"] * held_rows.size
@@ -34,7 +36,7 @@ def table(models):
           "| T model | T DEM | err T |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name, m in models:
-        s = shear_state(m, rows["phi"], rows["e"])
+        s = steady_shear(m, rows["phi"], rows["e"])
         for i, rec in enumerate(rows):
             eta, p, T = (float(np.broadcast_to(v, rows.shape)[i]) for v in (s.eta_over_eta0, s.p_over_nT, s.T))
             print(f"| {name} | {rec['phi']:g} | {rec['e']:g} | {role[i]} | {eta:.3f} | {rec['eta_over_eta0']:.3f} | "

@@ -21,10 +21,10 @@ DATA = SHARED / "data"
 
 @pytest.fixture(scope="session")
 def data_dir() -> Path:
-    """The DEM reference data folder; tests that need it skip (saying so) when it is absent."""
-    if not DATA.is_dir():
-        pytest.skip(f"reference data folder {DATA} is absent")
-    return DATA
+    """The DEM reference data shipped in the package (a copy of ``shared/data``: ``tests/data/test_shipped.py``)."""
+    from ktgf.data import shipped_data_dir
+
+    return shipped_data_dir()
 
 
 def run_temp(tmp_path_factory) -> Path:

@@ -9,13 +9,7 @@ from ._startup import quit_on_interrupt_outside_the_run_loop
 
 quit_on_interrupt_outside_the_run_loop()  # before the slow imports below
 
-from importlib.metadata import PackageNotFoundError, version  # noqa: E402
-
-try:
-    __version__ = version("ktgf")
-except PackageNotFoundError:  # running from a source tree without installation
-    __version__ = "0+unknown"
-
+from ._version import __version__  # noqa: E402
 from .closures import PAPER_MODELS, Model, get_model, list_models, register_model
 from .errors import ConvergenceError, DivergenceError, InputError, KtgfError, UnknownModelError
 

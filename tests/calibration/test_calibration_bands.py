@@ -19,15 +19,19 @@ from ktgf.calibration import read_data
 from ktgf.calibration.bands import SHEAR_BAND_COLUMNS, couette_bands, delta_sigma, shear_bands
 from ktgf.calibration.model_file import load_model_file
 from ktgf.cli import app
-from ktgf.couette.uniform_shear import shear_state
+from ktgf.shear.steady import steady_shear
 
 runner = CliRunner()
 
 
 def _columns(model, phi, e):
-    s = shear_state(model, phi, e)
-    return np.array([s.T, s.eta_star, s.eta_over_eta0, s.p_over_nT, s.astar, s.stress_ratio, s.L_over_d,
-                     phi * s.p_over_nT * s.T])
+    """The banded columns point by point (a friction part solves its rotational balance for one e at a time)."""
+    out = []
+    for p, q in zip(phi, e):
+        s = steady_shear(model, np.array([p]), float(q))
+        out.append([s.T[0], s.eta_star[0], s.eta_over_eta0[0], s.p_over_nT[0], s.astar[0], s.tau_over_p[0], s.L_over_d[0],
+                    p * s.p_over_nT[0] * s.T[0]])
+    return np.array(out).T
 
 
 def test_delta_sigma_is_the_diagonal_of_j_c_jt():
@@ -101,8 +105,8 @@ def test_shear_prints_bands_for_the_model_file_rows(fitted):
     J = np.empty((phi.size, len(names)))
     for j, n in enumerate(names):
         h = 1e-6 * x[n]
-        J[:, j] = (shear_state(m.with_options(**{n: x[n] + h}), phi, 0.9).p_over_nT
-                   - shear_state(m.with_options(**{n: x[n] - h}), phi, 0.9).p_over_nT) / (2 * h)
+        J[:, j] = (steady_shear(m.with_options(**{n: x[n] + h}), phi, 0.9).p_over_nT
+                   - steady_shear(m.with_options(**{n: x[n] - h}), phi, 0.9).p_over_nT) / (2 * h)
     np.testing.assert_allclose([row["p_over_nT_sd"] for row in rows[2:]], delta_sigma(J, C), rtol=1e-5)
     assert all(row["p_over_nT_sd"] > 0 for row in rows[2:])
     assert "delta method" in r.stderr
@@ -147,3 +151,21 @@ def test_couette_compare_prints_bands_for_the_model_file(fitted, data_dir, tmp_p
     assert own["tau_wall_sd"] == pytest.approx(sd["tau_wall"], rel=1e-6) and own["tau_wall_sd"] > 0
     assert own["p_sd"] == pytest.approx(sd["p"], rel=1e-6)
     assert "specularity follows the parameters" in r.stderr
+
+
+def test_fallback_through_the_rows_gives_the_same_jacobian(monkeypatch):
+    """A model the vectorised paths cannot evaluate falls back to checked evaluations, one e at a time (mixed e)."""
+    import ktgf.calibration.bands as bands
+
+    m = get_model("frictional")
+    phi, e = np.array([0.3, 0.5, 0.4]), np.array([0.7, 0.9, 0.7])
+    J, used = bands.shear_jacobian(m, ["c"], phi, e)
+    assert used == "jax"
+
+    def fail(*args, **kwargs):
+        raise TypeError("not traceable")
+
+    monkeypatch.setattr(bands, "_vectorised_jacobian", fail)
+    Jf, used = bands.shear_jacobian(m, ["c"], phi, e)
+    assert used == "central differences, point by point"
+    np.testing.assert_allclose(Jf, J, rtol=1e-6, atol=1e-12)

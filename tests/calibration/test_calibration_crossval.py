@@ -19,7 +19,7 @@ from ktgf.calibration import calibrate, read_data
 from ktgf.calibration.crossval import cross_validate, states_of
 from ktgf.calibration.fit import CORRELATION_WARNING, identifiability
 from ktgf.cli import app
-from ktgf.couette.uniform_shear import shear_state
+from ktgf.shear.steady import steady_shear
 from ktgf.errors import InputError
 
 runner = CliRunner()
@@ -38,7 +38,7 @@ def write_shear(path, phi, T, eta, p, rel_sigma=0.01):
 
 def model_data(path, model, phi, scale=None):
     """Uniform-shear states of ``model``; ``scale`` multiplies η/η0 and p/(nT) state by state (a known misfit)."""
-    s = shear_state(model, np.asarray(phi, float), 0.9)
+    s = steady_shear(model, np.asarray(phi, float), 0.9)
     k = np.ones(len(phi)) if scale is None else np.asarray(scale, float)
     return write_shear(path, phi, s.T, s.eta_over_eta0 * k, s.p_over_nT * k)
 
@@ -61,7 +61,7 @@ def _independent_refit(model, phi, T, eta, p, sig, start):
     obs, s = np.concatenate([T, eta, p]), np.concatenate(sig)
 
     def r(x):
-        st = shear_state(model.with_options(beta=float(x[0])), np.asarray(phi), 0.9)
+        st = steady_shear(model.with_options(beta=float(x[0])), np.asarray(phi), 0.9)
         return (np.concatenate([st.T, st.eta_over_eta0, st.p_over_nT]) - obs) / s
 
     return least_squares(r, [start], bounds=([0.05], [6.0]), xtol=1e-14, ftol=1e-14, gtol=1e-14).x[0]
@@ -79,7 +79,7 @@ def test_left_out_errors_match_independent_refits(tmp_path):
         keep = [j for j in range(len(PHI)) if j != i]
         beta = _independent_refit(model, np.array(PHI)[keep], *(data.values[k][keep] for k in ("T", "eta_over_eta0", "p_over_nT")),
                                   [s[keep] for s in sig], cv.full.value_dict()["beta"])
-        st = shear_state(model.with_options(beta=beta), np.array([PHI[i]]), 0.9)
+        st = steady_shear(model.with_options(beta=beta), np.array([PHI[i]]), 0.9)
         rows = {r["quantity"]: r for r in cv.rows if r["state"].endswith(f"phi={PHI[i]:g} e=0.9")}
         assert rows["eta_over_eta0"]["refit_beta"] == pytest.approx(beta, rel=1e-5)
         assert rows["eta_over_eta0"]["error"] == pytest.approx(st.eta_over_eta0[0] / data.values["eta_over_eta0"][i] - 1, abs=1e-6)

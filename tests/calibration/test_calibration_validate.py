@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 from ktgf import get_model
 from ktgf.calibration.validate import detect_case, fit_sources, validate
 from ktgf.cli import app
-from ktgf.couette.uniform_shear import shear_state
+from ktgf.shear.steady import steady_shear
 from ktgf.errors import InputError
 
 runner = CliRunner()
@@ -62,7 +62,7 @@ def test_dem_columns_and_errors(dense_table, data_dir):
             for q in ("T", "eta_over_eta0", "p_over_nT"):
                 assert got[q]["dem"] == float(d[q]) and got[q]["dem_sigma"] == float(d["d" + q])
                 assert got[q]["error"] == pytest.approx(got[q]["model"] / float(d[q]) - 1, rel=1e-12)
-            s = shear_state(get_model("dense"), np.array([float(d["phi"])]), float(d["e"]))
+            s = steady_shear(get_model("dense"), np.array([float(d["phi"])]), float(d["e"]))
             assert got["eta_over_eta0"]["model"] == pytest.approx(s.eta_over_eta0[0], rel=1e-12)
     fr = {(r["state"], r["quantity"]): r for r in rows if r["file"] == "dem_uniform_shear_friction.csv"}
     d = next(x for x in _rows(data_dir / "dem_uniform_shear_friction.csv") if float(x["mu"]) == 0.5 and float(x["phi"]) == 0.4)

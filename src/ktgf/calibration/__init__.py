@@ -10,7 +10,7 @@ Jacobians), :mod:`.fit` (the driver), :mod:`.model_file` (the TOML files every c
 with ``--model-file``).  See ``docs/calibration.md``.
 """
 
-from .data import CouetteCase, CouetteData, UniformShearData, read_couette, read_couette_case, read_data, read_uniform_shear
+from ..data import CouetteCase, CouetteData, UniformShearData, read_couette, read_couette_case, read_data, read_uniform_shear
 from .fit import FitResult, calibrate, fittable_parameters
 
 __all__ = [

@@ -6,11 +6,11 @@ a band is honest where the prediction is close to linear over ±σ of the parame
 only the parameters' uncertainty (not the model's own error, which cross-validation measures).
 
 uniform shear
-    J by ``jax.jacfwd`` of the closed forms (:func:`ktgf.couette.uniform_shear.shear_state`,
+    J by ``jax.jacfwd`` of the closed forms (:func:`ktgf.shear.steady.steady_shear`,
     ``check=False``) with the fitted options as JAX values, compiled once per process and model; or
     (``method="differences"``) by central differences evaluated in one vectorised NumPy call, which
     spares a single command the JAX import and compilation (seconds, more than the prediction).
-    Central differences of the rows for a model whose closures cannot be traced or that carries a
+    Central differences point by point for a model whose closures cannot be traced or that carries a
     frictional stress (NumPy-only); the result says which.
 Couette cell
     J by the implicit-function theorem of :class:`~ktgf.calibration.residuals.CouetteTerm` (the
@@ -39,16 +39,14 @@ def delta_sigma(J: np.ndarray, cov: np.ndarray) -> np.ndarray:
     return np.sqrt(np.maximum(var, 0.0))
 
 
-def _shear_columns(model: Any, phi: Any, e: Any) -> Any:
+def _shear_columns(model: Any, phi: Any, e: Any, stress_scale: float | None = None) -> Any:
     """The banded columns of the uniform-shear state, stacked (NumPy or JAX, no range checks)."""
     from .._array import namespace
-    from ..couette.uniform_shear import shear_state
+    from ..shear.steady import steady_shear
 
-    s = shear_state(model, phi, e, check=False)
+    s = steady_shear(model, phi, e, stress_scale=stress_scale, check=False)
     xp = namespace(s.T, s.eta_over_eta0)
-    cols = {"T": s.T, "eta_star": s.eta_star, "eta_over_eta0": s.eta_over_eta0, "p_over_nT": s.p_over_nT,
-            "astar": s.astar, "tau_over_p": s.stress_ratio, "L_over_d": s.L_over_d, "p_star": phi * s.p_over_nT * s.T}
-    return xp.stack([xp.broadcast_to(cols[k], xp.shape(phi)) * 1.0 for k in SHEAR_BAND_COLUMNS])
+    return xp.stack([xp.broadcast_to(getattr(s, k), xp.shape(phi)) * 1.0 for k in SHEAR_BAND_COLUMNS])
 
 
 #: ``jit(jacfwd(...))`` of the banded columns by (model, names, shape of the points): op-by-op
@@ -57,19 +55,20 @@ _JACOBIANS: dict[tuple, Any] = {}
 _JACOBIANS_MAX = 16
 
 
-def _compiled_jacobian(model: Any, names: tuple[str, ...], shape: tuple[int, ...]) -> Any:
+def _compiled_jacobian(model: Any, names: tuple[str, ...], shape: tuple[int, ...], e_value: float | None = None) -> Any:
+    """``fn(x, phi, e)``; with ``e_value`` the restitution is that constant (``e`` is ignored) and part of the key."""
     import jax
 
     from .residuals import traced_model
 
-    key = (model, names, shape)
+    key = (model, names, shape, e_value)
     try:
         fn = _JACOBIANS.get(key)
     except TypeError:  # an unhashable option: no caching
         key, fn = None, None
     if fn is None:
         def f(x, phi, e):
-            return _shear_columns(traced_model(model, dict(zip(names, x))), phi, e)
+            return _shear_columns(traced_model(model, dict(zip(names, x))), phi, e if e_value is None else e_value)
 
         fn = jax.jit(jax.jacfwd(f))
         if key is not None:
@@ -82,16 +81,41 @@ def _compiled_jacobian(model: Any, names: tuple[str, ...], shape: tuple[int, ...
 JACOBIANS = ("jax", "differences")
 
 
+def _vectorised_jacobian(model: Any, names: Sequence[str], x: np.ndarray, h: np.ndarray, phi: np.ndarray, e: Any,
+                         method: str) -> np.ndarray:
+    """(columns, points, parameters) by JAX or by vectorised central differences (see :func:`shear_jacobian`)."""
+    from .residuals import enable_x64, traced_model
+
+    if method == "jax":
+        import jax.numpy as jnp
+
+        enable_x64()
+        scalar = np.ndim(e) == 0
+        fn = _compiled_jacobian(model, tuple(names), phi.shape, float(e) if scalar else None)
+        return np.asarray(fn(jnp.asarray(x, dtype=jnp.float64), jnp.asarray(phi), jnp.asarray(e)))
+    X = np.repeat(x[None, :], 2 * x.size, axis=0)
+    for j in range(x.size):
+        X[2 * j, j] += h[j]
+        X[2 * j + 1, j] -= h[j]
+    shape = (2 * x.size, phi.size)
+    with np.errstate(all="ignore"):
+        cols = _shear_columns(traced_model(model, {n: X[:, j:j + 1] for j, n in enumerate(names)}),
+                              np.broadcast_to(phi, shape), e if np.ndim(e) == 0 else np.broadcast_to(e, shape))
+    return np.stack([(cols[:, 2 * j] - cols[:, 2 * j + 1]) / (2 * h[j]) for j in range(x.size)], axis=-1)
+
+
 def shear_jacobian(model: Any, names: Sequence[str], phi: np.ndarray, e: np.ndarray, *,
                    stress_scale: float | None = None, method: str = "jax") -> tuple[np.ndarray, str]:
-    """∂(banded columns)/∂(options ``names``) at the model's values: array (columns, points, parameters), method used.
+    """∂(banded columns)/∂(options ``names``) at the points (φ_i, e_i): array (columns, points, parameters), method used.
 
     ``method="jax"``: ``jax.jit(jax.jacfwd(...))`` (exact; the first call in a process imports JAX and
     compiles, ~1–3 s); ``"differences"``: central differences, all 2n parameter sets in one vectorised
-    NumPy evaluation (options set as column arrays; relative error ~1e-8, no JAX).  A model that JAX
-    cannot trace, or with a frictional stress, falls back to central differences of ``ktgf shear``'s rows.
+    NumPy evaluation (options set as column arrays; relative error ~1e-8, no JAX).  A model with a friction
+    part is evaluated one restitution at a time (its rotational balance is solved for a scalar e).  A model
+    that cannot be traced, or with a frictional stress, falls back to central differences of
+    :func:`~ktgf.shear.steady.steady_shear` one restitution at a time (checked, as ``ktgf shear``).
     """
-    from .residuals import enable_x64, model_at, traced_model
+    from .residuals import model_at
 
     if method not in JACOBIANS:
         raise InputError(f"band Jacobian {method!r} is not valid; choose one of {', '.join(JACOBIANS)}")
@@ -99,39 +123,28 @@ def shear_jacobian(model: Any, names: Sequence[str], phi: np.ndarray, e: np.ndar
     phi, e = np.asarray(phi, dtype=float), np.asarray(e, dtype=float)
     x = np.array([values[n] for n in names])
     h = 1e-6 * np.maximum(np.abs(x), 1e-2)
+    by_e = [(np.flatnonzero(e == v), float(v)) for v in np.unique(e)]
+    J = np.empty((len(SHEAR_BAND_COLUMNS), phi.size, x.size))
     if not model.friction.has_stress:
         try:
-            if method == "jax":
-                import jax.numpy as jnp
-
-                enable_x64()
-                fn = _compiled_jacobian(model, tuple(names), phi.shape)
-                J = np.asarray(fn(jnp.asarray(x, dtype=jnp.float64), jnp.asarray(phi), jnp.asarray(e)))
-            else:
-                X = np.repeat(x[None, :], 2 * x.size, axis=0)
-                for j in range(x.size):
-                    X[2 * j, j] += h[j]
-                    X[2 * j + 1, j] -= h[j]
-                shape = (2 * x.size, phi.size)
-                with np.errstate(all="ignore"):
-                    cols = _shear_columns(traced_model(model, {n: X[:, j:j + 1] for j, n in enumerate(names)}),
-                                          np.broadcast_to(phi, shape), np.broadcast_to(e, shape))
-                J = np.stack([(cols[:, 2 * j] - cols[:, 2 * j + 1]) / (2 * h[j]) for j in range(x.size)], axis=-1)
+            groups = by_e if model.friction.key != "none" else [(np.arange(phi.size), e)]
+            for idx, ev in groups:
+                J[:, idx, :] = _vectorised_jacobian(model, names, x, h, phi[idx], ev, method)
             with np.errstate(all="ignore"):
-                if np.all(np.isfinite(J)) or not np.all(np.isfinite(_shear_columns(model, phi, e))):
+                if np.all(np.isfinite(J)) or not all(np.all(np.isfinite(_shear_columns(model, phi[i], v))) for i, v in by_e):
                     return J, method
         except Exception:  # noqa: BLE001, S110  (a part that is not JAX or array code: central differences below, and say so)
             pass
-    from ..cli.shear import shear_rows
+    from ..shear.steady import steady_shear
 
-    def g(v: dict[str, float]) -> np.ndarray:
-        rows = shear_rows(model_at(model, v), phi, e, stress_scale)
-        return np.array([[r[k] for r in rows] for k in SHEAR_BAND_COLUMNS])
+    for idx, ev in by_e:  # one restitution at a time, as ktgf shear (a friction part needs a scalar e)
+        def g(v: dict[str, float], idx=idx, ev=ev) -> np.ndarray:
+            s = steady_shear(model_at(model, v), phi[idx], ev, stress_scale=stress_scale)
+            return np.array([np.broadcast_to(getattr(s, k), idx.shape) for k in SHEAR_BAND_COLUMNS])
 
-    J = np.empty((len(SHEAR_BAND_COLUMNS), phi.size * e.size, len(names)))
-    for j, n in enumerate(names):
-        J[:, :, j] = (g({**values, n: values[n] + h[j]}) - g({**values, n: values[n] - h[j]})) / (2 * h[j])
-    return J, "central differences of the rows"
+        for j, n in enumerate(names):
+            J[:, idx, j] = (g({**values, n: values[n] + h[j]}) - g({**values, n: values[n] - h[j]})) / (2 * h[j])
+    return J, "central differences, point by point"
 
 
 def shear_bands(model: Any, names: Sequence[str], cov: np.ndarray, phi: np.ndarray, e: np.ndarray, *,

@@ -24,7 +24,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..errors import InputError
-from .data import CouetteData
+from ..data import CouetteData
 from .fit import FitResult, calibrate
 from .residuals import COUETTE_OBSERVABLES, make_terms
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..closures.models import Model
 from ..errors import ConvergenceError, InputError
-from .data import CouetteData, UniformShearData
+from ..data import CouetteData, UniformShearData
 from .residuals import DEFAULT_SPECULARITY, WALL_PARAMETERS, make_terms, model_at
 
 #: Bounds of the common options (φ_c, φ_f, β, a, RDF exponent); other float options default to (0, ∞)
@@ -200,7 +200,7 @@ def calibrate(model: Model, datasets: Sequence[Any], names: Sequence[str], *, st
               bounds: dict[str, tuple[float, float]] | None = None, weights: str = "sigma", errors: str | None = None,
               walls: dict[str, float] | None = None, n_cells: int = 200, max_evaluations: int = 100,
               keep: np.ndarray | None = None) -> FitResult:
-    """Fit parameters ``names`` of ``model`` to ``datasets`` (from :func:`ktgf.calibration.data.read_data`).
+    """Fit parameters ``names`` of ``model`` to ``datasets`` (from :func:`ktgf.data.read_data`).
 
     Parameters
     ----------

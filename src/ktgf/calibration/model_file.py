@@ -243,9 +243,9 @@ def fit_text(result: Any, *, command: str = "", start_file: ModelFile | None = N
     """Model-file text of a calibration (:class:`~ktgf.calibration.fit.FitResult`), with its provenance."""
     import datetime
 
-    from .. import __version__
+    from .._version import __version__
     from ..closures.models import get_model
-    from .data import file_hash
+    from ..data import file_hash
 
     reference = get_model(result.base)
     if start_file is not None and start_file.rdf:  # options are written relative to the swapped part's defaults

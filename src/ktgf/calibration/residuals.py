@@ -11,14 +11,14 @@ Jacobians
 ---------
 uniform shear
     ``jax.jacfwd`` through :meth:`Model.reduced` (``check=False``) and the closed form
-    :func:`ktgf.couette.uniform_shear.uniform_shear`: exact to round-off.
+    :func:`ktgf.shear.steady.steady_shear`: exact to round-off.
 Couette
     implicit-function theorem at the converged solution X(p) of R(X, p) = 0:
     dX/dp = −(∂R/∂X)⁻¹ ∂R/∂p with ∂R/∂X the solver's own sparse Jacobian (central
     differences, O(h²)) factorised once, and ∂R/∂p, ∂y/∂(X, p) by central differences of the
     residual and of the observables y (the Couette residual is NumPy code, not JAX).  No re-solve
     per parameter; the error is O(h²) ≈ 1e-8 relative, checked against finite differences of
-    re-solved cells in ``tests/test_calibration_gradients.py``.
+    re-solved cells in ``tests/calibration/test_calibration_gradients.py``.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ import numpy as np
 
 from ..closures.models import Model
 from ..errors import ConvergenceError, InputError
-from .data import CouetteData, UniformShearData
+from ..data import CouetteData, UniformShearData
 
 #: Parameters of the walls (Couette data only), with their range.
 WALL_PARAMETERS = {"specularity": (1e-4, 1.0), "wall_restitution": (0.05, 1.0)}
@@ -59,7 +59,7 @@ def shear_prediction(model: Model, data: UniformShearData, *, traced: bool = Fal
     NumPy; with ``traced=True`` (options that are JAX tracers, inside ``jax.jacfwd``) JAX, without
     range checks (a tracer has no value to check; the same values are checked concretely elsewhere).
     """
-    from ..couette.uniform_shear import uniform_shear
+    from ..shear.steady import steady_temperature
 
     if traced:
         import jax.numpy as xp
@@ -67,7 +67,7 @@ def shear_prediction(model: Model, data: UniformShearData, *, traced: bool = Fal
         xp = np
     phi, e = xp.asarray(data.phi), xp.asarray(data.e)
     r = model.reduced(phi, e, check=False)
-    T = (uniform_shear(model, phi, e, check=False) if traced else uniform_shear(model, phi, e)).temperature_ratio
+    T = steady_temperature(model, phi, e, check=not traced)
     return xp.concatenate([T, r.eta, r.p])
 
 

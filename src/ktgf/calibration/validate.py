@@ -6,7 +6,7 @@ uniform shear (``phi, e, T, eta_over_eta0, p_over_nT``; no ``mu``)
     T = θ/(γ̇d)², η/η0 and p/(nT) of the Navier–Stokes closed forms (the calibration's observables,
     :func:`~ktgf.calibration.residuals.shear_prediction`), the model at μ = 0.
 frictional shear (``mu, phi, e, T, p_star, tau_over_p, Trot_over_T``)
-    T, p*, τ/p and T_rot/T of :func:`ktgf.closures.friction_shear.model_uniform_shear` with the
+    T, p*, τ/p and T_rot/T of :func:`ktgf.shear.steady.steady_shear` with the
     model at the row's μ (a frictionless model gets Walton friction, as ``ktgf shear --mu``).
 Couette (``y, phi, ux, theta``; case from the header)
     wall shear stress and wall pressure of :func:`ktgf.couette.compare.compare_with_dem`:
@@ -18,7 +18,7 @@ homogeneous cooling (``phi, e, A_main, A_early``)
 
 A row is *fitted* when its state (a row of a shear file, a Couette file) was in the data the
 model's parameters were fitted to: for a model file, the files of its ``[[provenance.data]]`` (by
-SHA-256, or by name for a file without hash) with every state :func:`ktgf.calibration.data.read_data`
+SHA-256, or by name for a file without hash) with every state :func:`ktgf.data.read_data`
 takes from them (``ktgf calibrate`` fits them all); for a registered model, :data:`REGISTERED_FITS`.
 """
 
@@ -33,7 +33,8 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..errors import ConvergenceError, InputError
-from .data import RHO_S_DEM, _check_units, _split, file_hash
+from ..data import RHO_S_DEM, file_hash
+from ..data.table import Table, check_units, read_table, resolve
 
 CASES = ("uniform-shear", "frictional-shear", "couette", "homogeneous-cooling")
 _CASE_COLUMNS = {
@@ -66,7 +67,7 @@ REGISTERED_FITS: dict[str, tuple[FitSource, ...]] = {
 
 def detect_case(path: str | Path) -> str:
     """The case of a DEM file from its columns (one-line error naming the file and its columns if none fits)."""
-    _, names, _ = _split(Path(path))
+    names = read_table(path).names
     if "y" in names:
         return "couette"
     if "A_main" in names or "A_early" in names:
@@ -88,33 +89,17 @@ def data_files(paths: Sequence[str | Path]) -> list[Path]:
             if not found:
                 raise InputError(f"--data {str(p)!r}: folder holds no .csv file")
             out += found
-        elif p.is_file():
-            out.append(p)
         else:
-            raise InputError(f"--data {str(p)!r} does not exist")
+            out.append(resolve(p))  # a file, or the bare name of a file shipped with ktgf
     if not out:
         raise InputError("no data file given (--data FILE or folder)")
     return out
 
 
 def _at_mu(model: Any, mu: float) -> Any:
-    from ..cli.shear import with_friction  # the one place that adds friction to a frictionless model
+    from ..closures.friction.model_slot import with_friction
 
     return with_friction(model, mu)
-
-
-def _checked(path: Path, names: list[str], table: np.ndarray, columns: Sequence[str]) -> dict[str, np.ndarray]:
-    missing = [c for c in columns if c not in names]
-    if missing:
-        raise InputError(f"data file {path.name}: missing column(s) {', '.join(missing)} (columns present: {', '.join(names)})")
-    out = {}
-    for c in columns:
-        v = table[:, names.index(c)]
-        bad = np.flatnonzero(~np.isfinite(v))
-        if bad.size:
-            raise InputError(f"data file {path.name}: column {c} holds NaN or a non-number in data row {int(bad[0]) + 1}")
-        out[c] = v
-    return out
 
 
 def _row(case: str, path: Path, state: str, key: tuple, quantity: str, model: float, dem: float, sigma: float,
@@ -125,7 +110,7 @@ def _row(case: str, path: Path, state: str, key: tuple, quantity: str, model: fl
 
 
 def _uniform_shear(model: Any, path: Path) -> list[dict[str, Any]]:
-    from .data import UniformShearData, read_uniform_shear
+    from ..data import UniformShearData, read_uniform_shear
     from .residuals import shear_prediction
 
     d = read_uniform_shear(path)
@@ -147,20 +132,20 @@ def _uniform_shear(model: Any, path: Path) -> list[dict[str, Any]]:
     return rows
 
 
-def _frictional_shear(model: Any, path: Path, header: list[str], names: list[str], table: np.ndarray) -> list[dict[str, Any]]:
-    from ..closures.friction_shear import model_uniform_shear
+def _frictional_shear(model: Any, path: Path, table: Table) -> list[dict[str, Any]]:
+    from ..shear.steady import steady_shear
 
-    _check_units(path, header, shear_rate=True)
-    cols = _checked(path, names, table, ("mu", "phi", "e", *[c for pair in FRICTION_QUANTITIES.items() for c in pair]))
+    check_units(table, shear_rate=True)
+    cols = table.columns(("mu", "phi", "e", *[c for pair in FRICTION_QUANTITIES.items() for c in pair]))
     rows = []
-    for i in range(table.shape[0]):
+    for i in range(table.values.shape[0]):
         mu, phi, e = (float(cols[c][i]) for c in ("mu", "phi", "e"))
         state, key = f"mu={mu:g} phi={phi:g} e={e:g}", (mu, phi, e)
         m = _at_mu(model, mu)
         # a frictional stress is in Pa: in DEM units (d = m = gdot = 1) its scale rho_s d^2 gdot^2 is 6/pi
         note = "frictional stress with stress scale rho_s d^2 gdot^2 = 6/pi (DEM units)" if m.friction.has_stress else ""
         try:
-            s = model_uniform_shear(m, np.array([phi]), e, stress_scale=RHO_S_DEM if m.friction.has_stress else None)
+            s = steady_shear(m, np.array([phi]), e, stress_scale=RHO_S_DEM if m.friction.has_stress else None)
         except InputError as exc:  # e.g. φ beyond the model's packing limit: the model gives no answer there
             rows += [_row("frictional-shear", path, state, key, q, math.nan, cols[q][i], cols[s_][i], str(exc))
                      for q, s_ in FRICTION_QUANTITIES.items()]
@@ -175,7 +160,7 @@ def _frictional_shear(model: Any, path: Path, header: list[str], names: list[str
 
 def _couette(model: Any, path: Path, walls: dict[str, float] | None, n_cells: int) -> list[dict[str, Any]]:
     from ..couette.compare import compare_with_dem
-    from .data import read_couette
+    from ..data import read_couette
 
     d = read_couette(path)  # a file error is bad input (exit 2); a model that gives no answer is a note
     m0 = _at_mu(model, 0.0)
@@ -196,15 +181,16 @@ class _NoAnswer(Exception):
     """The model gives no answer for a file's case (solver failure, a state it refuses): a note, not an error."""
 
 
-def _hcs(model: Any, path: Path, header: list[str], names: list[str], table: np.ndarray) -> list[dict[str, Any]]:
+def _hcs(model: Any, path: Path, table: Table) -> list[dict[str, Any]]:
     from ..hcs.haff import cooling_rate
 
-    if not re.search(r"(?<![A-Za-z_])d\s*=\s*m\s*=\s*1(?![\d.])", " ".join(header)):
+    if not re.search(r"(?<![A-Za-z_])d\s*=\s*m\s*=\s*1(?![\d.])", " ".join(table.header)):
         raise InputError(f"data file {path.name}: header does not state the units d = m = 1 the cooling rates are in")
-    cols = _checked(path, names, table, ("phi", "e", "A_main", "A_main_sem", "A_early"))
+    cols = table.columns(("phi", "e", "A_main", "A_main_sem", "A_early"))
+    names = table.names
     m0 = _at_mu(model, 0.0)
     rows = []
-    for i in range(table.shape[0]):
+    for i in range(table.values.shape[0]):
         phi, e = float(cols["phi"][i]), float(cols["e"][i])
         state, key = f"phi={phi:g} e={e:g}", (0.0, phi, e)
         try:
@@ -218,7 +204,8 @@ def _hcs(model: Any, path: Path, header: list[str], names: list[str], table: np.
         rows.append(_row("homogeneous-cooling", path, state, key, "A_early", a, cols["A_early"][i], math.nan, note))
         rows.append(_row("homogeneous-cooling", path, state, key, "A_main", a, cols["A_main"][i], cols["A_main_sem"][i], note))
         if "p_over_nT" in names:
-            rows.append(_row("homogeneous-cooling", path, state, key, "p_over_nT", p, table[i, names.index("p_over_nT")], math.nan, note))
+            rows.append(_row("homogeneous-cooling", path, state, key, "p_over_nT", p, table.values[i, names.index("p_over_nT")],
+                             math.nan, note))
     return rows
 
 
@@ -243,7 +230,7 @@ def _fitted_keys(path: Path, case: str, sources: Sequence[FitSource]) -> set[tup
             return {("couette",)}
         if s.states is not None:
             return {tuple(float(x) for x in k) for k in s.states}
-        from .data import read_uniform_shear
+        from ..data import read_uniform_shear
 
         try:  # ktgf calibrate fits every state its reader takes: the frictionless rows
             d = read_uniform_shear(path)
@@ -285,11 +272,11 @@ def validate(model: Any, paths: Sequence[str | Path], *, sources: Sequence[FitSo
     rows: list[dict[str, Any]] = []
     notes: list[str] = []
     for path, case in cases:
-        header, names, table = _split(path)
+        table = read_table(path)
         if case == "uniform-shear":
             new = _uniform_shear(model, path)
         elif case == "frictional-shear":
-            new = _frictional_shear(model, path, header, names, table)
+            new = _frictional_shear(model, path, table)
         elif case == "couette":
             try:
                 new = _couette(model, path, walls, n_cells)
@@ -297,7 +284,7 @@ def validate(model: Any, paths: Sequence[str | Path], *, sources: Sequence[FitSo
                 notes.append(str(exc))
                 new = []
         else:
-            new = _hcs(model, path, header, names, table)
+            new = _hcs(model, path, table)
         fitted = _fitted_keys(path, case, sources)
         for r in new:
             key = r.pop("_key")

@@ -74,7 +74,7 @@ def calibrate_cmd(
     Prints the fitted values, their correlations, the data points per parameter and a warning for any
     pair correlated beyond 0.95 or a rank-deficient Jacobian; --cross-validate adds the leave-one-state-out errors.
     """
-    from ..calibration.data import read_data
+    from ..data import read_data
     from ..calibration.fit import calibrate
     from ..calibration.model_file import fit_text, load_model_file, write_model_file
     from ..closures import get_model

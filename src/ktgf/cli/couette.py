@@ -12,10 +12,10 @@ from ._common import DASK_HELP, MODEL_HELP, VALUES_HELP, OutputFormat, emit, han
 
 def _default_dem() -> Path:
     """The DEM Couette file in the data folder of :func:`ktgf.data.locate_data_dir` (may not exist)."""
-    from ..data import DATA_ENV, locate_data_dir
+    from ..data import COUETTE, DATA_ENV, locate_data_dir
 
     folder, _ = locate_data_dir(None)
-    return (folder or Path(f"${DATA_ENV}")) / "dem_couette_e0.9_phi0.50.csv"
+    return (folder or Path(f"${DATA_ENV}")) / COUETTE
 
 
 DEFAULT_DEM = _default_dem()
@@ -100,7 +100,8 @@ def compare_cmd(
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Models on one figure (u/U, phi, sqrt(theta)/U vs y/d) with DEM points, profile errors and wall stresses against the DEM."""
-    from ..couette.compare import compare_with_dem, load_dem_couette
+    from ..couette.compare import compare_with_dem
+    from ..data import read_couette
     from ..plotting.couette import plot_profiles
     from ._common import resolve_models
 
@@ -113,10 +114,9 @@ def compare_cmd(
         if mf.walls.get("specularity") is not None:
             walls[mf.model.name] = mf.walls
     if config is None:
-        if not dem.exists():
-            from ..errors import InputError
+        from ..data.table import resolve
 
-            raise InputError(f"no config given and the DEM file {str(dem)!r} does not exist")
+        dem = resolve(dem)  # a missing file: one line naming it and the shipped files
         rows, extra = compare_with_dem(dem, chosen, n_cells=n_cells, walls=walls)
         c = extra["case"]
         band_note = _couette_bands(rows, chosen, model_file, extra["dem"], walls, n_cells)
@@ -142,7 +142,7 @@ def compare_cmd(
                 rows.append({"model": m.name, "converged": False, "valid": str(exc)[:100]})
         rows = [{**{k: "" for k in rows[0] if k not in r}, **r} for r in rows] if rows else rows
         emit(rows, fmt, title=f"Couette comparison ({config})")
-        dem_data = load_dem_couette(dem) if dem.exists() and _is_dem_case(cfg, dem) else None
+        dem_data = read_couette(dem) if dem.exists() and _is_dem_case(cfg, dem) else None
         path = plot_profiles(datasets, out, dem=dem_data)
     typer.echo(f"wrote {path}", err=fmt == OutputFormat.json)
 
@@ -178,7 +178,7 @@ def _couette_bands(rows: list[dict[str, Any]], chosen: list[Any], model_file: Pa
 
 def _is_dem_case(cfg: Any, dem: Path) -> bool:
     """True if the config is the planar cell of the DEM file's header (gap in diameters and mean phi)."""
-    from ..calibration.data import read_couette_case
+    from ..data import read_couette_case
 
     c = read_couette_case(dem)
     g = cfg.geometry

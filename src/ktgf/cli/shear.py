@@ -9,6 +9,7 @@ import typer
 
 from pathlib import Path
 
+from ..closures.friction.model_slot import with_friction  # ``--mu`` (cli/couette.py imports it from here)
 from ..errors import InputError
 from ._common import MODEL_HELP, VALUES_HELP, OutputFormat, emit, handle_errors, model_file_option, parse_values, resolve_models
 
@@ -32,48 +33,21 @@ def parse_options(items: list[str] | None) -> dict[str, Any]:
     return out
 
 
-def with_friction(model: Any, mu: float | None) -> Any:
-    """The model at friction coefficient μ (``--mu``): routed to its friction part, added if it has none.
-
-    A frictionless model given μ > 0 gets the ``coulomb`` friction part with its defaults (Walton's rule,
-    β0 = 1), its RDF unchanged; μ = 0 leaves a frictionless model as it is.
-    """
-    if mu is None:
-        return model
-    from ..closures.friction._part import check_friction_coefficient
-
-    check_friction_coefficient(mu)
-    if model.friction.key == "none":
-        return model if mu == 0.0 else model.with_options(friction="coulomb", mu=float(mu))
-    return model.with_options(mu=float(mu))
-
-
 def shear_rows(model: Any, phi: np.ndarray, e: np.ndarray, stress_scale: float | None = None) -> list[dict[str, float]]:
     """One row per (φ, e): φ, e, T, eta_star, eta_over_eta0, p_over_nT, astar, τ/p, L/d, T_rot/T, p_star, μ."""
-    from ..closures.friction_shear import model_uniform_shear
-    from ..couette.uniform_shear import shear_state
+    from ..shear.steady import steady_shear
 
     if phi.size == 0 or e.size == 0:
         raise InputError("--phi and --e need at least one value each")
     if np.any(e >= 1.0):
         raise InputError(f"restitution coefficient e = {float(e.max()):g} is out of range: valid 0 < e < 1 "
                          "(elastic spheres have no steady uniform shear)")
-    phis, es = (a.ravel() for a in np.meshgrid(phi, e, indexing="ij"))
-    s = shear_state(model, phis, es)
-    cols = {"T": s.T, "eta_star": s.eta_star, "eta_over_eta0": s.eta_over_eta0, "p_over_nT": s.p_over_nT,
-            "astar": s.astar, "tau_over_p": s.stress_ratio, "L_over_d": s.L_over_d}
-    cols = {k: np.broadcast_to(v, phis.shape).astype(float) for k, v in cols.items()}
-    fr = [model_uniform_shear(model, np.array([p]), float(q), stress_scale=stress_scale) for p, q in zip(phis, es)]
-    cols["Trot_over_T"] = np.array([float(f.Trot_over_T[0]) for f in fr])
-    cols["p_star"] = np.array([float(f.p_star[0]) for f in fr])
-    if model.friction.has_stress:  # the frictional stress adds to p and τ (docs/friction.md §5)
-        cols["tau_over_p"] = np.array([float(f.tau_over_p[0]) for f in fr])
-        cols["p_over_nT"] = np.array([float(f.p_over_nT[0]) for f in fr])
     # the frictionless columns first, in their original order; the frictional DEM file's columns after them
     order = ("T", "eta_star", "eta_over_eta0", "p_over_nT", "astar", "tau_over_p", "L_over_d", "Trot_over_T", "p_star")
     mu = float(model.friction.mu)
-    return [{"phi": float(phis[i]), "e": float(es[i]), **{k: float(cols[k][i]) for k in order}, "mu": mu}
-            for i in range(phis.size)]
+    states = [steady_shear(model, phi, float(q), stress_scale=stress_scale) for q in e]
+    return [{"phi": float(p), "e": float(q), **{k: float(np.broadcast_to(getattr(s, k), phi.shape)[i]) for k in order},
+             "mu": mu} for i, p in enumerate(phi) for q, s in zip(e, states)]
 
 
 @handle_errors

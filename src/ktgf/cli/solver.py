@@ -77,10 +77,8 @@ def plot_run(
     """Plot a run's time series: for the cooling box θ/θ_Haff, transverse and longitudinal kinetic energy / θ
     and density variance against τ; for a sheared case θ and its stresses against the strain γ̇t (and the
     profiles across the gap at the last output for the Couette cell and the chute)."""
-    import matplotlib.pyplot as plt
-
     from ..io import read_dataset, require
-    from ..plotting import save
+    from ..plotting.cooling_gas import plot_cooling_run
     from ..plotting.sheared import needs, plot_sheared_run
 
     what = "time series written by `ktgf run`"
@@ -91,16 +89,7 @@ def plot_run(
         return
     require(ds, timeseries, ("tau", "theta_mean", "theta_haff", "ke_transverse", "ke_longitudinal",
                              "density_variance"), what)
-    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
-    ax[0].plot(ds.tau, ds.theta_mean / ds.theta_haff)
-    ax[0].set_xlabel("τ")
-    ax[0].set_ylabel("θ / θ_Haff")
-    for name, label in (("ke_transverse", "K⊥/θ"), ("ke_longitudinal", "K∥/θ"), ("density_variance", "var φ/φ²")):
-        ax[1].semilogy(ds.tau, ds[name] / (ds.theta_mean if name.startswith("ke") else 1.0), label=label)
-    ax[1].set_xlabel("τ")
-    ax[1].legend()
-    fig.suptitle(f"{ds.attrs.get('model_label', '')} HCS")
-    typer.echo(f"wrote {save(fig, out)}")
+    typer.echo(f"wrote {plot_cooling_run(ds, out)}")
 
 
 def register(app: typer.Typer, plot_app: typer.Typer) -> None:

@@ -22,7 +22,7 @@ with any theory.
 Where it applies: the factor needs the local shear measure s = d γ̇/√θ.  With ``shear=None``
 (homogeneous cooling, the HCS stability analysis, the 3D solver, the Couette solver) s = 0 and
 L = d: the standard theory, exactly.  The uniform-shear closed forms
-(:mod:`ktgf.couette.uniform_shear`) solve the energy balance with L consistently.
+(:mod:`ktgf.shear.steady`) solve the energy balance with L consistently.
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ def ekt_j(e: Any, G: Any) -> Any:
     """J(e, G) of extended kinetic theory (Jenkins & Berzi 2010), G = φχ.
 
     Equal to the Garzó–Dufty (1999) shear viscosity without the Sonine correction divided by
-    (8/(5√π)) ρ_s d φ G √T (the Enskog value at e = 1; ``tests/test_dense_models.py``).
+    (8/(5√π)) ρ_s d φ G √T (the Enskog value at e = 1; ``tests/closures/test_dense_models.py``).
     """
     num = (5.0 + 2.0 * (1.0 + e) * (3.0 * e - 1.0) * G) * (5.0 + 4.0 * (1.0 + e) * G)
     den = (24.0 - 6.0 * (1.0 - e) ** 2 - 5.0 * (1.0 - e**2)) * G**2

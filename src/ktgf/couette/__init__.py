@@ -2,7 +2,7 @@
 
 Modules: :mod:`.geometry` (cells, grids, metrics), :mod:`.walls` (Johnson–Jackson, prescribed,
 zero-flux walls), :mod:`.equations` (discrete balances), :mod:`.solver` (Newton, pseudo-transient
-and homotopy continuation), :mod:`.uniform_shear` (closed forms), :mod:`.run` (Dataset output),
+and homotopy continuation), :mod:`.run` (Dataset output),
 :mod:`.config` (validated TOML configs), :mod:`.compare` (four models, DEM data), :mod:`.chute`
 (steady gravity-driven inclined layer, :func:`solve_chute`).
 
@@ -26,10 +26,9 @@ from .compare import report_profiles
 from .equations import Problem
 from .geometry import AnnularCell, PlanarCell, stretched_nodes
 from .solver import CouetteConvergenceError, solve
-from .uniform_shear import UniformShear, uniform_shear
 from .walls import Wall
 
 __all__ = [
-    "AnnularCell", "CouetteConvergenceError", "InclinedLayer", "PlanarCell", "Problem", "report_profiles", "UniformShear", "Wall",
-    "solve", "solve_chute", "stretched_nodes", "uniform_shear",
+    "AnnularCell", "CouetteConvergenceError", "InclinedLayer", "PlanarCell", "Problem", "report_profiles", "Wall",
+    "solve", "solve_chute", "stretched_nodes",
 ]

@@ -46,7 +46,7 @@ solver: lengths in d, velocities in √(gH), ρ_s = 1, so gravity is (d/H)(sin �
 
 Bagnold scaling: where the local energy balance holds (deep layers, away from the base and the
 surface), the interior is a uniform-shear state at the solid fraction φ* with
-|P_xy|/p (φ*) = tan ζ (:func:`ktgf.couette.uniform_shear.uniform_shear`), θ = T(φ*) (γ̇ d)²,
+|P_xy|/p (φ*) = tan ζ (:func:`ktgf.shear.steady.steady_shear`), θ = T(φ*) (γ̇ d)²,
 so γ̇ ∝ √(p) ∝ √(H − y) and u ∝ H^{3/2} (Bagnold 1954; Silbert et al. 2001).
 """
 
@@ -66,7 +66,7 @@ from .equations import N_VARS, Problem
 from .geometry import stretched_nodes
 from .run import Material, to_dataset
 from .solver import newton, pseudo_transient
-from .uniform_shear import uniform_shear
+from ..shear.steady import steady_temperature
 from .walls import Wall
 
 #: Default base: bumpy (fully diffuse) Johnson–Jackson wall.
@@ -210,7 +210,7 @@ def bagnold_start(problem: ChuteProblem) -> np.ndarray:
     x = problem.x
     e = min(problem.e, 0.999)
     phi = min(problem.mean_phi, 0.95 * problem.phi_max)
-    ratio = float(uniform_shear(problem.model, phi, e).temperature_ratio)
+    ratio = float(steady_temperature(problem.model, phi, e))
     r = problem.model.reduced(phi, e)
     c = float(r.eta) * (5.0 * math.sqrt(math.pi) / 96.0) * math.sqrt(ratio)  # η/γ̇ with d = ρ_s = 1
     tau = problem.gravity[0] * phi * (x[-1] - x)

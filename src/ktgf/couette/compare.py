@@ -1,7 +1,7 @@
 """Model comparison with a DEM planar Couette profile, the case read from the DEM file's header.
 
 The DEM format (``shared/data/dem_couette_e0.9_phi0.50.csv``, README there; read by
-:func:`ktgf.calibration.data.read_couette`): frictionless spheres (d = m = 1, ρ_s = 6/π), bumpy walls
+:func:`ktgf.data.read_couette`): frictionless spheres (d = m = 1, ρ_s = 6/π), bumpy walls
 with sphere centres at y = ±H/2 moving at ±U/2; the header states e, the mean φ over the slab
 between the planes tangent to the wall spheres, H, U and the wall stresses.  The continuum cell is
 that slab: gap H − d with the same inventory.
@@ -22,17 +22,15 @@ from typing import Any
 
 import numpy as np
 
-from ..calibration.data import CouetteCase, CouetteData, read_couette
+from ..data import CouetteCase, CouetteData, read_couette
 from ..closures import PAPER_MODELS, get_model
-from ..errors import ConvergenceError, InputError
+from ..errors import ConvergenceError
 from .geometry import PlanarCell
 from .run import Material, run
 from .walls import Wall
 
-DEM_FILE = "dem_couette_e0.9_phi0.50.csv"
 
 #: The profile and case of a DEM Couette file (header fields checked, one-line errors).
-load_dem_couette = read_couette
 DemProfile = CouetteData
 
 
@@ -132,39 +130,6 @@ def compare_with_dem(dem_path: str | Path, models=PAPER_MODELS, *, n_cells: int 
         })
         datasets[m.name] = ds
     return rows, {"datasets": datasets, "dem": dem, "target_u": dem.slip_speed(), "case": dem.case}
-
-
-def compare_uniform_shear(path: str | Path, models=PAPER_MODELS) -> list[dict[str, Any]]:
-    """Uniform-shear closed forms (model.md §9) against ``dem_uniform_shear.csv`` (γ̇ = 1, d = m = 1).
-
-    Rows per (model, φ): T = θ/(γ̇d)² of the energy balance, η* = η/η0 and p* = p/(nT) of the
-    model at the DEM's (φ, e), with the DEM values and relative differences.  The DEM states have
-    a* = γ̇/ν0 ≈ 0.19–0.29, beyond strict Navier–Stokes order (README).
-    """
-    import io
-
-    path = Path(path)
-    if not path.exists():
-        raise InputError(f"DEM data file {str(path)!r} does not exist")
-    body = "\n".join(ln for ln in path.read_text().splitlines() if not ln.startswith("#"))
-    data = np.atleast_1d(np.genfromtxt(io.StringIO(body), delimiter=",", names=True))
-    from .uniform_shear import uniform_shear
-
-    rows = []
-    for name in models:
-        m = get_model(name)
-        for rec in data:
-            phi, e = float(rec["phi"]), float(rec["e"])
-            r = m.reduced(phi, e)
-            us = uniform_shear(m, phi, e)
-            T, eta, p = float(us.temperature_ratio), float(r.eta), float(r.p)
-            rows.append({
-                "model": m.label or m.name, "phi": phi, "e": e,
-                "T": T, "T_dem": float(rec["T"]), "dT": T / float(rec["T"]) - 1,
-                "eta*": eta, "eta*_dem": float(rec["eta_over_eta0"]), "deta*": eta / float(rec["eta_over_eta0"]) - 1,
-                "p*": p, "p*_dem": float(rec["p_over_nT"]), "dp*": p / float(rec["p_over_nT"]) - 1,
-            })
-    return rows
 
 
 def dem_slip_target(dem: CouetteData) -> float:

@@ -13,10 +13,10 @@ A model whose friction part has a frictional stress (option ``stress``) adds, in
 
 The frictional law is rate independent (τ_f = w p_f sin φ_fr for any γ̇ ≠ 0), so its viscosity is
 singular where γ̇ → 0 (a plug); ε (option ``regularisation``, default 10⁻³) bounds it there.  Halving
-ε changes converged profiles by less than the tolerance measured in ``tests/test_friction_couette.py``.
+ε changes converged profiles by less than the tolerance measured in ``tests/couette/test_friction_couette.py``.
 
 Energy: the frictional work w p_f sin φ_fr |γ̇| is taken to be dissipated at the contacts without
-feeding the granular temperature (the choice of :func:`ktgf.closures.friction_shear.model_uniform_shear`);
+feeding the granular temperature (the choice of :func:`ktgf.shear.steady.steady_shear`);
 it is returned so that the energy budget of the cell can count it.
 """
 

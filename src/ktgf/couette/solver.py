@@ -36,7 +36,7 @@ import scipy.sparse.linalg as spla
 from ..errors import ConvergenceError, InputError
 from . import arclength
 from .equations import N_VARS, Problem
-from .uniform_shear import uniform_shear
+from ..shear.steady import steady_temperature
 
 #: Largest change of ln θ or of logit φ in one Newton step.
 MAX_LOG_STEP = 3.0
@@ -226,7 +226,7 @@ def naive_start(problem: Problem) -> np.ndarray:
     gdot = abs(ut - ub) / (x[-1] - x[0])
     phi = min(problem.mean_phi, 0.95 * problem.phi_max)
     e = min(problem.e, 0.999)
-    ratio = float(uniform_shear(problem.model, phi, e).temperature_ratio)
+    ratio = float(steady_temperature(problem.model, phi, e))
     theta = np.full(x.size, ratio * gdot**2)
     return problem.pack(u, theta, np.full(x.size, phi))
 

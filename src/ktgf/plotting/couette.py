@@ -8,6 +8,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from . import save
+from .style import colour, dash
 
 
 def plot_profiles(datasets: Mapping[str, Any], out: str | Path, *, dem: Any = None, title: str = "") -> Path:
@@ -63,4 +64,38 @@ def plot_sweep(rows: list[dict[str, Any]], out: str | Path, *, quantity: str = "
     ax.grid(alpha=0.3)
     ax.legend()
     fig.tight_layout()
+    return save(fig, out)
+
+
+def plot_profile_comparison(ds: Any, out: str | Path) -> Path:
+    """u/U, φ and θ/U² across the gap from one Dataset of several models, DEM points with error bars."""
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
+
+
+    U = float(ds["wall_speed"])
+    scale = {"u": U, "phi": 1.0, "theta": U**2}
+    labels = {"u": "velocity $u/U$", "phi": r"solid fraction $\phi$", "theta": r"temperature $\theta/U^2$ (log)"}
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.4), constrained_layout=True)
+    for ax, var in zip(axes, ("u", "phi", "theta")):
+        for i in range(ds.sizes["model"]):
+            ax.plot(ds[var][i] / scale[var], ds.y, dash(i), color=colour(i),
+                    label=str(ds.label[i].values))
+        if f"{var}_dem" in ds:
+            occupied = ds.phi_dem.values > 0.05  # bins inside the wall layers hold no flowing particles
+            ax.errorbar(ds[f"{var}_dem"].values[occupied] / scale[var], ds.y_dem.values[occupied],
+                        xerr=ds[f"{var}_dem_sem"].values[occupied] / scale[var], fmt="k.", ms=4, label="DEM")
+        ax.set_xlabel(labels[var])
+        ax.set_ylabel("y / d")
+        ax.grid(True, which="both", alpha=0.3)
+    ax = axes[2]
+    ax.set_xscale("log")
+    # θ spans about one decade: label 1-2-5 steps so that the axis shows several readable numbers
+    ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    fmt = ScalarFormatter()
+    fmt.set_scientific(False)
+    ax.xaxis.set_major_formatter(fmt)
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    axes[0].legend(fontsize=8)
+    fig.suptitle(f"Planar Couette cell: profiles across the gap (walls at u/U = ±1/2, U = {U:g})")
     return save(fig, out)

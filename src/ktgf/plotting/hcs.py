@@ -9,22 +9,15 @@ import numpy as np
 
 from ..closures.models import Model
 from . import save
+from .style import LINESTYLES, MODEL_COLOURS, colour, dash, panels, rc_style
 
-#: Same colour for a model in every figure (paper order: Enskog, RET, Visc.div., Proposed).
-MODEL_COLOURS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000")
-#: Dash per model, so that models whose curves coincide remain visible on top of each other.
-LINESTYLES = ("-", "--", "-.", ":")
-
-
-def _style() -> dict[str, Any]:
-    return {"font.size": 9, "axes.labelsize": 9, "legend.fontsize": 8, "xtick.labelsize": 8, "ytick.labelsize": 8}
 
 
 def plot_haff(ds: Any, out: str | Path) -> Path:
     """θ(t)/θ0 of each model: Haff's law (line) and the integrated ODE (markers), log–log axes."""
     import matplotlib.pyplot as plt
 
-    with plt.rc_context(_style()):
+    with plt.rc_context(rc_style()):
         fig, ax = plt.subplots(figsize=(4.2, 3.2), constrained_layout=True)
         t = ds["t"].values
         theta0 = ds["theta_haff"].values[:, 0]
@@ -62,7 +55,7 @@ def plot_stability_map(ds: Any, e_values: Sequence[float], out: str | Path) -> P
 
     e_values = list(e_values)
     n = len(e_values)
-    with plt.rc_context(_style()):
+    with plt.rc_context(rc_style()):
         fig, axes = plt.subplots(1, n, figsize=(3.4 * n, 3.0), sharey=True, constrained_layout=True, squeeze=False)
         phi = ds["phi"].values
         for ax, e in zip(axes[0], e_values):
@@ -109,7 +102,7 @@ def plot_dispersion(
         k_max = 2.0 * max(kc) if kc else 1.0
     k = np.linspace(0.0, k_max, n)
     disp = dispersion_relation(r, k)
-    with plt.rc_context(_style()):
+    with plt.rc_context(rc_style()):
         fig, ax = plt.subplots(figsize=(5.6, 3.3), constrained_layout=True)
         trans = ax.get_xaxis_transform()
         ax.fill_between(k, 0, 1, where=disp.transverse > 0, transform=trans, color="#0072B2", alpha=0.12, lw=0,
@@ -135,3 +128,51 @@ def plot_dispersion(
         ax.legend(frameon=False, loc="upper left", bbox_to_anchor=(1.01, 1.0))
         ax.grid(True, alpha=0.25)
         return save(fig, out)
+
+
+def plot_cooling_errors(ds: Any, out: str | Path) -> Path:
+    """Relative error of each model's cooling rate against the DEM (early window), per e, against φ."""
+    es = np.unique(ds.e.values)
+    fig, axes = panels(1, len(es))
+    for j, e in enumerate(es):
+        ax = axes[0, j]
+        sel = ds.e.values == e
+        phi = ds.phi.values[sel]
+        unc = 100 * ds.dem_rel_sem.values[sel]
+        ax.fill_between(phi, -np.maximum(unc, 0.5), np.maximum(unc, 0.5), color="0.85", label="DEM ±0.5 % (or s.e.m.)")
+        for i, m in enumerate(ds.model.values):
+            ax.plot(phi, 100 * ds.error_early.values[i, sel], marker="o", ls=dash(i), color=colour(i),
+                    label=str(ds.label[i].values))
+        ax.axhline(0, color="k", lw=0.8)
+        ax.set_title(f"e = {e:g}")
+        ax.set_xlabel(r"solid fraction $\phi$")
+        ax.set_ylabel(r"$A_\mathrm{model}/A_\mathrm{DEM} - 1$  [%]")
+        ax.grid(True, alpha=0.3)
+    axes[0, 0].legend(fontsize=8)
+    fig.suptitle("Cooling rate A = ζ/√T against DEM (fit over T0 → T0/2)")
+    return save(fig, out)
+
+
+def plot_dispersion_comparison(ds: Any, out: str | Path) -> Path:
+    """Several models' growth rates of the transverse mode and real parts of the three longitudinal modes against k*."""
+    fig, axes = panels(1, 2, w=5.6)
+    k = ds.kstar.values
+    colors = [colour(i) for i in range(ds.sizes["model"])]
+    for i in range(ds.sizes["model"]):
+        lab = str(ds.label[i].values)
+        axes[0, 0].plot(k, ds.s_perp[i], color=colors[i], ls=dash(i), label=lab)
+        axes[0, 0].plot([float(ds.k_perp[i])], [0.0], "o", color=colors[i])
+        for b in range(ds.sizes["branch"]):
+            axes[0, 1].plot(k, ds.s_par_real[i, :, b], color=colors[i], ls=dash(i), lw=1.2,
+                            label=lab if b == 0 else None)
+        axes[0, 1].plot([float(ds.k_par[i])], [0.0], "o", color=colors[i])
+    for ax, title in zip(axes[0], ("transverse (vortex) mode  s⊥", "longitudinal modes  Re s")):
+        ax.axhline(0, color="k", lw=0.8)
+        ax.set_xlabel(r"$k^* = k\ell$")
+        ax.set_ylabel(r"growth rate / $\nu_0$")
+        ax.set_title(title)
+        ax.grid(True, alpha=0.3)
+    axes[0, 1].set_ylim(bottom=max(float(np.nanmin(ds.s_par_real)), -3.0 * float(np.nanmax(np.abs(ds.s_perp)))))
+    axes[0, 0].legend()
+    fig.suptitle(f"HCS dispersion relations at φ = {float(ds.phi):g}, e = {float(ds.e):g} (dots: closed-form k⊥*, k∥*)")
+    return save(fig, out)

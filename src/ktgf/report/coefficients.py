@@ -17,7 +17,7 @@ import xarray as xr
 from ..closures.models import get_model
 from ..hcs.stability import critical_box_size, critical_wavenumbers
 from ..io import run_metadata
-from .dem import HCS_COOLING, UNIFORM_SHEAR, read_table
+from ..data import HCS_COOLING, UNIFORM_SHEAR, read_cooling, read_table
 from .framework import Section, SectionContext, closest, join_labels, model_inputs, register_section
 from .overlap import OVERLAP_RTOL, coincide_below
 from .settings import ReportSettings
@@ -141,7 +141,7 @@ def step_sentence(steps: dict[str, dict[str, float]]) -> str:
 def _dem_checks(ctx: SectionContext, names: tuple[str, ...]) -> None:
     path = ctx.data_file(HCS_COOLING)
     if path is not None:
-        t = read_table(path)
+        t = read_cooling(path)
         rows, errs = [], {}
         for n in names:
             m = get_model(n)
@@ -167,7 +167,7 @@ def _dem_checks(ctx: SectionContext, names: tuple[str, ...]) -> None:
         ctx.number("pstar_dense_mean_abs_error", {n: float(np.mean(np.abs(errs[n][dense]))) for n in names})
     path = ctx.data_file(UNIFORM_SHEAR)
     if path is not None:
-        t = read_table(path)
+        t = read_table(path).as_dict()
         rows = []
         eta_err = {}
         for n in names:
@@ -272,5 +272,5 @@ def discuss(nb: dict[str, Any]) -> list[str]:
 
 SECTION = register_section(Section(
     "coefficients", "1. Transport coefficients and radial distribution functions", run, inputs, order=10,
-    data_files=(HCS_COOLING, UNIFORM_SHEAR), modules=("ktgf.plotting.coefficients", "ktgf.report.dem"), discuss=discuss,
+    data_files=(HCS_COOLING, UNIFORM_SHEAR), modules=("ktgf.plotting.coefficients", "ktgf.data"), discuss=discuss,
 ))

@@ -6,12 +6,9 @@ For each model of ``settings.cooling_models`` two periodic cubes are run: one of
 of model.md §8.  At φ = 0.5 (above φ_f = 0.49, where the Proposed RDF departs from RET's) the two
 models have different critical sizes; the paper's claim is that the Proposed RDF keeps RET's
 ability to predict the instability, so the section compares, box by box, whether each model's
-run does what its own linear theory predicts and whether the two models agree.  The section needs the 3D solver (package :mod:`ktgf.solver`); without it the
-page says "not available in this build".
+run does what its own linear theory predicts and whether the two models agree.
 
-Contract with the solver (the one thing to wire up)
----------------------------------------------------
-The section calls :data:`ENTRY_POINT`, ``ktgf.solver.report_cooling_run``, once per run::
+The section calls ``ktgf.solver.report_cooling_run`` once per run::
 
     report_cooling_run(model: ktgf.Model, *, phi: float, e: float, box: float, n_cells: int,
                        t_end: float, seed: int, d: float, rho_s: float, theta0: float) -> xarray.Dataset
@@ -25,8 +22,6 @@ time 1/ν0(θ0); uniform φ, θ0 and a small random velocity perturbation from `
 * coordinates ``x``, ``y`` (units of d) with ``phi_slice``, ``ux_slice``, ``uy_slice``: the
   fields in the mid-plane z = box/2 at the final time;
 * attrs from :func:`ktgf.io.run_metadata`.
-
-If the solver's API differs, adapt :func:`run_box` (the only call into it).
 """
 
 from __future__ import annotations
@@ -40,24 +35,21 @@ import xarray as xr
 from ..closures.models import get_model
 from ..hcs.haff import haff_temperature
 from ..hcs.stability import critical_box_size, critical_wavenumbers
-from .framework import Section, SectionContext, model_inputs, optional_entry, register_section
+from ..plotting.cooling_gas import plot_slices, plot_time_series
+from .framework import Section, SectionContext, model_inputs, register_section
 from .settings import ReportSettings
 
-ENTRY_POINT = ("ktgf.solver", "report_cooling_run")
 #: Growth of the density contrast above which the page says that clusters formed.
 CLUSTER_GROWTH = 2.0
 RHO_S_DEM = 6.0 / math.pi
 
 
-_entry, available = optional_entry(*ENTRY_POINT, "the 3D flow solver", "(model, *, phi, e, box, n_cells, t_end, seed, d, rho_s, theta0)")
-
 
 def run_box(model: Any, box: float, s: ReportSettings) -> xr.Dataset:
     """One 3D cooling run (the only call into the solver)."""
-    fn = _entry()
-    if fn is None:
-        raise RuntimeError(available() or "3D solver unavailable")
-    return fn(model, phi=s.cooling_phi, e=s.cooling_e, box=box, n_cells=s.cooling_cells, t_end=s.cooling_t_end,
+    from ..solver import report_cooling_run  # JAX is imported only when the section runs
+
+    return report_cooling_run(model, phi=s.cooling_phi, e=s.cooling_e, box=box, n_cells=s.cooling_cells, t_end=s.cooling_t_end,
               seed=s.cooling_seed, d=1.0, rho_s=RHO_S_DEM, theta0=1.0)
 
 
@@ -71,51 +63,6 @@ def boxes(name: str, s: ReportSettings) -> dict[str, float]:
     kp, kl = critical_wavenumbers(get_model(name).reduced(s.cooling_phi, s.cooling_e))
     return {"below": s.cooling_below * float(critical_box_size(s.cooling_phi, kp)),
             "above": s.cooling_above * float(critical_box_size(s.cooling_phi, kl))}
-
-
-def plot_time_series(ds: xr.Dataset, out: Any) -> Any:
-    import matplotlib.pyplot as plt
-
-    from ..plotting import save
-
-    fig, axes = plt.subplots(1, 3, figsize=(14, 4), constrained_layout=True)
-    for r in range(ds.sizes["run"]):
-        lab = str(ds.run.values[r])
-        axes[0].plot(ds.time, ds.theta_over_haff[r], label=lab)
-        axes[1].semilogy(ds.time, ds.flow_energy[r], label=lab)
-        axes[2].semilogy(ds.time, ds.phi_std[r], label=lab)
-    for ax, t in zip(axes, (r"$\theta/\theta_\mathrm{Haff}$", "mean-flow / thermal energy", r"std($\phi$)/mean($\phi$)")):
-        ax.set_xlabel(r"time $t\,\nu_0(\theta_0)$")
-        ax.set_ylabel(t)
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=8)
-    fig.suptitle("3D cooling gas: departure from Haff's law, flow energy and density contrast")
-    return save(fig, out)
-
-
-def plot_slices(ds: xr.Dataset, out: Any) -> Any:
-    import matplotlib.pyplot as plt
-
-    from ..plotting import save
-
-    n = ds.sizes["run"]
-    fig, axes = plt.subplots(2, n, figsize=(3.6 * n, 7.6), constrained_layout=True, squeeze=False)
-    for r in range(n):
-        x, y = ds.x.values[r], ds.y.values[r]
-        im = axes[0, r].pcolormesh(x, y, ds.phi_slice[r].T, shading="auto", cmap="viridis")
-        fig.colorbar(im, ax=axes[0, r], label=r"$\phi$", shrink=0.8, location="bottom", pad=0.02)  # below: no overlap with the next panel
-        speed = np.hypot(ds.ux_slice[r], ds.uy_slice[r]).T
-        im = axes[1, r].pcolormesh(x, y, speed, shading="auto", cmap="magma")
-        step = max(1, x.size // 16)
-        axes[1, r].quiver(x[::step], y[::step], ds.ux_slice[r].T[::step, ::step], ds.uy_slice[r].T[::step, ::step], color="w")
-        fig.colorbar(im, ax=axes[1, r], label="|u| in plane", shrink=0.8, location="bottom", pad=0.02)
-        axes[0, r].set_title(str(ds.run.values[r]), fontsize=9)
-        for ax in axes[:, r]:
-            ax.set_aspect("equal")
-            ax.set_xlabel("x / d")
-            ax.set_ylabel("y / d")
-    fig.suptitle("Mid-plane slices at the final time: solid fraction (top), in-plane velocity (bottom)")
-    return save(fig, out)
 
 
 def run(ctx: SectionContext) -> None:
@@ -265,5 +212,5 @@ def discuss(nb: dict[str, Any]) -> list[str]:
 
 SECTION = register_section(Section(
     "cooling_gas", "4. 3D homogeneous cooling gas", run, inputs, order=40,
-    modules=(ENTRY_POINT[0],), available=available, discuss=discuss,
+    modules=("ktgf.solver",), discuss=discuss,
 ))

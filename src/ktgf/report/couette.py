@@ -2,27 +2,8 @@
 
 The case is the DEM run of ``dem_couette_e0.9_phi0.50.csv`` (U = 10, mean φ = 0.50, e = 0.9,
 units d = m = 1); the continuum cell is the slab between the planes tangent to the wall spheres,
-H = 19 d (wall-sphere centres at ±10).  The section needs the Couette
-solver (package :mod:`ktgf.couette`); without it the page says "not available in this build".
-
-Contract with the solver (the one thing to wire up)
----------------------------------------------------
-The section calls :data:`ENTRY_POINT`, ``ktgf.couette.report_profiles``, once per model::
-
-    report_profiles(model: ktgf.Model, *, phi_mean: float, e: float, height: float,
-                    wall_speed: float, d: float, rho_s: float, n_cells: int,
-                    dem_path=None) -> xarray.Dataset
-
-returning the steady profiles with
-
-* coordinate ``y``: distance from the channel centre, −height/2 … height/2, in the units of ``d``;
-* variables ``u`` (mean velocity along the walls, walls at ∓wall_speed/2), ``phi`` and ``theta``
-  (granular temperature per unit mass), all on ``y``;
-* attrs from :func:`ktgf.io.run_metadata` including the wall condition used and its calibration
-  (e.g. Johnson–Jackson specularity, said to be calibrated on this DEM case), and optionally
-  ``valid`` (0/1: max φ below random close packing) and ``max_phi``.
-
-If the solver's API differs, adapt :func:`solve_profiles` (the only call into it).
+H = 19 d (wall-sphere centres at ±10).  The profiles come from
+:func:`ktgf.couette.compare.report_profiles` (one call per model, :func:`solve_profiles`).
 """
 
 from __future__ import annotations
@@ -35,13 +16,13 @@ import xarray as xr
 
 from ..closures.models import get_model
 from ..io import run_metadata
-from .dem import COUETTE, read_table
-from .framework import Section, SectionContext, closest, join_labels, model_inputs, optional_entry, register_section
+from ..data import COUETTE, read_table
+from ..couette.compare import report_profiles
+from ..plotting.couette import plot_profile_comparison
+from .framework import Section, SectionContext, closest, join_labels, model_inputs, register_section
 from .overlap import overlap_sentence
 from .settings import ReportSettings
 
-#: module, function: the agreed entry point of the Couette solver.
-ENTRY_POINT = ("ktgf.couette", "report_profiles")
 #: DEM units: d = 1, m = 1 → ρ_s = 6/π.
 RHO_S_DEM = 6.0 / math.pi
 
@@ -56,7 +37,6 @@ ERROR_COLUMNS = {
 LONG_NAMES = {"u": "mean velocity along the walls in DEM units", "phi": "solid fraction",
               "theta": "granular temperature per unit mass in DEM units"}
 
-_entry, available = optional_entry(*ENTRY_POINT, "the Couette solver", "(model, *, phi_mean, e, height, wall_speed, d, rho_s, n_cells)")
 
 
 def solve_profiles(model: Any, s: ReportSettings, dem_path: Any = None) -> xr.Dataset:
@@ -64,11 +44,8 @@ def solve_profiles(model: Any, s: ReportSettings, dem_path: Any = None) -> xr.Da
 
     With the DEM file, the solver fits each model's wall specularity to the DEM slip.
     """
-    fn = _entry()
-    if fn is None:
-        raise RuntimeError(available() or "Couette solver unavailable")
     extra = {"dem_path": dem_path} if dem_path is not None else {}
-    return fn(model, phi_mean=s.couette_phi_mean, e=s.couette_e, height=s.couette_height,
+    return report_profiles(model, phi_mean=s.couette_phi_mean, e=s.couette_e, height=s.couette_height,
               wall_speed=s.couette_wall_speed, d=1.0, rho_s=RHO_S_DEM, n_cells=s.couette_cells, **extra)
 
 
@@ -95,46 +72,10 @@ def profile_errors(y: np.ndarray, prof: dict[str, np.ndarray], dem: dict[str, np
     }
 
 
-def plot_profiles(ds: xr.Dataset, out: Any) -> Any:
-    """u/U, φ and θ/U² across the gap, one line per model, DEM points with error bars."""
-    import matplotlib.pyplot as plt
-    from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
-
-    from ..plotting import save
-    from ..plotting.hcs import LINESTYLES, MODEL_COLOURS
-
-    U = float(ds["wall_speed"])
-    scale = {"u": U, "phi": 1.0, "theta": U**2}
-    labels = {"u": "velocity $u/U$", "phi": r"solid fraction $\phi$", "theta": r"temperature $\theta/U^2$ (log)"}
-    fig, axes = plt.subplots(1, 3, figsize=(14, 4.4), constrained_layout=True)
-    for ax, var in zip(axes, ("u", "phi", "theta")):
-        for i in range(ds.sizes["model"]):
-            ax.plot(ds[var][i] / scale[var], ds.y, LINESTYLES[i % len(LINESTYLES)], color=MODEL_COLOURS[i % len(MODEL_COLOURS)],
-                    label=str(ds.label[i].values))
-        if f"{var}_dem" in ds:
-            occupied = ds.phi_dem.values > 0.05  # bins inside the wall layers hold no flowing particles
-            ax.errorbar(ds[f"{var}_dem"].values[occupied] / scale[var], ds.y_dem.values[occupied],
-                        xerr=ds[f"{var}_dem_sem"].values[occupied] / scale[var], fmt="k.", ms=4, label="DEM")
-        ax.set_xlabel(labels[var])
-        ax.set_ylabel("y / d")
-        ax.grid(True, which="both", alpha=0.3)
-    ax = axes[2]
-    ax.set_xscale("log")
-    # θ spans about one decade: label 1-2-5 steps so that the axis shows several readable numbers
-    ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
-    fmt = ScalarFormatter()
-    fmt.set_scientific(False)
-    ax.xaxis.set_major_formatter(fmt)
-    ax.xaxis.set_minor_formatter(NullFormatter())
-    axes[0].legend(fontsize=8)
-    fig.suptitle(f"Planar Couette cell: profiles across the gap (walls at u/U = ±1/2, U = {U:g})")
-    return save(fig, out)
-
-
 def run(ctx: SectionContext) -> None:
     s = ctx.settings
     path = ctx.data_file(COUETTE)
-    dem = read_table(path) if path is not None else None
+    dem = read_table(path).as_dict() if path is not None else None
     sols = {}
     for n in s.models:
         ctx.step(f"solving the Couette cell with {get_model(n).label}")
@@ -155,7 +96,7 @@ def run(ctx: SectionContext) -> None:
         coords["y_dem"] = ("y_dem", dem["y"], {"long_name": "DEM bin centre, distance from the channel centre in diameters", "units": "1"})
     ds = xr.Dataset(data, coords=coords, attrs=run_metadata(None, **{k: v for k, v in inputs(s).items() if k != "models"},
                                                             models=list(s.models), units="d = m = 1"))
-    plot_profiles(ds, ctx.figure_path("couette_profiles"))
+    plot_profile_comparison(ds, ctx.figure_path("couette_profiles"))
     overlaps = "".join(overlap_sentence({n: ds[v].sel(model=n).values for n in s.models}, f"{v} profiles")
                        for v in ("u", "phi", "theta"))
     ctx.add_figure("couette_profiles", f"Velocity u/U, solid fraction and temperature θ/U² across the Couette cell (H = {s.couette_height:g} d, "
@@ -203,5 +144,5 @@ def discuss(nb: dict[str, Any]) -> list[str]:
 
 SECTION = register_section(Section(
     "couette", "3. Couette shear cell", run, inputs, order=30, data_files=(COUETTE,),
-    modules=(ENTRY_POINT[0], "ktgf.report.dem"), available=available, discuss=discuss,
+    modules=("ktgf.couette", "ktgf.data"), discuss=discuss,
 ))

@@ -2,7 +2,7 @@
 
 Models: ``settings.dense_models``, by default the report's models plus ``dense`` when the registry
 has it (the recommended dense composition of issue 9).  Curves: the Navier–Stokes uniform-shear
-closed forms of model.md §9 (:func:`ktgf.couette.uniform_shear.uniform_shear`) in the DEM files'
+closed forms of model.md §9 (:func:`ktgf.shear.steady.steady_shear`) in the DEM files'
 dimensionless columns (d = m = 1, γ̇ = 1):
 
 * T = θ/(γ̇d)² from the energy balance η γ̇² = (3/2)ρθζ0;
@@ -11,7 +11,7 @@ dimensionless columns (d = m = 1, γ̇ = 1):
 * p/(nT), the model's reduced pressure.
 
 DEM points: ``dem_uniform_shear.csv`` (e = 0.9) and the frictionless μ = 0 row of
-``dem_uniform_shear_friction.csv`` (e = 0.7), read by :mod:`ktgf.calibration.data`.  Couette:
+``dem_uniform_shear_friction.csv`` (e = 0.7), read by :mod:`ktgf.data`.  Couette:
 every model in the case of ``dem_couette_e0.9_phi0.50.csv``'s header with its specularity fitted
 to the DEM slip (:func:`ktgf.couette.compare.compare_with_dem`); the wall shear stress and
 pressure are predictions.  No parameter of the four paper models is fitted to any of these data.
@@ -27,16 +27,16 @@ import xarray as xr
 
 from ..closures.models import get_model, list_models
 from ..io import run_metadata
-from .dem import COUETTE, UNIFORM_SHEAR
-from .framework import Section, SectionContext, closest, join_labels, model_inputs, optional_entry, register_section
+from ..data import COUETTE, FRICTION_SHEAR as FRICTION, UNIFORM_SHEAR, read_uniform_shear
+from ..shear.steady import ETA0_DEM, steady_shear
+from ..couette.compare import compare_with_dem
+from ..plotting.shear import plot_shear_curves
+from .framework import Section, SectionContext, closest, join_labels, model_inputs, register_section
 from .settings import ReportSettings
 
-FRICTION = "dem_uniform_shear_friction.csv"
 #: Restitution of the curves: the two DEM uniform-shear sets.
 CURVE_E = (0.9, 0.7)
 QUANTITIES = {"T": "T = θ/(γ̇d)²", "eta_star": "η* = η d²/√(mT)", "p_star": "p* = p/(ρ_s d² γ̇²)", "p_over_nT": "p/(nT)"}
-
-_compare, couette_available = optional_entry("ktgf.couette.compare", "compare_with_dem", "the Couette solver", "(dem_path, models, *, n_cells)")
 
 
 def section_models(s: ReportSettings) -> tuple[str, ...]:
@@ -52,13 +52,10 @@ def inputs(s: ReportSettings) -> dict[str, Any]:
 
 
 def shear_state(model: Any, phi: np.ndarray, e: float) -> dict[str, np.ndarray]:
-    """The four DEM columns of the uniform-shear closed forms at (φ, e), p* = φ T p/(nT) added."""
-    from ..couette.uniform_shear import shear_state as closed_form
-
+    """The four DEM columns of the uniform-shear closed forms at (φ, e)."""
     phi = np.asarray(phi, dtype=float)
-    s = closed_form(model, phi, e)
-    T, eta, p = (np.broadcast_to(np.asarray(v, dtype=float), phi.shape) for v in (s.T, s.eta_star, s.p_over_nT))
-    return {"T": T, "eta_star": eta, "p_star": phi * T * p, "p_over_nT": p}
+    s = steady_shear(model, phi, e)
+    return {k: np.broadcast_to(np.asarray(getattr(s, k), dtype=float), phi.shape) for k in ("T", "eta_star", "p_star", "p_over_nT")}
 
 
 def shear_curves(names: tuple[str, ...], n: int) -> xr.Dataset:
@@ -84,9 +81,6 @@ def shear_curves(names: tuple[str, ...], n: int) -> xr.Dataset:
 
 def dem_points(ctx: SectionContext) -> dict[str, np.ndarray] | None:
     """The frictionless uniform-shear DEM states of both files (those present), in the four columns with errors."""
-    from ..calibration.data import read_uniform_shear
-    from ..couette.uniform_shear import ETA0_DEM
-
     sets = [read_uniform_shear(p) for p in (ctx.data_file(UNIFORM_SHEAR), ctx.data_file(FRICTION)) if p is not None]
     if not sets:
         return None
@@ -101,36 +95,6 @@ def dem_points(ctx: SectionContext) -> dict[str, np.ndarray] | None:
     return {"phi": phi, "e": e, "source": source, "T": T, "dT": dT, "eta_star": ETA0_DEM * eta,
             "deta_star": ETA0_DEM * deta, "p_star": pstar, "dp_star": pstar * np.hypot(dT / T, dp / p),
             "p_over_nT": p, "dp_over_nT": dp}
-
-
-def plot_dense(ds: xr.Dataset, dem: dict[str, np.ndarray] | None, out: Any) -> Any:
-    """2 × 2 panels (T, η*, p*, p/(nT) against φ), one colour per model, line style per e, DEM points with error bars."""
-    import matplotlib.pyplot as plt
-
-    from ..plotting import save
-    from ..plotting.hcs import MODEL_COLOURS
-
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8), constrained_layout=True)
-    styles = ("-", "--", ":")
-    for ax, k in zip(axes.ravel(), QUANTITIES):
-        for i in range(ds.sizes["model"]):
-            for j, e in enumerate(ds.e.values):
-                ax.plot(ds.phi, ds[k][i, j], styles[j % 3], color=MODEL_COLOURS[i % len(MODEL_COLOURS)],
-                        label=f"{ds.label.values[i]}, e = {e:g}" if k == "T" else None)
-        if dem is not None:
-            for j, e in enumerate(ds.e.values):
-                sel = dem["e"] == e
-                if sel.any():
-                    ax.errorbar(dem["phi"][sel], dem[k][sel], yerr=dem[f"d{k}"][sel], fmt="ko" if j == 0 else "ks", mfc="none",
-                                ms=6, capsize=3, label=f"DEM, e = {e:g}" if k == "T" else None)
-        ax.set_xlabel("solid fraction φ")
-        ax.set_ylabel(QUANTITIES[k])
-        ax.grid(True, alpha=0.3)
-        if k != "T":
-            ax.set_yscale("log")
-    axes[0, 0].legend(fontsize=7, ncol=2)
-    fig.suptitle("Uniform shear (Navier–Stokes closed forms) against frictionless DEM")
-    return save(fig, out)
 
 
 def _shear_table(ctx: SectionContext, names: tuple[str, ...], dem: dict[str, np.ndarray]) -> None:
@@ -173,11 +137,8 @@ def _couette_table(ctx: SectionContext, names: tuple[str, ...]) -> None:
     path = ctx.data_file(COUETTE)
     if path is None:
         return
-    if couette_available() is not None:
-        ctx.note(f"Couette wall stresses left out: {couette_available()}")
-        return
     ctx.step("Couette cell of the DEM header, every model")
-    rows, extra = _compare()(path, list(names), n_cells=ctx.settings.couette_cells)
+    rows, extra = compare_with_dem(path, list(names), n_cells=ctx.settings.couette_cells)
     c = extra["case"]
     table, nums = [], {}
     for n, r in zip(names, rows):
@@ -220,7 +181,7 @@ def run(ctx: SectionContext) -> None:
     )
     ds = shear_curves(names, ctx.settings.dense_points)
     dem = dem_points(ctx)
-    plot_dense(ds, dem, ctx.figure_path("uniform_shear_dense"))
+    plot_shear_curves(ds, dem, ctx.figure_path("uniform_shear_dense"))
     ctx.add_figure("uniform_shear_dense", "Uniform shear against φ: T, η*, p* and p/(nT) of the models (solid e = 0.9, dashed e = 0.7)"
                    + (f" with the frictionless DEM ({UNIFORM_SHEAR}, μ = 0 row of {FRICTION})." if dem is not None else "."), ds)
     if dem is not None:
@@ -255,6 +216,6 @@ def discuss(nb: dict[str, Any]) -> list[str]:
 
 SECTION = register_section(Section(
     "dense", "5. Dense regime: uniform shear and Couette wall stresses", run, inputs, order=50,
-    data_files=(UNIFORM_SHEAR, FRICTION, COUETTE), modules=("ktgf.calibration", "ktgf.couette", "ktgf.report.dem"),
+    data_files=(UNIFORM_SHEAR, FRICTION, COUETTE), modules=("ktgf.shear", "ktgf.couette", "ktgf.data", "ktgf.plotting"),
     discuss=discuss,
 ))

@@ -18,19 +18,19 @@ Layout of the output folder::
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import importlib
 import json
 import os
 import shutil
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from .. import __version__
+from .._version import __version__
 from ..errors import InputError
+from .results import GENERATOR, PAGE_NAME, FigureRef, SectionResult, TableData  # noqa: F401  (the sections' types)
 from .settings import ReportSettings
 
 CACHE_DIR = ".cache"
@@ -38,61 +38,6 @@ FIGURE_DIR = "figures"
 DATA_DIR = "data"
 #: Bump to invalidate every cache entry when the result format changes.
 CACHE_FORMAT = 1
-
-
-@dataclass
-class FigureRef:
-    """A figure file (path relative to the output folder), its caption and its data file."""
-
-    file: str
-    caption: str
-    data: str | None = None
-
-
-@dataclass
-class TableData:
-    """A small table: column titles and rows of plain values (numbers are formatted on the page)."""
-
-    title: str
-    columns: list[str]
-    rows: list[list[Any]]
-    note: str = ""
-    figure: str | None = None  # file of the figure it is shown beside (None: end of the section)
-
-
-@dataclass
-class SectionResult:
-    """Everything a section produced, in a JSON-serialisable form (what the cache stores).
-
-    ``status`` is ``computed`` (this run), ``cached`` (read back), ``unavailable`` (its package
-    is not part of this build; ``reason`` says why) or ``failed`` (``reason`` holds the error).
-    """
-
-    key: str
-    title: str
-    status: str = "computed"
-    reason: str = ""
-    paragraphs: list[str] = field(default_factory=list)
-    figures: list[FigureRef] = field(default_factory=list)
-    tables: list[TableData] = field(default_factory=list)
-    numbers: dict[str, Any] = field(default_factory=dict)
-    notes: list[str] = field(default_factory=list)
-    datasets: list[str] = field(default_factory=list)
-    inputs: dict[str, Any] = field(default_factory=dict)
-
-    def to_json(self) -> dict[str, Any]:
-        return dataclasses.asdict(self)
-
-    @classmethod
-    def from_json(cls, d: dict[str, Any]) -> SectionResult:
-        d = dict(d)
-        d["figures"] = [FigureRef(**f) for f in d.get("figures", [])]
-        d["tables"] = [TableData(**t) for t in d.get("tables", [])]
-        return cls(**d)
-
-    def files(self) -> list[str]:
-        """Every file the section wrote (relative paths)."""
-        return [f.file for f in self.figures] + list(self.datasets)
 
 
 class SectionContext:
@@ -355,8 +300,6 @@ def clear_section_outputs(out: Path, key: str) -> None:
 
 def prepare_out_dir(out: Path) -> Path:
     """Create the output folder and check it is writable; InputError (one line) otherwise."""
-    from .page import GENERATOR, PAGE_NAME
-
     out = Path(out)
     page = out / PAGE_NAME
     try:
@@ -388,34 +331,3 @@ def join_labels(names: list[str]) -> str:
 
     labels = [get_model(n).label or n for n in names]
     return labels[0] if len(labels) == 1 else ", ".join(labels[:-1]) + " and " + labels[-1]
-
-
-def optional_entry(module: str, function: str, what: str, signature: str) -> tuple[Callable[[], Any], Callable[[], str | None]]:
-    """The entry point ``module.function`` of an optional solver, as ``(entry, available)``.
-
-    ``entry()`` returns the function or None if the package is absent; ``available()`` returns
-    None when it can be called, else the sentence the page shows instead of the section.
-    """
-    import importlib
-
-    def entry() -> Any:
-        try:
-            mod = importlib.import_module(module)
-        except ModuleNotFoundError as exc:
-            if exc.name and module.startswith(exc.name):
-                return None
-            raise
-        return getattr(mod, function, None)
-
-    def available() -> str | None:
-        try:
-            importlib.import_module(module)
-        except ModuleNotFoundError as exc:
-            if exc.name and not module.startswith(exc.name):  # the package is there, one of its imports is not
-                return f"{module} is present but cannot be imported: {exc}."
-            return f"{what} (package {module}) is not installed in this build."
-        if entry() is None:
-            return f"{module} has no function {function}{signature} that the report calls."
-        return None
-
-    return entry, available

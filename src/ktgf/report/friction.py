@@ -3,7 +3,7 @@
 Models: the registered ``frictional`` model (RET, Chialvo–Sundaresan χ at φ_c(μ), Walton's collision
 rule, EKT correlation length with c fitted to T of the row μ = 0.5, φ = 0.5; ``docs/friction.md``) at the
 DEM's μ, and frictionless RET (the kinetic theory
-users have without friction).  Curves and table: :func:`ktgf.closures.friction_shear.model_uniform_shear`
+users have without friction).  Curves and table: :func:`ktgf.shear.steady.steady_shear`
 in the columns of ``dem_uniform_shear_friction.csv`` (d = m = 1, γ̇ = 1, e = 0.7): T, T_rot/T, p*, τ/p.
 The issue's goal (within 15 % of the DEM for p*, τ/p and T at μ = 0.5) is checked row by row.
 """
@@ -17,8 +17,9 @@ import numpy as np
 import xarray as xr
 
 from ..closures.friction.calibrated import FRICTIONAL_C
-from ..closures.friction_dem import DEM_FILE, read_friction_dem
-from ..closures.friction_shear import model_uniform_shear
+from ..data import FRICTION_SHEAR as DEM_FILE, read_friction_shear
+from ..plotting.shear import plot_frictional_shear
+from ..shear.steady import steady_shear
 from ..closures.models import get_model
 from ..io import run_metadata
 from .framework import Section, SectionContext, model_inputs, register_section
@@ -51,7 +52,7 @@ def curves(n: int) -> xr.Dataset:
         for j, mu in enumerate(MUS):
             m = model_at(name, mu)
             ok = phi < 0.99 * m.phi_max
-            s = model_uniform_shear(m, phi[ok], E)
+            s = steady_shear(m, phi[ok], E)
             for k in QUANTITIES:
                 data[k][i, j, ok] = getattr(s, k)
     return xr.Dataset(
@@ -64,42 +65,13 @@ def curves(n: int) -> xr.Dataset:
     )
 
 
-def plot(ds: xr.Dataset, rows: list[dict[str, float]] | None, out: Any) -> Any:
-    """2 × 2 panels against φ, colour per model, line style per μ, DEM points with error bars."""
-    import matplotlib.pyplot as plt
-
-    from ..plotting import save
-    from ..plotting.hcs import MODEL_COLOURS
-
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8), constrained_layout=True)
-    styles = ("--", "-")
-    for ax, k in zip(axes.ravel(), QUANTITIES):
-        for i in range(ds.sizes["model"]):
-            for j, mu in enumerate(ds.mu.values):
-                if ds.model.values[i] == "ret" and mu > 0:
-                    continue  # frictionless RET does not depend on μ
-                ax.plot(ds.phi, ds[k][i, j], styles[j % 2], color=MODEL_COLOURS[i % len(MODEL_COLOURS)],
-                        label=f"{ds.label.values[i]}" + (f", μ = {mu:g}" if ds.model.values[i] != "ret" else "") if k == "T" else None)
-        for r, mark in zip(rows or [], ("ks", "ko", "ko")):
-            ax.errorbar([r["phi"]], [r[k]], yerr=[r["d" + k]], fmt=mark, mfc="none" if r["mu"] == 0 else "k", ms=6, capsize=3,
-                        label=(f"DEM, μ = {r['mu']:g}" if k == "T" and (r["mu"] == 0 or r["phi"] == 0.4) else None))
-        ax.set_xlabel("solid fraction φ")
-        ax.set_ylabel(QUANTITIES[k])
-        ax.grid(True, alpha=0.3)
-        if k == "p_star":
-            ax.set_yscale("log")
-    axes[0, 0].legend(fontsize=8)
-    fig.suptitle(f"Uniform shear of frictional spheres, e = {E:g}: models against DEM ({DEM_FILE})")
-    return save(fig, out)
-
-
 def errors(rows: list[dict[str, float]]) -> dict[str, list[dict[str, float]]]:
     """Per model, per DEM row: the model's value and model/DEM − 1 of every quantity (T_rot/T: NaN where not modelled)."""
     out: dict[str, list[dict[str, float]]] = {}
     for name in MODELS:
         recs = []
         for r in rows:
-            s = model_uniform_shear(model_at(name, r["mu"]), [r["phi"]], r["e"])
+            s = steady_shear(model_at(name, r["mu"]), np.array([r["phi"]]), r["e"])
             rec = {"mu": r["mu"], "phi": r["phi"]}
             for k in QUANTITIES:
                 v = float(getattr(s, k)[0])
@@ -121,8 +93,9 @@ def run(ctx: SectionContext) -> None:
     )
     ds = curves(ctx.settings.dense_points)
     path = ctx.data_file(DEM_FILE)
-    rows = read_friction_dem(path) if path is not None else None
-    plot(ds, rows, ctx.figure_path("uniform_shear_friction"))
+    rows = read_friction_shear(path) if path is not None else None
+    plot_frictional_shear(ds, rows, ctx.figure_path("uniform_shear_friction"),
+                          title=f"Uniform shear of frictional spheres, e = {E:g}: models against DEM ({DEM_FILE})")
     ctx.add_figure("uniform_shear_friction", f"Uniform shear at e = {E:g}: T, p*, τ/p and T_rot/T against φ; dashed μ = 0, "
                    "solid μ = 0.5" + (f"; DEM points of {DEM_FILE} (open: μ = 0, filled: μ = 0.5)." if rows else "."), ds)
     if not rows:
@@ -165,5 +138,5 @@ def discuss(nb: dict[str, Any]) -> list[str]:
 
 SECTION = register_section(Section(
     "friction", "6. Frictional particles: uniform shear against frictional DEM", run, inputs, order=60,
-    data_files=(DEM_FILE,), modules=("ktgf.couette.uniform_shear",), discuss=discuss,
+    data_files=(DEM_FILE,), modules=("ktgf.shear", "ktgf.plotting"), discuss=discuss,
 ))

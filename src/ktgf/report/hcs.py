@@ -22,9 +22,9 @@ from ..hcs.stability import critical_box_size, critical_wavenumbers
 from ..hcs.stability_map import stability_map
 from ..io import run_metadata
 from ..plotting.hcs import plot_haff, plot_stability_map
-from .dem import HCS_COOLING, read_table
+from ..data import HCS_COOLING, read_cooling
 from .framework import Section, SectionContext, closest, join_labels, model_inputs, register_section
-from .hcs_plots import plot_cooling_errors, plot_dispersion
+from ..plotting.hcs import plot_cooling_errors, plot_dispersion_comparison
 from .overlap import overlap_sentence
 from .settings import ReportSettings
 
@@ -143,7 +143,7 @@ def run(ctx: SectionContext) -> None:
     s = ctx.settings
     names = s.models
     path = ctx.data_file(HCS_COOLING)
-    dem = read_table(path) if path is not None else None
+    dem = read_cooling(path) if path is not None else None
 
     ctx.paragraph(
         "A uniform granular gas at rest cools by inelastic collisions as θ(t) = θ0/(1 + ζ0(θ0)t/2)² (Haff 1983). "
@@ -182,7 +182,7 @@ def run(ctx: SectionContext) -> None:
 
     ctx.step("dispersion relations")
     disp = dispersion(names, s.dispersion_phi, s.dispersion_e, s.dispersion_points)
-    plot_dispersion(disp, ctx.figure_path("dispersion"))
+    plot_dispersion_comparison(disp, ctx.figure_path("dispersion"))
     ctx.add_figure("dispersion", f"Growth rates of perturbations of the HCS against k* = kℓ at φ = {s.dispersion_phi:g}, "
                    f"e = {s.dispersion_e:g} (docs/model.md §8): modes with positive rate grow.", disp)
     check = np.abs(np.concatenate([disp.k_par_eigen.values / disp.k_par.values, disp.k_perp_eigen.values / disp.k_perp.values]) - 1.0)
@@ -273,5 +273,5 @@ def discuss(nb: dict[str, Any]) -> list[str]:
 
 SECTION = register_section(Section(
     "hcs", "2. Homogeneous cooling state: Haff's law and instabilities", run, inputs, order=20,
-    data_files=(HCS_COOLING,), modules=("ktgf.report.hcs_plots", "ktgf.report.dem"), discuss=discuss,
+    data_files=(HCS_COOLING,), modules=("ktgf.plotting", "ktgf.data"), discuss=discuss,
 ))

@@ -18,16 +18,14 @@ from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import Any
 
-from .. import __version__
-from .framework import SectionResult, TableData, _atomic_write, sections
+from .._version import __version__
+from .framework import _atomic_write, sections
+from .results import GENERATOR, PAGE_NAME, SectionResult, TableData
 from .settings import ReportSettings
 from .summary import summary_html
 
-PAGE_NAME = "index.html"
 #: The page is meant to be shared: readable by everyone, like the figures beside it.
 PAGE_MODE = 0o644
-#: Marks pages written by ktgf, so that a report never overwrites someone else's index.html.
-GENERATOR = "ktgf reproduce"
 #: Sections every page has besides the registered ones (generated at page time, never cached).
 FIXED_SECTIONS = ("summary", "discussion", "rerun")
 def closing_titles(n_sections: int) -> tuple[str, str]:

@@ -15,7 +15,7 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from ..closures.models import PAPER_MODELS, get_model
-from ..data import DATA_ENV, default_data_dirs, locate_data_dir  # noqa: F401  (re-exported)
+from ..data import DATA_ENV, locate_data_dir  # noqa: F401  (re-exported)
 from ..errors import InputError, UnknownModelError
 
 #: Environment variable naming the DEM reference-data folder (overridden by ``--data``).

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..closures.models import get_model
-from .framework import SectionResult
+from .results import SectionResult
 
 #: Errors closer than this (absolute, in the row's own measure) count as a tie.
 TIE = 1e-4

@@ -1,7 +1,7 @@
 """Linear stability of steady uniform shear flow at Navier–Stokes order, for every registered model.
 
 Base state (model.md §9): u = γ̇ y e_x, uniform φ and θ with the steady energy balance
-η γ̇² = (3/2) ρ θ ζ0, i.e. θ = T(φ, e) (γ̇ d)² with T of :func:`ktgf.couette.uniform_shear.uniform_shear`.
+η γ̇² = (3/2) ρ θ ζ0, i.e. θ = T(φ, e) (γ̇ d)² with T of :func:`ktgf.shear.steady.steady_shear`.
 
 Perturbations ∝ exp(i k·r) in the frame moving with the base flow.  With k_x = 0 the base
 advection γ̇ y ∂_x does not act on them and the problem has constant coefficients: normal modes
@@ -63,7 +63,7 @@ import numpy as np
 
 from ..closures import get_model
 from ..closures.coefficients import Dimensional
-from ..couette.uniform_shear import uniform_shear
+from .steady import steady_temperature
 from ..errors import InputError
 from ..validation import check_positive, check_range
 
@@ -110,7 +110,7 @@ def shear_base_state(model: Any, phi: float, e: float, shear_rate: float, *, d: 
     if model.dissipation.key != "none":
         raise InputError(f"model {model.name!r} has the shear-dependent dissipation {model.dissipation.key!r}; "
                          "the uniform-shear stability analysis supports dissipation 'none' only")
-    theta = float(uniform_shear(model, phi, e).temperature_ratio) * (shear_rate * d) ** 2
+    theta = float(steady_temperature(model, phi, e)) * (shear_rate * d) ** 2
     c = model.coefficients(phi, e, theta, d=d, rho_s=rho_s)
     r = model.reduced(phi, e)
     h = _PHI_STEP * max(phi, 1e-3)

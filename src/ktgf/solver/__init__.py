@@ -35,7 +35,7 @@ Several devices (one host)
     program runs, XLA inserts the halo exchanges for the periodic stencils.  On a CPU, create N
     devices with ``XLA_FLAGS=--xla_force_host_platform_device_count=N`` (set before Python
     starts).  The sharded run equals the single-device run to round-off
-    (tests/test_solver_sharding.py).
+    (tests/solver/test_solver_sharding.py).
 
 Several hosts
     Start one process per host with the same config and call

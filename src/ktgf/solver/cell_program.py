@@ -219,7 +219,7 @@ def source_for(treedef: Any, avals: tuple, dtype: Any, limits: str | None = None
     from .friction import cell_coefficients, needs_rate
     from .physics import is_frictional
     from .state import primitive_fields
-    from .stepping import START_TERMS, kernel_stage_inputs, limit_terms, status_terms
+    from .cell_terms import START_TERMS, kernel_stage_inputs, limit_terms, status_terms
 
     phys = jax.tree_util.tree_unflatten(treedef, avals)
     if needs_rate(phys):
@@ -270,7 +270,7 @@ def _compiled(source: str, dtype: Any, nlim: int, what: str) -> CellProgram:
 
 @functools.lru_cache(maxsize=None)
 def _program(treedef: Any, avals: tuple, dtype: Any, limits: str | None) -> CellProgram | None:
-    from .stepping import START_TERMS
+    from .cell_terms import START_TERMS
 
     model = jax.tree_util.tree_unflatten(treedef, avals).model.name
     what = f"the {np.dtype(dtype).name} {'step-start ' if limits else ''}cell program of {model}"

@@ -44,10 +44,12 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from ..closures import get_model
 from ..couette.config import WallsConfig
 from ..errors import InputError, KtgfError
+from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
 from ..io import plain, read_toml
-from .fluxes import LIMITERS, RIEMANN_SOLVERS
+from .stencil import LIMITERS, RIEMANN_SOLVERS
 from .grid import MIN_CELLS
 
 
@@ -305,7 +307,6 @@ def _check_friction(cfg: Config, model: Any, source: str) -> None:
 
 def check_physics(cfg: Config, source: str = "config") -> None:
     """Cross-field checks that need the model: φ0 below the packing limit, a valid model name/options."""
-    from ..closures import get_model
 
     try:
         model = get_model(cfg.model.name, **cfg.model.options)
@@ -334,7 +335,6 @@ def check_physics(cfg: Config, source: str = "config") -> None:
     check_case(cfg, source)
     _check_friction(cfg, model, source)
     if cfg.grid.relative_to is not None:
-        from ..hcs.stability import critical_wavenumbers
 
         kp, kl = critical_wavenumbers(model.reduced(phi0, cfg.model.restitution, hcs=True))
         k = kp if cfg.grid.relative_to == "transverse" else kl
@@ -449,9 +449,35 @@ def initial_temperature(cfg: Config) -> float:
     ini, b = cfg.initial, cfg.boundaries
     if ini.perturbation != "shear-mode":
         return float(ini.temperature)
-    from ..closures import get_model
     from ..shear.stability import shear_base_state
 
     le = getattr(b, b.shear_axis())
     return shear_base_state(get_model(cfg.model.name, **cfg.model.options), ini.solid_fraction, cfg.model.restitution,
                             float(le.shear_rate), d=cfg.particles.diameter, rho_s=cfg.particles.density).theta
+
+
+def config_value(d: Any, dotted: str) -> Any:
+    """The value at a dotted key (``grid.cells``) of a configuration dict (None if absent)."""
+    for key in dotted.split("."):
+        d = d.get(key) if isinstance(d, dict) else None
+    return d
+
+
+def box_lengths(cfg: Config) -> tuple[float, ...]:
+    """Box sides [m] from ``grid.length``, ``grid.length_d`` or ``relative_to``·``factor``."""
+    g, d, ndim = cfg.grid, cfg.particles.diameter, len(cfg.grid.cells)
+
+    def per_axis(v: Any, scale: float) -> tuple[float, ...]:
+        vals = v if isinstance(v, list) else [v]
+        vals = vals * ndim if len(vals) == 1 else vals
+        return tuple(float(x) * scale for x in vals)
+
+    if g.length is not None:
+        return per_axis(g.length, 1.0)
+    if g.length_d is not None:
+        return per_axis(g.length_d, d)
+    phi0 = cfg.initial.solid_fraction
+    model = get_model(cfg.model.name, **cfg.model.options)
+    kp, kl = critical_wavenumbers(model.reduced(phi0, cfg.model.restitution, hcs=True))
+    k = float(kp if g.relative_to == "transverse" else kl)
+    return per_axis(g.factor * BOX_CONSTANT / (phi0 * k), d)

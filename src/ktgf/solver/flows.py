@@ -3,7 +3,7 @@
 ==================  ======================================================================
 ``cooling``         periodic box cooling freely (the homogeneous cooling state, model.md §8)
 ``uniform-shear``   Lees–Edwards box sheared at rate γ̇ (:mod:`.boundaries`); its steady
-                    homogeneous state is the closed form :func:`ktgf.couette.uniform_shear`
+                    homogeneous state is the closed form :func:`ktgf.shear.steady.steady_shear`
 ``couette``         planar Couette cell: Johnson–Jackson walls on one axis moving at ∓U/2
                     along the flow direction; its steady state is the 1D Couette solver's
                     (:func:`ktgf.couette.run.run`, same model, same walls, same inventory)
@@ -44,8 +44,10 @@ import numpy as np
 
 from ..closures.coefficients import eta0
 from .boundaries import AXES, LEES_EDWARDS, PERIODIC, WALL, Boundaries, WallSide, wall_terms
-from .fluxes import cell_divergence, has_walls, pad_fields, pad_viscous, window
+from .fluxes import cell_divergence, has_walls, pad_fields, pad_viscous
+from .friction import cell_coefficients, frictional_shear_reference
 from .grid import Grid
+from .kinematics import gradient_axis, shear_rate, velocity_gradients
 from .physics import Physics
 from .state import conservative, primitive_fields
 
@@ -100,26 +102,6 @@ def gravity(cfg: Any) -> tuple[float, float, float] | None:
     return tuple(g)
 
 
-def gradient_axis(grid: Grid) -> int | None:
-    """The Lees–Edwards or wall axis (the direction of the velocity gradient), or None."""
-    bc = grid.boundaries
-    if bc is None:
-        return None
-    return bc.shear_axis if bc.shear_axis is not None else (bc.wall_axes[0] if bc.wall_axes else None)
-
-
-def shear_rate(grid: Grid) -> float:
-    """The imposed shear rate [1/s]: γ̇ of Lees–Edwards, U/L of the walls (0 for a periodic box)."""
-    bc = grid.boundaries
-    a = gradient_axis(grid)
-    if a is None:
-        return 0.0
-    if bc.shear_axis is not None:
-        return float(bc.shear_rate)
-    lower, upper = bc.walls[a]
-    return (upper.velocity[bc.flow] - lower.velocity[bc.flow]) / grid.lengths[a]
-
-
 def linear_profile(grid: Grid) -> np.ndarray:
     """u_f = γ̇(x_a − L_a/2) at the cells (the Lees–Edwards base flow; the Couette start)."""
     a = gradient_axis(grid)
@@ -138,13 +120,6 @@ def add_base_flow(U: Any, grid: Grid, base_shear: float | None = None) -> Any:
     return conservative(jnp.asarray(W[0]), jnp.asarray(np.stack(W[1:4])), jnp.asarray(W[4]))
 
 
-def _gradients(Pu: tuple, grid: Grid) -> list[list[Any]]:
-    """∂u_j/∂x_b at the cells (central differences of padded u; 0 along missing axes), rows b, columns j."""
-    zero = jnp.zeros(grid.cells, Pu[0].dtype)
-    return [[(window(Pu[j], grid.cells, b, 1, 0) - window(Pu[j], grid.cells, b, -1, 0)) * (0.5 / grid.spacing[b])
-             if b < grid.ndim else zero for j in range(3)] for b in range(3)]
-
-
 def _velocity_pad(W: Any, transport: Any, grid: Grid, phys: Physics, t: Any) -> tuple:
     """Velocities padded as the viscous fluxes see them (with walls: their ghost cells)."""
     if has_walls(grid):
@@ -157,14 +132,13 @@ def stress_tensor(U: Any, t: Any, grid: Grid, phys: Physics) -> Any:
     """Box average of P = pI − τ [Pa], as (xx, yy, zz, xy, xz, yz) (module docstring)."""
     W = primitive_fields(tuple(U))
     rho, u, theta = W[0], W[1:4], W[4]
-    from .friction import cell_coefficients  # (friction.py imports this module)
 
     r = cell_coefficients(W, grid, phys, t)  # with a frictional stress: p_f and μ_f too
     p = phys.pressure(rho, theta, r)
     transport = phys.transport(rho, theta, r)
     eta, lam, _, _ = transport
     Pu = _velocity_pad(W, transport, grid, phys, t)
-    g = _gradients(Pu, grid)
+    g = velocity_gradients(Pu, grid)
     divu = cell_divergence(Pu, grid)
     out = []
     for i, j in ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)):
@@ -207,7 +181,6 @@ def case_diagnostics(kind: str, U: Any, t: float, grid: Grid, phys: Physics) -> 
 def wall_diagnostics(U: Any, grid: Grid, phys: Physics) -> Any:
     """Mean over each wall of the shear stress η∂u_f/∂x_a [Pa] (lower, upper) and the slip u_f − U_w [m/s]."""
     W = primitive_fields(tuple(U))
-    from .friction import cell_coefficients
 
     r = cell_coefficients(W, grid, phys)
     transport = phys.transport(W[0], W[4], r)
@@ -255,18 +228,16 @@ def steady_change(kind: str, history: dict[str, list]) -> float | None:
 def uniform_shear_reference(phys: Physics, phi: float, rate: float) -> dict[str, float]:
     """Steady θ [m²/s²], η [Pa s] and p [Pa] of uniform shear at φ and γ̇ from the closed form.
 
-    θ = T(γ̇d)² with T = θ/(γ̇d)² of :func:`ktgf.couette.uniform_shear` (the energy balance
+    θ = T(γ̇d)² with T = θ/(γ̇d)² of :func:`ktgf.shear.steady.steady_shear` (the energy balance
     ηγ̇² = (3/2)ρθζ0), then η = η0(θ)η*(φ) and p = ρ_sφθp*(φ) (model.md §1, §9).
     """
-    from ..couette.uniform_shear import uniform_shear
+    from ..shear.steady import steady_temperature
 
     model, e, d, rho_s = phys.model, float(phys.restitution), float(phys.diameter), float(phys.material_density)
     if model.friction.has_stress:  # the frictional stress too: ``ktgf shear --mu`` (ktgf.solver.friction)
-        from .friction import frictional_shear_reference
 
         return frictional_shear_reference(phys, phi, rate)
-    state = uniform_shear(model, phi, e)
-    theta = float(state.temperature_ratio) * (rate * d) ** 2
+    theta = float(steady_temperature(model, phi, e)) * (rate * d) ** 2
     r = model.reduced(phi, e)
     return {"theta": theta, "eta": float(eta0(theta, d, rho_s) * r.eta), "p": float(rho_s * phi * theta * r.p)}
 
@@ -367,7 +338,7 @@ def verification(kind: str, history: dict[str, list], phys: Physics, grid: Grid,
     got = {"theta": history["theta_mean"][-1], "eta": history["viscosity"][-1], "p": history["pressure"][-1]}
     err = {k: abs(got[k] - ref[k]) / abs(ref[k]) for k in ref}
     return {
-        "reference": "closed-form uniform shear ktgf.couette.uniform_shear (model.md §9), same model",
+        "reference": "closed-form uniform shear ktgf.shear.steady (model.md §9), same model",
         "case": kind,
         "model": phys.model.name,
         "solid_fraction": phi0,

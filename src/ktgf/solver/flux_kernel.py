@@ -46,6 +46,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .cxx import shared_library
+from .stencil import GHOST, LIMITERS, RIEMANN_SOLVERS
 
 SOURCE = Path(__file__).with_name("flux_kernel.cc")
 #: Base names of the FFI targets; a variant's are these plus its :attr:`Variant.suffix`.
@@ -75,7 +76,7 @@ _loaded: dict[Any, Any] = {}
 @dataclass(frozen=True)
 class Variant:
     """One build of the kernel: the state precision (``"float64"`` or ``"float32"``), the limiter (one of
-    :data:`.fluxes.LIMITERS`), the Riemann solver (:data:`.fluxes.RIEMANN_SOLVERS`), the kind (:data:`KINDS`) and
+    :data:`.stencil.LIMITERS`), the Riemann solver (:data:`.stencil.RIEMANN_SOLVERS`), the kind (:data:`KINDS`) and
     the row length: the cells along the grid's last axis the library sweeps, 0 for any (:func:`row_length`)."""
 
     dtype: str
@@ -85,7 +86,6 @@ class Variant:
     row: int = 0
 
     def __post_init__(self) -> None:
-        from .fluxes import LIMITERS, RIEMANN_SOLVERS
 
         for value, valid in ((self.dtype, ("float64", "float32")), (self.limiter, LIMITERS),
                              (self.riemann, RIEMANN_SOLVERS), (self.kind, KINDS)):
@@ -106,7 +106,6 @@ class Variant:
     @property
     def macros(self) -> tuple[str, ...]:
         """The ``-D`` flags that select the variant in flux_kernel.cc."""
-        from .fluxes import LIMITERS, RIEMANN_SOLVERS
 
         return (f"-DKTGF_REAL={'double' if self.dtype == 'float64' else 'float'}",
                 f"-DKTGF_LIMITER={LIMITERS.index(self.limiter)}",
@@ -207,7 +206,6 @@ def _target(base: str, dtype: Any, limiter: str, riemann: str, kind: str, grid: 
 
 def _cell_fields(W: Any, eos: Any, transport: Any, grid: Any, viscous: bool) -> tuple[list[Any], Any]:
     """The kernel's 11 cell-field inputs and its workspace (their copies with periodic ghost cells)."""
-    from .fluxes import GHOST
 
     dtype = W[0].dtype
     fields = [jnp.asarray(f, dtype) for f in (*W, *eos)]
@@ -218,7 +216,6 @@ def _cell_fields(W: Any, eos: Any, transport: Any, grid: Any, viscous: bool) -> 
 
 
 def _schemes(limiter: str, riemann: str) -> dict[str, Any]:
-    from .fluxes import LIMITERS, RIEMANN_SOLVERS
 
     return {"limiter": np.int32(LIMITERS.index(limiter)), "riemann": np.int32(RIEMANN_SOLVERS.index(riemann))}
 

@@ -32,9 +32,7 @@ from .boundaries import lees_edwards_faces
 from .grid import Grid
 from .physics import Physics
 from .state import conservative_fields
-
-LIMITERS = ("minmod", "vanleer", "mc", "none")
-RIEMANN_SOLVERS = ("hll", "rusanov")
+from .stencil import GHOST, LIMITERS, RIEMANN_SOLVERS  # noqa: F401  (fluxes.GHOST etc. are read elsewhere)
 
 
 def limited_slope(dm: Any, dp: Any, limiter: str) -> Any:
@@ -54,8 +52,6 @@ def limited_slope(dm: Any, dp: Any, limiter: str) -> Any:
     return jnp.where(prod > 0.0, s, 0.0)
 
 
-#: Ghost cells per side: the MUSCL stencil of a face reaches two cells away.
-GHOST = 2
 #: Materialise shared intermediates (padded fields, face states, wave speeds, transport
 #: coefficients) with ``lax.optimization_barrier`` so XLA does not recompute them inside every
 #: consumer fusion (there are 5 flux components × 2 faces per cell consuming each).

@@ -35,11 +35,13 @@ from collections import namedtuple
 from typing import Any
 
 import jax
+import numpy as np
 import jax.numpy as jnp
 
 from ..closures.coefficients import Reduced
 from .fluxes import pad_fields
 from .grid import Grid
+from .kinematics import shear_rate, velocity_gradients
 from .physics import Physics
 
 
@@ -53,7 +55,6 @@ def for_case(phys: Physics, kind: str, grid: Grid) -> Physics:
     """The physics of a case: the HCS dissipation for ``cooling``, and the case's shear-rate scale."""
     import dataclasses
 
-    from .flows import shear_rate
 
     return dataclasses.replace(phys, hcs=kind == "cooling", shear_rate_scale=abs(float(shear_rate(grid))))
 
@@ -67,9 +68,8 @@ def needs_rate(phys: Physics) -> bool:
 def strain_invariants(u: Any, grid: Grid, t: Any = 0.0) -> tuple[Any, Any]:
     """(S:S, ∇·u) at the cells, S the deviatoric strain rate, by central differences of the padded u
     (Lees–Edwards images at time t; extrapolated ghosts at walls)."""
-    from .flows import _gradients
 
-    g = _gradients(pad_fields(tuple(u), grid, t, velocity=0), grid)
+    g = velocity_gradients(pad_fields(tuple(u), grid, t, velocity=0), grid)
     divu = g[0][0] + g[1][1] + g[2][2]
     dd = sum(0.25 * (g[b][j] + g[j][b]) ** 2 for b in range(3) for j in range(3))
     return dd - divu * divu / 3.0, divu
@@ -114,11 +114,11 @@ def explicit_part(r: Any) -> Any:
 
 def frictional_shear_reference(phys: Physics, phi: float, rate: float) -> dict[str, float]:
     """Steady θ [m²/s²], η = τ/γ̇ [Pa s] and p [Pa] of uniform shear with a frictional stress: the closed
-    form of ``ktgf shear --mu`` (:func:`ktgf.closures.friction_shear.model_uniform_shear`, unregularised)."""
-    from ..closures.friction_shear import model_uniform_shear
+    form of ``ktgf shear --mu`` (:func:`ktgf.shear.steady.steady_shear`, unregularised)."""
+    from ..shear.steady import steady_shear
 
     d, rho_s = float(phys.diameter), float(phys.material_density)
     scale = rho_s * (d * rate) ** 2
-    s = model_uniform_shear(phys.model, phi, float(phys.restitution), stress_scale=scale)
+    s = steady_shear(phys.model, np.atleast_1d(np.asarray(phi, dtype=float)), float(phys.restitution), stress_scale=scale)
     p = float(s.p_star[0]) * scale
     return {"theta": float(s.T[0]) * (rate * d) ** 2, "eta": float(s.tau_over_p[0]) * p / rate, "p": p}

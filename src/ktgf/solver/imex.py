@@ -32,7 +32,7 @@ second by CG (symmetric positive definite), both matrix-free with the exact inve
 constant-coefficient operator (mean ρ̂, η, λ_b, κ) applied by FFT as preconditioner (periodic
 grid; the symbols of the same discrete stencils).  ``sweeps`` Picard passes update θ_k: the
 first uses θ of Û (an O(Δt) error in the coefficients), the second θ of the first solution
-(O(Δt²)), which keeps the scheme second order (measured in tests/test_solver_imex.py).  The
+(O(Δt²)), which keeps the scheme second order (measured in tests/solver/test_solver_imex.py).  The
 stage state is then U = Û + aΔt f_I(ρ̂, u, θ) with f_I the same flux divergence the explicit
 scheme uses, so mass, momentum and energy are conserved exactly whatever the solver residual;
 the residual (stage equation minus that state) is checked, and a solve whose relative

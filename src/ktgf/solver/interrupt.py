@@ -9,7 +9,7 @@ matches the files on disk and stops.  A second signal quits at once with ``os._e
 every file ktgf writes is replaced atomically, so the last checkpoint stays consistent.
 
 ``KTGF_TEST_INTERRUPT`` places a SIGINT deterministically for the fault-injection tests
-(tests/test_reliability_interrupt.py): ``compile`` (0.2 s after the first chunk starts, i.e.
+(tests/solver/test_reliability_interrupt.py): ``compile`` (0.2 s after the first chunk starts, i.e.
 during its compilation), ``chunk:N`` (after the N-th chunk), ``output:K`` (while output K
 is being written) or ``checkpoint:K`` (just after the checkpoint of output K); a third part
 ``:KILL`` sends SIGKILL instead (a crash: nothing can be saved).

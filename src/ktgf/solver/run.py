@@ -35,9 +35,8 @@ import numpy as np
 from ..closures import get_model
 from ..closures.coefficients import mean_free_path
 from ..errors import DivergenceError, InputError, KtgfError
-from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
 from ..io import write_netcdf
-from .config import Config, initial_temperature
+from .config import Config, box_lengths, config_value, initial_temperature
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
 from .flows import (CASE_COLUMNS, CASE_UNITS, PROFILES, VERIFICATION_FILE, add_base_flow, case_diagnostics,
                     gradient_axis, shear_rate, steady_change, verification)
@@ -48,7 +47,8 @@ from .friction import for_case
 from .grid import Grid
 from .initial import haff_time, perturb, random_velocity, shear_mode, single_mode, t_of_tau, tau_of_t, uniform_fields
 from .interrupt import STOP, Interrupted, fault_hook
-from .io import load_checkpoint, save_checkpoint, save_slices, write_vti
+from ..plotting.fields import save_slices
+from .io import load_checkpoint, save_checkpoint, write_vti
 from .physics import Physics
 from .sequencing import mean_temperature, start_from_run
 from .state import PRIMITIVE_NAMES, conservative, primitive
@@ -108,32 +108,6 @@ def _diff(a: Any, b: Any, prefix: str = "") -> list[str]:
             out += _diff(a.get(key), b.get(key), f"{prefix}{key}.")
         return out
     return [] if a == b else [prefix.rstrip(".") or "config"]
-
-
-def _get(d: Any, dotted: str) -> Any:
-    for key in dotted.split("."):
-        d = d.get(key) if isinstance(d, dict) else None
-    return d
-
-
-def box_lengths(cfg: Config) -> tuple[float, ...]:
-    """Box sides [m] from ``grid.length``, ``grid.length_d`` or ``relative_to``·``factor``."""
-    g, d, ndim = cfg.grid, cfg.particles.diameter, len(cfg.grid.cells)
-
-    def per_axis(v: Any, scale: float) -> tuple[float, ...]:
-        vals = v if isinstance(v, list) else [v]
-        vals = vals * ndim if len(vals) == 1 else vals
-        return tuple(float(x) * scale for x in vals)
-
-    if g.length is not None:
-        return per_axis(g.length, 1.0)
-    if g.length_d is not None:
-        return per_axis(g.length_d, d)
-    phi0 = cfg.initial.solid_fraction
-    model = get_model(cfg.model.name, **cfg.model.options)
-    kp, kl = critical_wavenumbers(model.reduced(phi0, cfg.model.restitution, hcs=True))
-    k = float(kp if g.relative_to == "transverse" else kl)
-    return per_axis(g.factor * BOX_CONSTANT / (phi0 * k), d)
 
 
 def _x64(enabled: bool) -> Any:
@@ -482,8 +456,8 @@ class Simulation:
         if changed:
             f = changed[0]
             raise InputError(
-                f"{name} was written by a different configuration: field {f} = {_get(old, f)!r} in the checkpoint, "
-                f"{_get(new, f)!r} now (on resume only {', '.join(RESUMABLE_CHANGES)} may change)"
+                f"{name} was written by a different configuration: field {f} = {config_value(old, f)!r} in the checkpoint, "
+                f"{config_value(new, f)!r} now (on resume only {', '.join(RESUMABLE_CHANGES)} may change)"
             )
         U, t, steps, k, history = ck["U"], ck["t"], ck["steps"], ck["output_index"], ck["history"]
         shape = (5, *self.grid.cells)

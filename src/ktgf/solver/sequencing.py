@@ -90,7 +90,7 @@ def _earlier_cost(path: str | Path, steps: int) -> dict[str, Any]:
 def start_from_run(cfg: Any, cells: tuple[int, ...], lengths: tuple[float, ...]) -> tuple[np.ndarray, dict[str, Any]]:
     """The state of ``cfg.initial.from_run`` mapped onto this grid (checked against ``cfg``), and a record of it."""
     from .flows import boundaries
-    from .run import box_lengths
+    from .config import box_lengths
 
     source = cfg.initial.from_run
     U_old, old, steps = load_run(source)
@@ -121,12 +121,12 @@ def _leaves(d: Any, prefix: str = "") -> dict[str, Any]:
 def check_compatible(old: Any, new: Any, old_lengths: tuple[float, ...], new_lengths: tuple[float, ...],
                      source: str) -> None:
     """Refuse (one line naming the field) an earlier run that is not the same flow on a mappable box."""
-    from .run import _get  # (run.py imports this module)
+    from .config import config_value
 
     a, b = old.model_dump(mode="json"), new.model_dump(mode="json")
     where = f"(initial.from_run = {source!r})"
     for name in SAME_FIELDS:
-        sa, sb = _leaves(_get(a, name), name + "."), _leaves(_get(b, name), name + ".")
+        sa, sb = _leaves(config_value(a, name), name + "."), _leaves(config_value(b, name), name + ".")
         for key in sorted(set(sa) | set(sb)):
             if sa.get(key) != sb.get(key):
                 raise InputError(f"field {key} = {sb.get(key)!r} differs from the earlier run's {sa.get(key)!r} "

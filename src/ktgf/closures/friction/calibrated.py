@@ -14,26 +14,7 @@ is the one part of the registry that acts in that direction.  At the fitted c it
 
 from __future__ import annotations
 
-from typing import Any
-
-#: c of ``frictional``: :func:`fit_correlation_constant` on ``dem_uniform_shear_friction.csv`` (docs/friction.md §6).
+#: c of ``frictional``: :func:`ktgf.calibration.registry_fits.fit_correlation_constant` on ``dem_uniform_shear_friction.csv`` (docs/friction.md §6).
 FRICTIONAL_C = 0.7921
 #: (μ, φ) of the DEM row whose T fixes c.
 FIT_ROW = (0.5, 0.5)
-
-
-def fit_correlation_constant(rows: list[dict[str, float]], base: Any = None) -> float:
-    """c such that the model's uniform-shear T equals the DEM's at :data:`FIT_ROW` (Brent's method on [0.3, 2])."""
-    from scipy.optimize import brentq
-
-    from ..friction_shear import model_uniform_shear
-    from ..models import get_model
-
-    row = next(r for r in rows if (r["mu"], r["phi"]) == FIT_ROW)
-    base = base or get_model("frictional")
-
-    def miss(c: float) -> float:
-        m = base.with_options(mu=row["mu"], dissipation="jenkins-berzi-2010", c=c)
-        return float(model_uniform_shear(m, [row["phi"]], row["e"]).T[0]) / row["T"] - 1.0
-
-    return float(brentq(miss, 0.3, 2.0, xtol=1e-12))

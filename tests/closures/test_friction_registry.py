@@ -1,0 +1,230 @@
+"""The ``friction`` part of the registry: exact reduction at μ = 0, the ``frictional`` model, model files, ``ktgf shear --mu``."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from ktgf import get_model, list_models
+from ktgf.calibration.model_file import dumps, load_model_file, part_choice_options
+from ktgf.cli import app
+from ktgf.closures.friction import WaltonRestitution
+from ktgf.closures.friction.model_slot import Friction
+from ktgf.data import FRICTION_SHEAR as DEM_FILE, read_friction_shear
+from ktgf.shear.compositions import frictional_uniform_shear, recommended_parts
+from ktgf.shear.steady import steady_shear
+from ktgf.closures.dissipation import CorrelationLength
+from ktgf.calibration.registry_fits import fit_correlation_constant
+from ktgf.closures.friction.calibrated import FRICTIONAL_C
+from ktgf.closures.rdf import ChialvoSundaresan
+from ktgf.errors import InputError
+
+runner = CliRunner()
+PHI = np.array([0.05, 0.2, 0.35, 0.45, 0.5, 0.55])
+
+
+def _same_bits(a, b) -> bool:
+    return all(np.array_equal(np.asarray(x), np.asarray(y)) for x, y in zip(a, b))
+
+
+FRICTIONLESS = get_model("ret").replace(rdf=ChialvoSundaresan(), dissipation=CorrelationLength(c=FRICTIONAL_C))
+
+
+def test_frictional_model_at_mu_zero_is_the_frictionless_model_bit_for_bit():
+    """μ = 0: the RDF's φ_c(0) is φ_rcp = 0.64 exactly and ζ0 is untouched: RET + Chialvo–Sundaresan χ (+ its EKT part)."""
+    fr = get_model("frictional", mu=0.0)
+    for e in (0.5, 0.7, 0.95, 1.0):  # e = 1 is allowed without friction
+        assert _same_bits(fr.reduced(PHI, e), FRICTIONLESS.reduced(PHI, e))
+        assert _same_bits(fr.reduced(PHI, e, shear=np.full(PHI.size, 3.0)), FRICTIONLESS.reduced(PHI, e, shear=np.full(PHI.size, 3.0)))
+        assert _same_bits(fr.coefficients(PHI, e, 0.01, d=1e-3, rho_s=2500.0),
+                          FRICTIONLESS.coefficients(PHI, e, 0.01, d=1e-3, rho_s=2500.0))
+    a, b = steady_shear(fr, PHI, 0.7), steady_shear(FRICTIONLESS, PHI, 0.7)
+    assert _same_bits(a._replace(Trot_over_T=0), b._replace(Trot_over_T=0))
+    assert np.all(a.Trot_over_T == 0.0) and np.all(np.isnan(b.Trot_over_T))  # no rotation excited / not modelled
+    # and without the EKT part (its c is the one fitted number) the frictionless core is RET + CS13 χ
+    assert _same_bits(get_model("frictional", mu=0.0, dissipation="none").reduced(PHI, 0.7),
+                      get_model("ret").replace(rdf=ChialvoSundaresan()).reduced(PHI, 0.7))
+
+
+@pytest.mark.parametrize("name", [m.name for m in list_models() if m.friction.key == "none"])
+@pytest.mark.parametrize("law", ["walton", "rough-sphere", "chialvo-sundaresan-2013"])
+def test_every_model_with_a_friction_part_at_mu_zero_is_unchanged(name, law):
+    base = get_model(name)
+    fr = base.with_options(friction="coulomb", mu=0.0, restitution=law)
+    phi = PHI[PHI < base.phi_max]
+    assert _same_bits(fr.reduced(phi, 0.8), base.reduced(phi, 0.8))
+
+
+def test_friction_changes_only_the_dissipation_by_the_walton_factor():
+    fr = get_model("frictional", mu=0.5)
+    ref = FRICTIONLESS.replace(rdf=fr.rdf)
+    a, b = fr.reduced(PHI[:-1], 0.7), ref.reduced(PHI[:-1], 0.7)
+    inel = WaltonRestitution().inelasticity(0.7, 0.5)
+    for k in a._fields:
+        if k == "zeta0":
+            np.testing.assert_allclose(a.zeta0, b.zeta0 * inel / (1 - 0.7**2), rtol=1e-14)
+        else:
+            assert np.array_equal(getattr(a, k), getattr(b, k)), k
+
+
+def test_mu_is_routed_to_the_friction_part_and_the_jamming_fraction():
+    m = get_model("frictional", mu=0.1)
+    assert m.friction.mu == 0.1 and m.rdf.mu == 0.1
+    assert m.phi_max == pytest.approx(0.595, abs=1e-12)  # φ_c(0.1), docs/friction.md §2
+    assert get_model("frictional").friction.mu == 0.5  # registered default
+    assert m.metadata()["friction"] == "coulomb" and '"friction"' in m.metadata()["model_options"]
+
+
+def test_registered_model_is_the_documented_composition():
+    """``frictional`` = the parts of ktgf.shear.compositions.recommended_parts (docs/friction.md §6 numbers)."""
+    rows = [(0.4, 0.170, 0.539, 0.630, 0.497), (0.5, 0.184, 2.393, 0.599, 0.497)]  # docs/friction.md §6 table
+    s = steady_shear(get_model("frictional", mu=0.5), [r[0] for r in rows], 0.7)
+    parts = frictional_uniform_shear(recommended_parts(), [r[0] for r in rows], 0.7, 0.5)
+    for a, b in zip(s, parts):
+        np.testing.assert_allclose(a, b, rtol=1e-12)
+    for i, (_, T, p, tau, rot) in enumerate(rows):
+        assert (s.T[i], s.p_star[i], s.tau_over_p[i], s.Trot_over_T[i]) == pytest.approx((T, p, tau, rot), abs=6e-4)
+
+
+@pytest.mark.parametrize(
+    "options, field",
+    [
+        ({"mu": -0.1}, "mu"),
+        ({"stress": "schaeffer", "jj_phi_max": 0.6}, "jj_phi_max"),  # above φ_c(0.5) = 0.565
+        ({"stress": "schaeffer", "jj_phi_min": 0.58}, "jj_phi_min"),
+        ({"blend": "tanh", "blend_phi_star": 0.6}, "blend_phi_star"),
+        ({"blend": "tanh", "blend_phi_star": 0.5, "blend_width": 0.0}, "blend_width"),
+        ({"blend": "sigmoid"}, "blend_phi_star"),
+        ({"restitution": "smooth"}, "restitution"),
+        ({"stress": "mfix"}, "stress"),
+        ({"regularisation": -1e-3}, "regularisation"),
+    ],
+)
+def test_bad_friction_options_are_one_line_errors_naming_the_option(options, field):
+    with pytest.raises(InputError) as info:
+        get_model("frictional", **options)
+    msg = str(info.value)
+    assert field in msg and "\n" not in msg
+
+
+def test_frictional_dissipation_needs_e_below_one():
+    with pytest.raises(InputError, match="restitution coefficient e = 1"):
+        get_model("frictional").reduced(0.3, 1.0)
+
+
+def test_model_files_round_trip_the_friction_part(tmp_path):
+    cases = [
+        ("frictional", {"mu": 0.3, "restitution": "rough-sphere", "tangential_beta": 0.699}),
+        ("ret", {"friction": "coulomb", "mu": 0.25, "stress": "srivastava-sundaresan", "jj_phi_min": 0.55,
+                 "blend": "tanh", "blend_phi_star": 0.56}),
+        ("frictional", {"friction": "none"}),  # friction removed: RET with the frictionless CS13 RDF at mu = 0.5's φ_c
+    ]
+    for k, (base, opts) in enumerate(cases):
+        path = tmp_path / f"m{k}.toml"
+        path.write_text(dumps(base, opts, name=f"m{k}"))
+        mf = load_model_file(path)
+        want = get_model(base, **opts)
+        assert mf.model.friction == want.friction and mf.model.rdf == want.rdf
+        assert _same_bits(mf.model.reduced(0.4, 0.7), want.reduced(0.4, 0.7))
+        # what a calibration would write back (the part choice and the changed options) reloads to the same model
+        written = {**part_choice_options(mf.model, get_model(base)),
+                   **{o: v for o, v in mf.model.options().items() if get_model(base).options().get(o, object()) != v}}
+        again = tmp_path / f"again{k}.toml"
+        again.write_text(dumps(base, written))
+        assert load_model_file(again).model.friction == mf.model.friction
+
+
+def test_model_file_friction_option_errors_name_the_field(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(dumps("ret", {"mu": 0.3}))  # no friction part chosen: mu is not an option of ret
+    with pytest.raises(InputError, match="model.options.mu"):
+        load_model_file(path)
+
+
+def test_shear_cli_mu_prints_the_dem_columns():
+    r = runner.invoke(app, ["shear", "--model", "frictional", "--mu", "0.5", "--phi", "0.4,0.5", "--e", "0.7", "--format", "json"])
+    assert r.exit_code == 0, r.output
+    rows = json.loads(r.stdout)
+    want = steady_shear(get_model("frictional", mu=0.5), [0.4, 0.5], 0.7)
+    for i, row in enumerate(rows):
+        for col in ("phi", "T", "Trot_over_T", "p_star", "tau_over_p", "p_over_nT"):
+            assert row[col] == pytest.approx(float(getattr(want, col)[i]), rel=1e-12), col
+        assert {"eta_star", "eta_over_eta0", "astar", "L_over_d"} <= set(row)  # the frictionless columns stay
+    # a frictionless model: no rotation (null), and --mu 0 changes nothing
+    plain = json.loads(runner.invoke(app, ["shear", "--model", "ret", "--phi", "0.3", "--e", "0.7", "--format", "json"]).stdout)
+    zero = json.loads(runner.invoke(app, ["shear", "--model", "ret", "--mu", "0", "--phi", "0.3", "--e", "0.7",
+                                          "--format", "json"]).stdout)
+    assert plain == zero and plain[0]["Trot_over_T"] is None
+    csv = runner.invoke(app, ["shear", "--model", "frictional", "--mu", "0.3", "--phi", "0.4", "--e", "0.7", "--format", "csv"])
+    assert csv.stdout.splitlines()[0] == ("model,phi,e,T,eta_star,eta_over_eta0,p_over_nT,astar,tau_over_p,L_over_d,"
+                                          "Trot_over_T,p_star,mu")  # the frictionless columns keep their places
+
+
+@pytest.mark.parametrize(
+    "extra, word",
+    [
+        (["--mu", "-0.5"], "mu"),
+        (["--mu", "0.5", "-O", "stress=schaeffer", "-O", "jj_phi_max=0.6"], "jj_phi_max"),
+        (["--mu", "0.5", "-O", "blend=tanh", "-O", "blend_phi_star=0.5", "-O", "blend_width=0"], "blend_width"),
+        (["--mu", "0.5", "-O", "stress=schaeffer"], "--stress-scale"),
+        (["--mu", "0.5", "--phi", "0.6"], "phi"),
+    ],
+)
+def test_shear_cli_bad_friction_input_exits_2_with_one_line(extra, word):
+    args = ["shear", "--model", "frictional", "--e", "0.7"] + (["--phi", "0.4"] if "--phi" not in extra else []) + extra
+    r = runner.invoke(app, args)
+    assert r.exit_code == 2, r.output
+    lines = [ln for ln in r.output.strip().splitlines() if ln.strip()]
+    assert len(lines) == 1 and word in lines[0]
+
+
+def test_shear_cli_frictional_stress_adds_to_the_pressure():
+    """At φ = 0.55 > φ_min the Johnson–Jackson stress adds p_f/(ρ_s d²γ̇²) to p* and sin φ_fr p_f to τ."""
+    scale = 2500.0 * 1e-6 * 100.0  # ρ_s d² γ̇² [Pa]: 2500 kg/m³, 1 mm, 10 /s
+    args = ["shear", "--model", "frictional", "--mu", "0.5", "--phi", "0.55", "--e", "0.7", "--format", "json"]
+    kin = json.loads(runner.invoke(app, args).stdout)[0]
+    r = runner.invoke(app, args + ["-O", "stress=schaeffer", "--stress-scale", str(scale)])
+    assert r.exit_code == 0, r.output
+    fr = json.loads(r.stdout)[0]
+    m = get_model("frictional", stress="schaeffer")
+    p_f = float(m.friction.pressure_part(m.phi_max).pressure(0.55)) / scale
+    assert fr["p_star"] == pytest.approx(kin["p_star"] + p_f, rel=1e-12)
+    tau = kin["tau_over_p"] * kin["p_star"] + np.sin(np.radians(28.5)) * p_f
+    assert fr["tau_over_p"] == pytest.approx(tau / fr["p_star"], rel=1e-12)
+
+
+def test_walton_under_jit_is_the_numpy_value():
+    jax = pytest.importorskip("jax")
+    m = get_model("frictional")
+    got = jax.jit(lambda e: m.reduced(0.4, e, check=False).zeta0)(jax.numpy.asarray(0.7))
+    assert float(got) == float(m.reduced(0.4, 0.7).zeta0)
+
+
+def test_friction_part_is_hashable_and_a_value():
+    a, b = Friction(mu=0.3), Friction(mu=0.3)
+    assert a == b and hash(a) == hash(b) and a.law == b.law
+
+
+def test_the_fitted_constant_is_the_registered_one(data_dir):
+    """c of ``frictional`` is solved from T at μ = 0.5, φ = 0.5 of the shared file (the one fitted number)."""
+    c = fit_correlation_constant(read_friction_shear(data_dir / DEM_FILE))
+    assert c == pytest.approx(FRICTIONAL_C, abs=1e-4)
+    assert get_model("frictional").dissipation.c == FRICTIONAL_C
+
+
+def test_dem_rows_within_15_percent_and_the_no_fit_variant_is_not(data_dir):
+    """The issue's goal on the shared file: T, p*, τ/p within 15 % at μ = 0.5 (T at φ = 0.5 is the fit, the other
+    five are predictions); without the fitted EKT part the φ = 0.5 row misses it (T −17 %, p* −23 %)."""
+    rows = [r for r in read_friction_shear(data_dir / DEM_FILE) if r["mu"] == 0.5]
+
+    def errs(m):
+        s = steady_shear(m, [r["phi"] for r in rows], 0.7)
+        return np.array([[getattr(s, q)[i] / r[q] - 1 for q in ("T", "p_star", "tau_over_p")] for i, r in enumerate(rows)])
+
+    fitted, plain = errs(get_model("frictional", mu=0.5)), errs(get_model("frictional", mu=0.5, dissipation="none"))
+    assert np.all(np.abs(fitted) < 0.15), fitted
+    assert abs(fitted[1, 0]) < 1e-3  # the fitted number
+    assert np.abs(plain[1]).max() > 0.2

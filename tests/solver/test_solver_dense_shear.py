@@ -1,0 +1,100 @@
+"""Dense sheared flows in the 3D solver (φ up to 0.55, model "dense", IMEX) run to a detected steady
+state and agree with the closed form (uniform shear) and the 1D Couette solver.
+
+Oracles from outside the 3D solver: the closed-form uniform shear of :mod:`ktgf.shear.steady`
+(θ, η, p of the energy balance ηγ̇² = (3/2)ρθζ0, model.md §9) and the steady profile of the 1D
+Couette solver :func:`ktgf.couette.run.run` (same model, walls, inventory and gap).  The runs start
+off the steady state (θ three times the steady one; uniform φ, θ in the Couette cell), so the
+steady-state stop (``time.steady_tol``) has a transient to detect.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ktgf.errors import InputError
+from ktgf.solver.config import load_config, parse_config
+from ktgf.solver.flows import steady_change, uniform_shear_reference
+from ktgf.solver.run import Simulation
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _example(name: str, **changes: object) -> dict:
+    data = tomllib.loads((ROOT / "examples" / f"{name}.toml").read_text())
+    for dotted, value in changes.items():
+        section, key = dotted.split("__")
+        data[section][key] = value
+    return data
+
+
+def test_steady_change_is_the_largest_relative_change_of_the_monitors_between_the_last_two_outputs() -> None:
+    h = {"time": [0.0, 1.0], "theta_mean": [2.0, 2.002], "viscosity": [1.0, 1.0], "pressure": [4.0, 3.996]}
+    assert steady_change("uniform-shear", h) == pytest.approx(max(0.002 / 2.002, 0.004 / 3.996))
+    assert steady_change("uniform-shear", {k: v[:1] for k, v in h.items()}) is None
+    assert steady_change("cooling", h) is None
+    # profiles: u relative to max|u| (u changes sign mid-gap), φ and θ pointwise
+    p = {"time": [0.0, 1.0], "u_profile": [[-1.0, 0.0, 1.0], [-1.0, 0.01, 1.0]],
+         "phi_profile": [[0.5, 0.5, 0.5]] * 2, "theta_profile": [[1.0, 2.0, 1.0], [1.0, 2.0, 1.001]]}
+    assert steady_change("couette", p) == pytest.approx(0.01)
+
+
+def test_steady_tol_is_refused_for_the_cooling_box_in_one_line_naming_the_field() -> None:
+    data = tomllib.loads((ROOT / "examples" / "hcs_3d.toml").read_text())
+    data["time"]["steady_tol"] = 1e-4
+    with pytest.raises(InputError, match="field time.steady_tol") as exc:
+        parse_config(data)
+    assert "\n" not in str(exc.value)
+    data["time"]["steady_tol"] = -1.0
+    with pytest.raises(InputError, match="time.steady_tol"):
+        parse_config(data)
+
+
+def _check_uniform_shear(sim: Simulation, tolerance: float) -> dict:
+    sim.run(progress=False, write_files=False)
+    ver = sim.verification
+    ref = uniform_shear_reference(sim.phys, sim.phi0, 50.0)
+    assert sim.theta0 == pytest.approx(3.0 * ref["theta"], rel=0.01)  # started off the steady state
+    assert ver["steady"]["reached"], ver["steady"]
+    assert ver["steady"]["strain"] < sim.cfg.time.end  # the stop, not the end time, ended the run
+    assert max(ver["max_rel_error"].values()) < tolerance, ver["max_rel_error"]
+    assert ver["run"]["binding_step_limit"] in ("cfl", "cooling")
+    return ver
+
+
+def test_dense_uniform_shear_small_box_reaches_the_closed_form_and_stops_when_steady() -> None:
+    """The 64³ example's path (dense model, φ 0.55, IMEX, mixed precision, steady stop) on 4³ (8 d)."""
+    sim = Simulation(parse_config(_example("uniform_shear_dense", grid__cells=[4, 4, 4], grid__length_d=8.0)))
+    _check_uniform_shear(sim, 1e-3)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("phi, precision", [(0.55, "mixed"), (0.5, "float64")])
+def test_dense_uniform_shear_32_cubed_reaches_the_closed_form(phi: float, precision: str) -> None:
+    sim = Simulation(parse_config(_example("uniform_shear_dense", grid__cells=[32, 32, 32], grid__length_d=32.0,
+                                           initial__solid_fraction=phi, initial__temperature=3.0 * {
+                                               0.55: 9.968341e-4, 0.5: 1.0611799e-3}[phi],
+                                           numerics__precision=precision)))
+    _check_uniform_shear(sim, 1e-3)
+
+
+@pytest.mark.slow
+def test_dense_uniform_shear_example_64_cubed_reaches_the_closed_form() -> None:
+    """examples/uniform_shear_dense.toml as shipped (64³; about 10 min wall on 2 loaded cores)."""
+    _check_uniform_shear(Simulation(load_config(ROOT / "examples" / "uniform_shear_dense.toml")), 1e-3)
+
+
+@pytest.mark.slow
+def test_dense_couette_example_reaches_the_1d_solver_within_one_percent() -> None:
+    """examples/couette_dense.toml (φ̄ 0.5, 64 cells across the gap) against the 1D Couette solver."""
+    sim = Simulation(load_config(ROOT / "examples" / "couette_dense.toml"))
+    sim.run(progress=False, write_files=False)
+    ver = sim.verification
+    assert ver["steady"]["reached"] and ver["cells_across_gap"] == 64, ver["steady"]
+    assert max(ver["max_rel_error"].values()) < 0.01, ver["max_rel_error"]
+    tau = np.asarray(ver["wall_shear_stress_Pa"]["run"]) / np.asarray(ver["wall_shear_stress_Pa"]["reference"])
+    assert np.max(np.abs(tau - 1.0)) < 0.01, ver["wall_shear_stress_Pa"]
