@@ -19,7 +19,8 @@ homogeneous cooling (``phi, e, A_main, A_early``)
 A row is *fitted* when its state (a row of a shear file, a Couette file) was in the data the
 model's parameters were fitted to: for a model file, the files of its ``[[provenance.data]]`` (by
 SHA-256, or by name for a file without hash) with every state :func:`ktgf.data.read_data`
-takes from them (``ktgf calibrate`` fits them all); for a registered model, :data:`REGISTERED_FITS`.
+takes from them (``ktgf calibrate`` fits them all); for a registered model,
+:data:`ktgf.calibration.registry_fits.REGISTERED_FITS`.
 """
 
 from __future__ import annotations
@@ -32,9 +33,10 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..errors import ConvergenceError, InputError
 from ..data import RHO_S_DEM, file_hash
 from ..data.table import Table, check_units, read_table, resolve
+from ..errors import ConvergenceError, InputError
+from .registry_fits import REGISTERED_FITS, FitSource
 
 CASES = ("uniform-shear", "frictional-shear", "couette", "homogeneous-cooling")
 _CASE_COLUMNS = {
@@ -44,25 +46,6 @@ _CASE_COLUMNS = {
     "homogeneous-cooling": ("phi", "e", "A_main", "A_early"),
 }
 FRICTION_QUANTITIES = {"T": "dT", "p_star": "dp_star", "tau_over_p": "dtau_over_p", "Trot_over_T": "dTrot_over_T"}
-
-
-@dataclass(frozen=True)
-class FitSource:
-    """States of one data file a model was fitted to: ``states`` are (μ, φ, e) tuples, or None for every state."""
-
-    file: str
-    states: tuple[tuple[float, float, float], ...] | None = None
-    sha256: str = ""
-
-
-#: What the registered fitted models were fitted to (their docstrings and docs/dense.md, docs/friction.md):
-#: ``dense`` — β on both rows of dem_uniform_shear.csv (φ 0.3, 0.5; e 0.9); ``frictional`` — the EKT
-#: constant c on T of the row μ = 0.5, φ = 0.5 of dem_uniform_shear_friction.csv.  The other registered
-#: models have published parameters only: every row is a prediction.  Update this with the models.
-REGISTERED_FITS: dict[str, tuple[FitSource, ...]] = {
-    "dense": (FitSource("dem_uniform_shear.csv"),),
-    "frictional": (FitSource("dem_uniform_shear_friction.csv", ((0.5, 0.5, 0.7),)),),
-}
 
 
 def detect_case(path: str | Path) -> str:
