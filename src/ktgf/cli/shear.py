@@ -63,9 +63,10 @@ def shear(
     option: list[str] = typer.Option(
         None, "--option", "-O", help="Model option KEY=VALUE (repeatable, applied to every model), e.g. phi_f=0.46."
     ),
-    band_jacobian: str = typer.Option("jax", "--band-jacobian", help="How the +-1 sigma bands of a --model-file fit "
-                                      "differentiate the prediction: jax (exact; compiles once per process) or differences "
-                                      "(vectorised central differences, no JAX: faster for one command)."),
+    band_jacobian: str = typer.Option("differences", "--band-jacobian", help="How the +-1 sigma bands of a --model-file "
+                                      "fit differentiate the prediction: differences (vectorised central differences, "
+                                      "relative error ~1e-8; default: a band costs about one prediction) or jax (exact "
+                                      "JAX Jacobian; importing and compiling JAX costs seconds per command)."),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Steady uniform (Lees–Edwards) shear from the closed forms of docs/model.md §9 (frictional: docs/friction.md).
