@@ -139,6 +139,14 @@ def test_units_or_columns_that_do_not_match(data_dir, tmp_path, name, old, new, 
     _one_line_exit_2(["validate", "--model", "dense", "--data", str(f)], match)
 
 
+def test_without_data_the_shipped_files_are_used(dense_table):
+    r = runner.invoke(app, ["validate", "--model", "dense", "--cells", CELLS, "--format", "json"])
+    assert r.exit_code == 0, r.output
+    shipped = json.loads(r.stdout)["rows"]
+    assert [(x["file"], x["state"], x["quantity"], x["dem"]) for x in shipped] == \
+        [(x["file"], x["state"], x["quantity"], x["dem"]) for x in dense_table["rows"]]
+
+
 def test_missing_data_and_model_choice(tmp_path, data_dir):
     _one_line_exit_2(["validate", "--model", "dense", "--data", str(tmp_path / "none.csv")], "does not exist")
     _one_line_exit_2(["validate", "--data", str(data_dir)], "give exactly one of --model NAME or --model-file FILE")

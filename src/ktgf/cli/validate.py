@@ -13,8 +13,9 @@ from ._common import OutputFormat, emit, handle_errors, model_file_option
 def validate_cmd(
     model: str = typer.Option(None, "--model", "-m", help="Registered model (see `ktgf models`)."),
     model_file: Path = model_file_option(),
-    data: list[Path] = typer.Option(..., "--data", help="DEM file or folder of them (uniform shear, frictional shear, Couette, "
-                                    "homogeneous cooling; the case from the columns); repeat for several."),
+    data: list[Path] = typer.Option(None, "--data", help="DEM file or folder of them (uniform shear, frictional shear, Couette, "
+                                    "homogeneous cooling; the case from the columns); repeat for several. Default: the DEM "
+                                    "files shipped with ktgf."),
     n_cells: int = typer.Option(200, "--cells", help="Grid cells of Couette cells."),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
@@ -39,6 +40,10 @@ def validate_cmd(
 
         m = get_model(model)
         sources, walls = fit_sources(model_name=m.name), None
+    if not data:
+        from ..data import shipped_data_dir
+
+        data = [shipped_data_dir()]
     result = validate(m, data, sources=sources, walls=walls, n_cells=n_cells)
     if fmt == OutputFormat.json:
         import json
