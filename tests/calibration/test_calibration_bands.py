@@ -155,7 +155,7 @@ def test_couette_compare_prints_bands_for_the_model_file(fitted, data_dir, tmp_p
 
 def test_fallback_through_the_rows_gives_the_same_jacobian(monkeypatch):
     """A model the vectorised paths cannot evaluate falls back to checked evaluations, one e at a time (mixed e)."""
-    import ktgf.calibration.bands as bands
+    from ktgf.calibration import bands
 
     m = get_model("frictional")
     phi, e = np.array([0.3, 0.5, 0.4]), np.array([0.7, 0.9, 0.7])

@@ -19,8 +19,8 @@ from ktgf.calibration import calibrate, read_data
 from ktgf.calibration.crossval import cross_validate, states_of
 from ktgf.calibration.fit import CORRELATION_WARNING, identifiability
 from ktgf.cli import app
-from ktgf.shear.steady import steady_shear
 from ktgf.errors import InputError
+from ktgf.shear.steady import steady_shear
 
 runner = CliRunner()
 HEADER = "# synthetic uniform shear (ktgf tests)\n# units d = m = 1; shear rate gdot = 1\n"

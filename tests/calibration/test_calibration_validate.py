@@ -16,8 +16,8 @@ from typer.testing import CliRunner
 from ktgf import get_model
 from ktgf.calibration.validate import detect_case, fit_sources, validate
 from ktgf.cli import app
-from ktgf.shear.steady import steady_shear
 from ktgf.errors import InputError
+from ktgf.shear.steady import steady_shear
 
 runner = CliRunner()
 CELLS = "60"
