@@ -23,8 +23,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..errors import InputError
 from ..data import CouetteData
+from ..errors import InputError
 from .fit import FitResult, calibrate
 from .residuals import COUETTE_OBSERVABLES, make_terms
 
