@@ -5,11 +5,13 @@
 * ``frictional``: the EKT correlation-length constant c (:data:`ktgf.closures.friction.calibrated.FRICTIONAL_C`)
   by :func:`fit_correlation_constant` on one row of the frictional DEM uniform shear (``docs/friction.md`` §6).
 
-Tests refit both from the shipped data and compare with the constants.
+Tests refit both from the shipped data and compare with the constants.  :data:`REGISTERED_FITS` says which
+data files and states each fit used (``ktgf validate`` marks those rows *fitted*): change it with the fits.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -19,6 +21,25 @@ from ..closures.friction.calibrated import FIT_ROW
 from ..closures.models import get_model
 from ..closures.rdf import ViscosityDivergence
 from ..shear.steady import steady_shear
+
+
+@dataclass(frozen=True)
+class FitSource:
+    """States of one data file a model was fitted to: ``states`` are (μ, φ, e) tuples, or None for every state."""
+
+    file: str
+    states: tuple[tuple[float, float, float], ...] | None = None
+    sha256: str = ""
+
+
+#: What the registered fitted models were fitted to (their docstrings and docs/dense.md, docs/friction.md):
+#: ``dense`` — β on both rows of dem_uniform_shear.csv (φ 0.3, 0.5; e 0.9); ``frictional`` — the EKT
+#: constant c on T of the row μ = 0.5, φ = 0.5 of dem_uniform_shear_friction.csv.  The other registered
+#: models have published parameters only: every row is a prediction.  Update this with the models.
+REGISTERED_FITS: dict[str, tuple[FitSource, ...]] = {
+    "dense": (FitSource("dem_uniform_shear.csv"),),
+    "frictional": (FitSource("dem_uniform_shear_friction.csv", ((0.5, 0.5, 0.7),)),),
+}
 
 
 def relative_errors(model: Any, rows: np.ndarray) -> np.ndarray:
