@@ -34,6 +34,7 @@ def _columns(model, phi, e):
     return np.array(out).T
 
 
+@pytest.mark.analytic
 def test_delta_sigma_is_the_diagonal_of_j_c_jt():
     rng = np.random.default_rng(3)
     J = rng.normal(size=(5, 3))
@@ -45,6 +46,7 @@ def test_delta_sigma_is_the_diagonal_of_j_c_jt():
 @pytest.mark.parametrize("method", ["jax", "differences"])
 @pytest.mark.parametrize("model, names", [("dense", ["phi_c", "beta"]), ("proposed", ["phi_f", "phi_c", "beta"]),
                                           ("frictional", ["c"])])
+@pytest.mark.analytic
 def test_shear_band_matches_central_differences(model, names, method):
     m = get_model(model)
     phi, e = np.array([0.3, 0.5, 0.55]), np.array([0.7, 0.9])
@@ -73,6 +75,7 @@ def fitted(tmp_path_factory, data_dir):
     return out
 
 
+@pytest.mark.contract
 def test_model_file_holds_the_covariance(fitted):
     fit = tomllib.loads(fitted.read_text())["fit"]
     se, corr, cov = np.array(fit["standard_errors"]), np.array(fit["correlation"]), np.array(fit["covariance"])
@@ -82,6 +85,7 @@ def test_model_file_holds_the_covariance(fitted):
     np.testing.assert_allclose(c, cov)
 
 
+@pytest.mark.contract
 def test_older_model_file_without_covariance_rebuilds_it(fitted, tmp_path):
     text = "\n".join(ln for ln in fitted.read_text().splitlines() if not ln.startswith("covariance"))
     f = tmp_path / "old.toml"
@@ -91,6 +95,7 @@ def test_older_model_file_without_covariance_rebuilds_it(fitted, tmp_path):
     np.testing.assert_allclose(c, np.array(fit["covariance"]), rtol=1e-10)
 
 
+@pytest.mark.contract
 def test_shear_prints_bands_for_the_model_file_rows(fitted):
     r = runner.invoke(app, ["shear", "--model", "dense", "--model-file", str(fitted), "--phi", "0.5,0.58", "--e", "0.9",
                             "--format", "json"])
@@ -112,6 +117,7 @@ def test_shear_prints_bands_for_the_model_file_rows(fitted):
     assert "delta method" in r.stderr
 
 
+@pytest.mark.analytic
 def test_couette_band_matches_resolved_cells(data_dir):
     """∂(τ_w, p_w)/∂β of the DEM cell with the specularity re-fitted to the slip: against re-solved, re-fitted cells.
 
@@ -138,6 +144,7 @@ def test_couette_band_matches_resolved_cells(data_dir):
     assert math.isfinite(sd["tau_wall"]) and sd["tau_wall"] > 0
 
 
+@pytest.mark.contract
 def test_couette_compare_prints_bands_for_the_model_file(fitted, data_dir, tmp_path):
     dem = data_dir / "dem_couette_e0.9_phi0.50.csv"
     r = runner.invoke(app, ["couette", "compare", "--dem", str(dem), "--model", "ret", "--model-file", str(fitted),
@@ -153,6 +160,7 @@ def test_couette_compare_prints_bands_for_the_model_file(fitted, data_dir, tmp_p
     assert "specularity follows the parameters" in r.stderr
 
 
+@pytest.mark.analytic
 def test_fallback_through_the_rows_gives_the_same_jacobian(monkeypatch):
     """A model the vectorised paths cannot evaluate falls back to checked evaluations, one e at a time (mixed e)."""
     from ktgf.calibration import bands

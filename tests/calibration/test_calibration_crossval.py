@@ -43,6 +43,7 @@ def model_data(path, model, phi, scale=None):
     return write_shear(path, phi, s.T, s.eta_over_eta0 * k, s.p_over_nT * k)
 
 
+@pytest.mark.analytic
 def test_exact_data_are_predicted_exactly_when_left_out(tmp_path):
     """Data made by proposed with β = 2.6: every left-out state is predicted to solver precision."""
     f = model_data(tmp_path / "s.csv", get_model("proposed", beta=TRUE_BETA), PHI)
@@ -67,6 +68,7 @@ def _independent_refit(model, phi, T, eta, p, sig, start):
     return least_squares(r, [start], bounds=([0.05], [6.0]), xtol=1e-14, ftol=1e-14, gtol=1e-14).x[0]
 
 
+@pytest.mark.analytic
 def test_left_out_errors_match_independent_refits(tmp_path):
     """A 20 % misfit put on one state: its left-out error is what a refit without it (scipy, by hand) predicts."""
     scale = [1.0, 1.05, 0.97, 1.2, 1.0]
@@ -90,6 +92,7 @@ def test_left_out_errors_match_independent_refits(tmp_path):
     assert cv.mean_abs_error > cv.mean_abs_in_sample_error
 
 
+@pytest.mark.contract
 def test_states_are_rows_of_shear_files_and_whole_couette_files(data_dir):
     ds = [read_data(data_dir / "dem_uniform_shear.csv"), read_data(data_dir / "dem_uniform_shear_extra.csv"),
           read_data(data_dir / "dem_couette_e0.9_phi0.50.csv")]
@@ -100,6 +103,7 @@ def test_states_are_rows_of_shear_files_and_whole_couette_files(data_dir):
     assert states[-1].quantities == ("tau_wall", "p_wall", "slip_speed")
 
 
+@pytest.mark.contract
 def test_cli_cross_validate_prints_the_mean_left_out_error(tmp_path):
     f = model_data(tmp_path / "s.csv", get_model("proposed", beta=TRUE_BETA), PHI, [1.0, 1.05, 0.97, 1.2, 1.0])
     r = runner.invoke(app, ["calibrate", "--model", "proposed", "--data", str(f), "--fit", "beta", "--cross-validate",
@@ -117,6 +121,7 @@ def test_cli_cross_validate_prints_the_mean_left_out_error(tmp_path):
 
 
 # -- identifiability ---------------------------------------------------------------------------
+@pytest.mark.analytic
 def test_identifiability_of_constructed_jacobians():
     rng = np.random.default_rng(1)
     a, b = rng.normal(size=(2, 8))
@@ -132,6 +137,7 @@ def test_identifiability_of_constructed_jacobians():
                               "the data determine mainly one combination of them"),)
 
 
+@pytest.mark.analytic
 def test_degenerate_pair_is_named_with_its_correlation(tmp_path):
     """Three states close together at high φ: φ_c and β of proposed act almost only through one χ level."""
     f = model_data(tmp_path / "s.csv", get_model("proposed", beta=TRUE_BETA), [0.55, 0.555, 0.56])
@@ -145,6 +151,7 @@ def test_degenerate_pair_is_named_with_its_correlation(tmp_path):
     assert "Warning: parameters phi_c and beta are" in r.stderr
 
 
+@pytest.mark.analytic
 def test_exactly_degenerate_pair_is_rank_deficient(data_dir):
     """dem_uniform_shear.csv (φ 0.3, 0.5): proposed's φ_c and β act only through χ(0.5), φ 0.3 is on the CS branch."""
     fit = calibrate(get_model("proposed"), [read_data(data_dir / "dem_uniform_shear.csv")], ["phi_c", "beta"])
@@ -152,6 +159,7 @@ def test_exactly_degenerate_pair_is_rank_deficient(data_dir):
     assert "phi_c" in w and "beta" in w
 
 
+@pytest.mark.contract
 def test_fewer_points_than_parameters_is_one_line_exit_2(tmp_path):
     f = model_data(tmp_path / "s.csv", get_model("proposed"), [0.55])
     with pytest.raises(InputError, match=r"a fit of 4 parameters \(phi_f, phi_c, beta, junction_width\) to 3 data point"):
@@ -166,6 +174,7 @@ def test_fewer_points_than_parameters_is_one_line_exit_2(tmp_path):
         cross_validate(get_model("dense"), [read_data(g)], ["phi_f", "phi_c", "beta", "junction_width"])
 
 
+@pytest.mark.analytic
 def test_a_parameter_lost_in_a_three_way_direction_is_named(data_dir):
     """dense's φ_f, φ_c, β on the shared frictionless files: no pair beyond 0.95 with φ_f, yet φ_f is not determined."""
     data = [read_data(data_dir / "dem_uniform_shear.csv"), read_data(data_dir / "dem_uniform_shear_extra.csv")]
@@ -177,6 +186,7 @@ def test_a_parameter_lost_in_a_three_way_direction_is_named(data_dir):
                for w in fit.identifiability.warnings)
 
 
+@pytest.mark.analytic
 def test_left_out_couette_file_is_predicted_by_the_fit_on_the_rest(data_dir):
     """Couette file left out: β refitted on the shear file alone (a separate fit), specularity kept (and said so)."""
     from ktgf.calibration.residuals import CouetteTerm

@@ -19,6 +19,8 @@ from ktgf.cli import app
 from ktgf.errors import InputError
 from ktgf.shear.steady import steady_shear
 
+pytestmark = pytest.mark.contract
+
 runner = CliRunner()
 CELLS = "60"
 SHEAR_FILES = ("dem_uniform_shear.csv", "dem_uniform_shear_extra.csv")
