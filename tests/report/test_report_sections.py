@@ -7,7 +7,6 @@ eigenvalues of the full matrix, and manufactured solver outputs whose errors are
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
@@ -17,7 +16,7 @@ import xarray as xr
 from ktgf import get_model
 from ktgf.hcs import stability_map
 from ktgf.hcs.haff import haff_temperature
-from ktgf.report import ReportSettings, build_report, check_report, cooling_gas, couette, framework, locate_data_dir
+from ktgf.report import ReportSettings, build_report, check_report, cooling_gas, couette, locate_data_dir
 from ktgf.data import COUETTE, HCS_COOLING, read_table
 from ktgf.report.hcs import compare_pair, cooling_comparison, dispersion, ret_proposed_sentence
 
@@ -92,10 +91,14 @@ def test_ret_and_proposed_critical_sizes_agree_where_their_rdfs_do() -> None:
 
 
 # -- Couette and 3D sections through their contracts (manufactured solver outputs) ---------------
-def _enable(monkeypatch, key: str, module, fake) -> None:
-    monkeypatch.setattr(module, "_entry", lambda: fake)
-    sec = framework._SECTIONS[key]
-    monkeypatch.setitem(framework._SECTIONS, key, dataclasses.replace(sec, available=lambda: None))
+def _enable(monkeypatch, key: str, fake) -> None:
+    """Replace the solver entry point a section calls by ``fake`` (the sections import it by name)."""
+    if key == "couette":
+        monkeypatch.setattr(couette, "report_profiles", fake)
+    else:
+        import ktgf.solver
+
+        monkeypatch.setattr(ktgf.solver, "report_cooling_run", fake)
 
 
 @pytest.mark.analytic
@@ -109,7 +112,7 @@ def test_couette_section_errors_of_a_known_solution(monkeypatch, tmp_path, dem_d
         return xr.Dataset({"u": ("y", dem["ux"] + shift * wall_speed), "phi": ("y", dem["phi"]), "theta": ("y", dem["theta"])},
                           coords={"y": dem["y"]}, attrs={"wall": "manufactured", "valid": 1})
 
-    _enable(monkeypatch, "couette", couette, fake)
+    _enable(monkeypatch, "couette", fake)
     out = copy_of(quick_report, tmp_path)
     (out / ".cache" / "couette.json").unlink(missing_ok=True)  # the real solver's result is cached there
     rep = build_report(ReportSettings.preset(quick=True, out=out))
@@ -140,7 +143,7 @@ def test_cooling_gas_section_through_its_contract(monkeypatch, tmp_path, quick_r
             coords={"time": t, "x": x, "y": x},
         )
 
-    _enable(monkeypatch, "cooling_gas", cooling_gas, fake)
+    _enable(monkeypatch, "cooling_gas", fake)
     out = copy_of(quick_report, tmp_path)
     (out / ".cache" / "cooling_gas.json").unlink(missing_ok=True)  # the real solver's result is cached there
     s = ReportSettings.preset(quick=True, out=out)

@@ -131,9 +131,7 @@ def test_couette_without_dem_is_not_called_an_error(monkeypatch, tmp_path, quick
         return xr.Dataset({"u": ("y", wall_speed * y / height), "phi": ("y", phi_mean + 0 * y), "theta": ("y", 1 + 0 * y)},
                           coords={"y": y}, attrs={"valid": 1})
 
-    monkeypatch.setattr(couette, "_entry", lambda: fake)
-    sec = framework._SECTIONS["couette"]
-    monkeypatch.setitem(framework._SECTIONS, "couette", dataclasses.replace(sec, available=lambda: None))
+    monkeypatch.setattr(couette, "report_profiles", fake)
     sec = framework._SECTIONS["cooling_gas"]
     monkeypatch.setitem(framework._SECTIONS, "cooling_gas", dataclasses.replace(sec, available=lambda: "skipped"))
     out = tmp_path / "r"
