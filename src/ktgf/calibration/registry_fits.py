@@ -123,17 +123,26 @@ def _least_squares(residual: Callable[[np.ndarray], np.ndarray], names: tuple[st
     return sol, cov, sd
 
 
-def fit_frictionless(states: dict[str, np.ndarray] | None = None) -> Fit:
-    """Step 1: a, b (χ) and c (EKT) on frictionless uniform shear (default: the shipped e = 0.9 set)."""
+def _free(table: dict[str, tuple[float, float, float]], hold: dict[str, float]) -> tuple[tuple[str, ...], list, list, list]:
+    names = tuple(k for k in table if k not in hold)
+    start, lower, upper = (list(v) for v in zip(*(table[k] for k in names)))
+    return names, start, lower, upper
+
+
+def fit_frictionless(states: dict[str, np.ndarray] | None = None, *, hold: dict[str, float] | None = None) -> Fit:
+    """Step 1: a, b (χ) and c (EKT) on frictionless uniform shear (default: the shipped e = 0.9 set).
+
+    ``hold`` keeps some of them at given values (e.g. ``{"exponent": 1.5}``, Chialvo & Sundaresan's).
+    """
     states = frictionless_states() if states is None else states
-    names = tuple(FRICTIONLESS_PARAMETERS)
-    start, lower, upper = (list(v) for v in zip(*FRICTIONLESS_PARAMETERS.values()))
+    hold = dict(hold or {})
+    names, start, lower, upper = _free(FRICTIONLESS_PARAMETERS, hold)
 
-    def residual(x: np.ndarray) -> np.ndarray:
-        return log_errors(dict(zip(names, x)), states).ravel()
+    def params(x: np.ndarray) -> dict[str, float]:
+        return {**hold, **dict(zip(names, x))}
 
-    sol, cov, sd = _least_squares(residual, names, start, lower, upper)
-    return _result(names, sol, cov, sd, states, lambda x: dict(zip(names, x)))
+    sol, cov, sd = _least_squares(lambda x: log_errors(params(x), states).ravel(), names, start, lower, upper)
+    return _result(names, sol, cov, sd, states, params)
 
 
 def _lowest_mu_scale(states: dict[str, np.ndarray]) -> float:
@@ -150,14 +159,19 @@ def _lowest_mu_scale(states: dict[str, np.ndarray]) -> float:
     return worst
 
 
-def fit_frictional(frictionless: dict[str, float], states: dict[str, np.ndarray] | None = None) -> Fit:
-    """Step 2: μ_Z and k (Eq. 2 of :class:`~ktgf.closures.jamming.FrictionalPowerLaw`) at μ > 0, step 1 held."""
+def fit_frictional(frictionless: dict[str, float], states: dict[str, np.ndarray] | None = None, *,
+                   hold: dict[str, float] | None = None) -> Fit:
+    """Step 2: μ_Z and k (Eq. 2 of :class:`~ktgf.closures.jamming.FrictionalPowerLaw`) at μ > 0, step 1 held.
+
+    ``hold`` keeps one of them at a given value (e.g. ``{"amplitude_growth": 0.0}``: φ_J(μ) alone).
+    """
     states = frictional_states() if states is None else states
-    names = tuple(FRICTIONAL_PARAMETERS)
-    start, lower, upper = (list(v) for v in zip(*FRICTIONAL_PARAMETERS.values()))
-    lower[0] = max(lower[0], _lowest_mu_scale(states) * (1.0 + 1e-6) + 1e-9)
-    start[0] = min(max(start[0], lower[0] * 1.5), upper[0])
-    base = {k: frictionless[k] for k in FRICTIONLESS_PARAMETERS}
+    hold = dict(hold or {})
+    names, start, lower, upper = _free(FRICTIONAL_PARAMETERS, hold)
+    if "mu_scale" in names:
+        lower[0] = max(lower[0], _lowest_mu_scale(states) * (1.0 + 1e-6) + 1e-9)
+        start[0] = min(max(start[0], lower[0] * 1.5), upper[0])
+    base = {**{k: frictionless[k] for k in FRICTIONLESS_PARAMETERS}, **hold}
 
     def params(x: np.ndarray) -> dict[str, float]:
         return {**base, **dict(zip(names, x))}
