@@ -23,8 +23,8 @@ from ktgf.calibration.registry_fits import (
 LABELS = {"T": "T", "p_over_nT": "p/(nT)", "tau_over_p": "τ/p"}
 
 
-def pct(x: float) -> str:
-    return "refused" if not np.isfinite(x) else f"{100 * x:+.1f} %"
+def pct(x: float, sign: str = "+") -> str:
+    return "refused" if not np.isfinite(x) else f"{100 * x:{sign}.1f} %"
 
 
 def report_fit(title, fit):
@@ -46,9 +46,9 @@ def table(states, fit_err, loo_err, mu_label):
     for i in range(states["phi"].size):
         cells = " | ".join(f"{pct(np.expm1(fit_err[k, i]))} | {pct(loo_err[k, i])}" for k in range(len(OBSERVABLES)))
         print(f"| {mu_label(i)} | {states['phi'][i]:g} | {states['e'][i]:g} | {cells} |")
-    mean = " | ".join(f"{pct(np.mean(np.abs(np.expm1(fit_err[k]))))} | {pct(np.nanmean(np.abs(loo_err[k])))}"
+    mean = " | ".join(f"{pct(np.mean(np.abs(np.expm1(fit_err[k]))), '')} | {pct(np.nanmean(np.abs(loo_err[k])), '')}"
                       for k in range(len(OBSERVABLES)))
-    worst = " | ".join(f"{pct(np.max(np.abs(np.expm1(fit_err[k]))))} | {pct(np.nanmax(np.abs(loo_err[k])))}"
+    worst = " | ".join(f"{pct(np.max(np.abs(np.expm1(fit_err[k]))), '')} | {pct(np.nanmax(np.abs(loo_err[k])), '')}"
                        for k in range(len(OBSERVABLES)))
     print(f"| mean abs. | | | {mean} |")
     print(f"| max abs. | | | {worst} |")
@@ -78,6 +78,18 @@ err = np.expm1(log_errors(reg, zero))
 for i in range(zero["phi"].size):
     print(f"- μ = 0, φ = {zero['phi'][i]:g}, e = {zero['e'][i]:g}: "
           + ", ".join(f"{LABELS[k]} {pct(err[j, i])}" for j, k in enumerate(OBSERVABLES)))
+
+print("\n## predicted, never fitted: homogeneous cooling (dem_hcs_cooling.csv), p/(nT) = 1 + 2(1 + e)φχ of dense")
+from ktgf import get_model  # noqa: E402
+from ktgf.data import HCS_COOLING, read_cooling, shipped  # noqa: E402
+
+hcs = read_cooling(shipped(HCS_COOLING))
+dense = get_model("dense")
+print("| φ | e | p/(nT) DEM | dense | err | Carnahan–Starling χ (RET) | err |")
+print("|---|---|---|---|---|---|---|")
+for phi, e, p in zip(hcs["phi"], hcs["e"], hcs["p_over_nT"]):
+    model, cs = float(dense.reduced(phi, e, hcs=True).p), float(get_model("ret").reduced(phi, e).p)
+    print(f"| {phi:g} | {e:g} | {p:.4f} | {model:.4f} | {pct(model / p - 1)} | {cs:.4f} | {pct(cs / p - 1)} |")
 
 print("\n## alternative kept for comparison: Chialvo–Sundaresan's exponent b = 1.5 held (a, c fitted)")
 g1 = fit_frictionless(fl, hold={"exponent": 1.5})
