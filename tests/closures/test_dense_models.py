@@ -190,7 +190,7 @@ def test_dense_fit_reproduces_the_registered_parameters():
 
 
 @pytest.mark.xfail(strict=True, reason="issue 33: the refitted dense (nothing chosen on the Couette file) predicts "
-                   "the wall stresses 21-24 % low (theta ~25 % low across the cell); docs/dense.md §4")
+                   "the wall stresses 21-24 % low (theta ~25 % low across the cell); docs/dense.md §5.1")
 def test_dense_predicts_the_couette_wall_stresses_within_15_percent(data_dir):
     """Goal of issues 9 and 33: the Couette file is not fitted; wall shear stress and pressure within 15 %, valid profile."""
     pytest.importorskip("ktgf.couette")
