@@ -14,11 +14,23 @@ from __future__ import annotations
 import time
 
 import numpy as np
+from scipy.optimize import least_squares
 
+from ktgf import get_model
 from ktgf.calibration.registry_fits import (
-    OBSERVABLES, fit_frictional, fit_frictionless, frictional_states, frictionless_states, leave_one_out, log_errors,
-    registered_parameters, subset,
+    FRICTIONLESS_PARAMETERS,
+    OBSERVABLES,
+    family_model,
+    fit_frictional,
+    fit_frictionless,
+    frictional_states,
+    frictionless_states,
+    leave_one_out,
+    log_errors,
+    registered_parameters,
+    subset,
 )
+from ktgf.data import HCS_COOLING, read_cooling, shipped
 
 LABELS = {"T": "T", "p_over_nT": "p/(nT)", "tau_over_p": "τ/p"}
 
@@ -80,8 +92,6 @@ for i in range(zero["phi"].size):
           + ", ".join(f"{LABELS[k]} {pct(err[j, i])}" for j, k in enumerate(OBSERVABLES)))
 
 print("\n## predicted, never fitted: homogeneous cooling (dem_hcs_cooling.csv), p/(nT) = 1 + 2(1 + e)φχ of dense")
-from ktgf import get_model  # noqa: E402
-from ktgf.data import HCS_COOLING, read_cooling, shipped  # noqa: E402
 
 hcs = read_cooling(shipped(HCS_COOLING))
 dense = get_model("dense")
@@ -92,10 +102,6 @@ for phi, e, p in zip(hcs["phi"], hcs["e"], hcs["p_over_nT"]):
     print(f"| {phi:g} | {e:g} | {p:.4f} | {model:.4f} | {pct(model / p - 1)} | {cs:.4f} | {pct(cs / p - 1)} |")
 
 print("\n## variant: the cooling-state p/(nT) added to the step-1 residuals (10 more points)")
-from scipy.optimize import least_squares  # noqa: E402
-
-from ktgf.calibration.registry_fits import FRICTIONLESS_PARAMETERS, family_model  # noqa: E402
-
 names = tuple(FRICTIONLESS_PARAMETERS)
 
 

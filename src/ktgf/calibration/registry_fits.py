@@ -19,8 +19,9 @@ shipped data and compare with the registered constants.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -30,8 +31,16 @@ from ..closures.friction.model_slot import Friction
 from ..closures.garzo_dufty1999 import GarzoDufty1999
 from ..closures.jamming import CoordinationJamming, FrictionalPowerLaw
 from ..closures.models import Model
-from ..data import (FRICTION_SHEAR, FRICTION_SHEAR_EXTRA, UNIFORM_SHEAR, UNIFORM_SHEAR_EXTRA, read_friction_shear,
-                    shipped, uniform_shear_records)
+from ..data import (
+    FRICTION_SHEAR,
+    FRICTION_SHEAR_EXTRA,
+    UNIFORM_SHEAR,
+    UNIFORM_SHEAR_EXTRA,
+    read_friction_shear,
+    shipped,
+    uniform_shear_records,
+)
+from ..errors import InputError
 from ..shear.steady import steady_shear
 
 #: Observables compared at every state (log-ratio residuals).
@@ -201,8 +210,8 @@ def leave_one_out(fit: Callable[[dict[str, np.ndarray]], dict[str, float]],
         params = fit(subset(states, np.arange(n) != i))
         try:
             out[:, i] = np.expm1(log_errors(params, subset(states, [i]))[:, 0])
-        except Exception:  # refused: the left-out φ lies above the refit's φ_J(μ)
-            pass
+        except InputError:  # refused: the left-out φ lies above the refit's φ_J(μ); stays NaN
+            continue
     return out
 
 
