@@ -1,4 +1,5 @@
-"""Shared fixtures: paths to the shared reference material and float64 JAX."""
+"""Shared fixtures (paths to the shared reference material, float64 JAX) and the rule that every test
+names where its expected value comes from (one of the reference labels, tests/README.md)."""
 
 from __future__ import annotations
 
@@ -17,6 +18,36 @@ _CANDIDATES = [Path(os.environ["KTGF_SHARED"])] if os.environ.get("KTGF_SHARED")
 _CANDIDATES += [ROOT.parent / "shared", ROOT.parent.parent / "shared"]
 SHARED = next((c for c in _CANDIDATES if c.is_dir()), _CANDIDATES[0])
 DATA = SHARED / "data"
+
+#: The reference labels (registered in pyproject.toml): every test carries exactly one.
+REFERENCE_LABELS = ("published", "analytic", "dem", "regression", "contract")
+#: How many offending test ids the collection error lists.
+LISTED = 20
+
+
+@pytest.hookimpl(tryfirst=True)  # before ``-m`` deselects: the rule holds for slow tests too
+def pytest_collection_modifyitems(config, items) -> None:
+    """Fail the collection when a test has no reference label or more than one.
+
+    A file labels all its tests with one module-level ``pytestmark``, or (when its tests differ)
+    each test with its own decorator and no module label; a test label inside a labelled module
+    is two labels, refused like any other pair.
+    """
+    bad = []
+    for item in items:
+        labels = sorted(m.name for m in item.iter_markers() if m.name in REFERENCE_LABELS)
+        if len(labels) != 1:
+            bad.append(f"{item.nodeid} ({', '.join(labels) or 'no label'})")
+    if bad:
+        more = f"\n  ... and {len(bad) - LISTED} more" if len(bad) > LISTED else ""
+        message = (f"{len(bad)} test(s) without exactly one reference label ({', '.join(REFERENCE_LABELS)}; "
+                   "tests/README.md):\n  " + "\n  ".join(bad[:LISTED]) + more)
+        # A collection error, not an exception (which pytest-xdist's workers turn into an INTERNALERROR):
+        # pytest shows it and stops ("Interrupted: 1 error during collection", also with --collect-only);
+        # xdist's workers hand it to the controller, which shows it once, and have nothing left to run.
+        config.hook.pytest_collectreport(
+            report=pytest.CollectReport("reference labels", "failed", message, result=[]))
+        items.clear()
 
 
 @pytest.fixture(scope="session")

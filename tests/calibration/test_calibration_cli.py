@@ -33,6 +33,7 @@ def fitted(tmp_path_factory):
     return out, data, json.loads(r.stdout)
 
 
+@pytest.mark.analytic
 def test_calibrate_prints_values_errors_correlations_residuals_and_cost(fitted):
     out, data, res = fitted
     assert res["success"] and res["cost"] < 1e-12
@@ -43,6 +44,7 @@ def test_calibrate_prints_values_errors_correlations_residuals_and_cost(fitted):
     assert "residual variance" in res["standard_errors"]
 
 
+@pytest.mark.contract
 def test_model_file_holds_values_and_provenance(fitted):
     out, data, _ = fitted
     f = tomllib.loads(out.read_text())
@@ -53,6 +55,7 @@ def test_model_file_holds_values_and_provenance(fitted):
     assert prov["cost"] == f["fit"]["cost"] and prov["created"].endswith("Z")
 
 
+@pytest.mark.contract
 def test_models_describes_the_file(fitted):
     out, _, _ = fitted
     r = runner.invoke(app, ["models", "--model-file", str(out), "--format", "json"])
@@ -61,6 +64,7 @@ def test_models_describes_the_file(fitted):
     assert row["base"] == "proposed" and "phi_c=0.625" in row["rdf"] and "shear.csv" in row["data"]
 
 
+@pytest.mark.contract
 def test_coefficients_with_model_file_equal_the_model_with_those_options(fitted):
     out, _, _ = fitted
     r = runner.invoke(app, ["coefficients", "--model-file", str(out), "--phi", "0.55,0.6", "--e", "0.9", "--format", "json"])
@@ -71,6 +75,7 @@ def test_coefficients_with_model_file_equal_the_model_with_those_options(fitted)
     assert rows[0]["eta*"] != pytest.approx(float(get_model("proposed").reduced(0.55, 0.9).eta), rel=1e-3)
 
 
+@pytest.mark.contract
 def test_shear_with_model_file_predicts_the_synthetic_data(fitted):
     """`ktgf shear --model-file` reproduces the uniform-shear data the file was fitted on."""
     out, data, _ = fitted
@@ -85,6 +90,7 @@ def test_shear_with_model_file_predicts_the_synthetic_data(fitted):
     np.testing.assert_allclose([row["T"] for row in rows], ref.T, rtol=1e-6)
 
 
+@pytest.mark.contract
 def test_hcs_commands_take_the_model_file(fitted, tmp_path):
     out, _, _ = fitted
     r = runner.invoke(app, ["hcs", "stability", "--model-file", str(out), "--phi", "0.55", "--e", "0.9", "--format", "json"])
@@ -105,6 +111,7 @@ def test_hcs_commands_take_the_model_file(fitted, tmp_path):
     assert r.exit_code == 0, r.output
 
 
+@pytest.mark.contract
 def test_couette_run_and_compare_take_the_model_file(fitted, tmp_path):
     out, _, _ = fitted
     nc = tmp_path / "c.nc"
@@ -125,6 +132,7 @@ def _model_file(tmp_path, text):
     return f
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("text, field", [
     ('[model]\nbase = "nosuch"\n', "model.base"),
     ('[model]\nbase = "proposed"\nrdf = "nosuch"\n', "model.rdf"),
@@ -145,6 +153,7 @@ def test_bad_model_files_are_one_line_errors_naming_the_field(tmp_path, text, fi
     assert len(lines) == 1 and f"field '{field}'" in lines[0], r.output
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("extra, match", [
     (["--fit", "phi_c", "--start", "phi_c=0.9"], "phi_c = 0.9 is out of range"),
     (["--fit", "beta", "--start", "beta=-2"], "beta = -2 is out of range"),
@@ -159,6 +168,7 @@ def test_calibrate_bad_input_exits_2(fitted, tmp_path, extra, match):
     assert not (tmp_path / "x.toml").exists()
 
 
+@pytest.mark.contract
 def test_calibrate_bad_data_file_exits_2(tmp_path):
     f = tmp_path / "bad.csv"
     f.write_text("# units d = m = 1; shear rate gdot = 1\nphi,e,T\n0.3,0.9,1.0\n")
@@ -166,6 +176,7 @@ def test_calibrate_bad_data_file_exits_2(tmp_path):
     assert r.exit_code == 2 and "missing column(s) dT" in r.output
 
 
+@pytest.mark.contract
 def test_calibrate_from_a_model_file_continues_from_its_values(fitted, tmp_path):
     out, data, _ = fitted
     out2 = tmp_path / "again.toml"
@@ -178,6 +189,7 @@ def test_calibrate_from_a_model_file_continues_from_its_values(fitted, tmp_path)
     assert f["model"]["base"] == "proposed" and f["model"]["options"]["phi_c"] == pytest.approx(TRUE["phi_c"], rel=1e-6)
 
 
+@pytest.mark.contract
 def test_calibrate_that_stops_early_writes_its_best_point_and_exits_1(fitted, tmp_path):
     _, data, _ = fitted
     out = tmp_path / "partial.toml"
@@ -190,6 +202,7 @@ def test_calibrate_that_stops_early_writes_its_best_point_and_exits_1(fitted, tm
     assert "FIT FAILED" in out.read_text().splitlines()[0]
 
 
+@pytest.mark.contract
 def test_plot_coefficients_and_couette_sweep_take_the_model_file(fitted, tmp_path):
     out, _, _ = fitted
     png = tmp_path / "coef.png"
@@ -206,6 +219,7 @@ def test_plot_coefficients_and_couette_sweep_take_the_model_file(fitted, tmp_pat
     assert mine["converged"] and mine["wall_shear_stress_Pa"] != pytest.approx(plain["wall_shear_stress_Pa"], rel=1e-3)
 
 
+@pytest.mark.analytic
 def test_couette_calibration_round_trip_walls_through_compare(tmp_path, data_dir):
     """Calibrate φ' and β on synthetic Couette data; `couette compare` with the file then uses its walls and reproduces the data."""
     from helpers.calibration_synthetic import synthetic_couette

@@ -25,6 +25,7 @@ def synthetic(tmp_path_factory):
     return synthetic_shear(tmp_path_factory.mktemp("syn") / "shear.csv", truth, [0.3, 0.52, 0.55, 0.58, 0.6])
 
 
+@pytest.mark.analytic
 def test_recovers_rdf_parameters_from_uniform_shear(synthetic):
     fit = calibrate(get_model("proposed"), [read_data(synthetic)], ["phi_c", "beta"])
     assert fit.success, fit.message
@@ -36,6 +37,7 @@ def test_recovers_rdf_parameters_from_uniform_shear(synthetic):
     assert fit.correlation[0, 0] == pytest.approx(1.0) and abs(fit.correlation[0, 1]) <= 1.0
 
 
+@pytest.mark.analytic
 def test_stated_errors_match_the_linearised_covariance(synthetic):
     """With σ-weights and errors='stated', C = (JᵀJ)⁻¹: check it against the Jacobian of finite differences."""
     data = [read_data(synthetic)]
@@ -52,6 +54,7 @@ def test_stated_errors_match_the_linearised_covariance(synthetic):
     np.testing.assert_allclose(fit.stderr, se, rtol=1e-5)
 
 
+@pytest.mark.contract
 def test_a_fit_stopped_early_keeps_its_best_point(synthetic):
     fit = calibrate(get_model("proposed"), [read_data(synthetic)], ["phi_c", "beta"], max_evaluations=2)
     assert not fit.success and "stopped" in fit.message
@@ -59,6 +62,7 @@ def test_a_fit_stopped_early_keeps_its_best_point(synthetic):
     assert fit.cost <= start_cost
 
 
+@pytest.mark.analytic
 def test_unidentifiable_parameters_are_reported(data_dir):
     """On dem_uniform_shear.csv (φ = 0.3, 0.5) proposed's φ_c and β act only through χ(0.5): one combination."""
     fit = calibrate(get_model("proposed"), [read_data(data_dir / "dem_uniform_shear.csv")], ["phi_c", "beta"])
@@ -66,6 +70,7 @@ def test_unidentifiable_parameters_are_reported(data_dir):
     assert "do not determine" in fit.message
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("names, kw, match", [
     (["phi_c"], {"start": {"phi_c": 0.9}}, r"phi_c = 0.9 is out of range: valid 0.601 <= phi_c <= 0.74"),
     (["beta"], {"start": {"beta": -1.0}}, r"beta = -1 is out of range"),
@@ -82,6 +87,7 @@ def test_bad_parameters_are_one_line_errors(synthetic, names, kw, match):
     assert "\n" not in str(exc.value)
 
 
+@pytest.mark.contract
 def test_generic_parameters_are_the_float_options():
     from ktgf.calibration import fittable_parameters
 
@@ -96,6 +102,7 @@ def test_generic_parameters_are_the_float_options():
     assert math.isnan(fittable_parameters(get_model("ret"), couette=True)["specularity"])
 
 
+@pytest.mark.contract
 def test_a_failing_evaluation_stops_the_fit_and_keeps_the_best_point(synthetic, monkeypatch):
     """A solver failure in the middle of a fit: no exception, success False, the reason, the best point so far."""
     from ktgf.calibration import residuals

@@ -25,6 +25,7 @@ def _fd(term, x, h_rel=1e-6):
     return J
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("model, x", [
     ("proposed", {"phi_f": 0.47, "phi_c": 0.63, "beta": 1.9}),
     ("visc-div", {"phi_c": 0.65, "beta": 1.6, "alpha": 1.1}),
@@ -38,6 +39,7 @@ def test_uniform_shear_jax_jacobian_matches_finite_differences(tmp_path, model, 
     np.testing.assert_allclose(J, _fd(term, x), rtol=1e-6, atol=1e-7 * np.abs(J).max())
 
 
+@pytest.mark.contract
 def test_uniform_shear_jacobian_compiled_once_per_model_and_data(tmp_path):
     """A second term of the same model, names and states reuses the compiled Jacobian; other states do not."""
     x = {"phi_c": 0.65, "beta": 1.6}
@@ -68,6 +70,7 @@ def synthetic_couette(tmp_path_factory, data_dir):
                                   TRUTH["specularity"], case, N_CELLS)
 
 
+@pytest.mark.analytic
 def test_couette_ift_jacobian_matches_resolved_finite_differences(synthetic_couette):
     x = {"specularity": 0.15, "beta": 1.8, "wall_restitution": 0.85}
     (term,) = make_terms(get_model("proposed"), [read_data(synthetic_couette)], list(x), "relative", n_cells=N_CELLS)
@@ -81,6 +84,7 @@ def test_couette_ift_jacobian_matches_resolved_finite_differences(synthetic_coue
     np.testing.assert_allclose(J, J_fd, rtol=2e-4, atol=2e-5 * np.abs(J).max())
 
 
+@pytest.mark.analytic
 def test_couette_fit_recovers_walls_and_rdf_exponent(synthetic_couette):
     fit = calibrate(get_model("proposed"), [read_data(synthetic_couette)], ["specularity", "beta"], n_cells=N_CELLS)
     assert fit.success, fit.message
@@ -88,6 +92,7 @@ def test_couette_fit_recovers_walls_and_rdf_exponent(synthetic_couette):
     assert fit.walls["wall_restitution"] == 0.9  # not fitted: e_w = e of the header
 
 
+@pytest.mark.analytic
 def test_jax_jacobian_survives_option_checks_that_reject_tracers(tmp_path):
     """Parts whose __post_init__ accepts only real numbers (as strict option checks do) are still traced exactly."""
     import dataclasses

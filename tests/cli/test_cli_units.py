@@ -24,6 +24,9 @@ BRACKETS = re.compile(r"\[[^\]\[]+\]")
 ROOT_CMD = typer.main.get_command(app)
 
 
+pytestmark = pytest.mark.contract
+
+
 def _flat(text: str) -> str:
     return " ".join(text.split())
 
@@ -177,7 +180,7 @@ def test_model_option_is_the_same_everywhere() -> None:
         for p in cmd.params:
             if "--model" in getattr(p, "opts", []):
                 seen += 1
-                if path in (("plot", "dispersion"), ("calibrate",)):  # one model's dispersion relation / fit
+                if path in (("plot", "dispersion"), ("calibrate",), ("validate",)):  # one model's dispersion relation / fit / table
                     continue
                 assert p.default is None and "paper's four models" in p.help, (path, p.default)
                 assert resolve_models(p.default) == [get_model(n) for n in PAPER_MODELS]

@@ -25,6 +25,9 @@ SPECIAL = st.sampled_from(["", ",", " ", "nan", "inf", "-inf", "1e309", "-0", "0
                            "0.1:0.5:-2", "1:2", "0.2,", ",0.3", "0.1:0.4:1e3", "0:0.5:100000000000", "0.3;0.4"])
 
 
+pytestmark = pytest.mark.contract
+
+
 def _num_text(x: float) -> str:
     return repr(x)
 

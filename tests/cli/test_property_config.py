@@ -36,6 +36,9 @@ VALUE = st.one_of(
 )
 
 
+pytestmark = pytest.mark.contract
+
+
 def _leaves(d: dict, prefix: tuple = ()) -> list[tuple]:
     out = []
     for k, v in d.items():

@@ -15,6 +15,9 @@ from ktgf.errors import InputError
 ROOT = Path(__file__).resolve().parents[2]
 
 
+pytestmark = pytest.mark.contract
+
+
 def _refused(args: list[str], *words: str) -> None:
     res = CliRunner().invoke(app, args)
     assert res.exception is None or isinstance(res.exception, SystemExit), repr(res.exception)

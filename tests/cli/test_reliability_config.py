@@ -19,6 +19,9 @@ HCS = {"initial": {"solid_fraction": 0.25, "temperature": 1e-4},
        "grid": {"cells": [8, 8], "relative_to": "transverse", "factor": 1.5}, "time": {"end": 4.0}}
 
 
+pytestmark = pytest.mark.contract
+
+
 def _with(section: str, key: str, value) -> dict:
     cfg = copy.deepcopy(HCS)
     cfg.setdefault(section, {})[key] = value

@@ -19,6 +19,7 @@ from ktgf.errors import InputError
 SLIPS = np.array([0.0, 0.3, 1.0, 2.5])
 
 
+@pytest.mark.analytic
 def test_geometry_of_a_touching_layer_of_equal_spheres() -> None:
     wall = BumpyWall()
     assert math.degrees(wall.bumpiness) == pytest.approx(30.0, rel=1e-14)
@@ -29,6 +30,7 @@ def test_geometry_of_a_touching_layer_of_equal_spheres() -> None:
     assert wall.theta_max(math.pi / 6.0) == pytest.approx(math.acos(wall.resting_height / wall.sigma), rel=1e-12)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("wall", [BumpyWall(), BumpyWall(d_w=0.5, gap=0.2, row_angle=0.4), BumpyWall(d_w=2.0)])
 def test_cap_boundary_agrees_with_the_distances_to_the_neighbours(wall) -> None:
     psi = np.linspace(-math.pi, math.pi, 181)
@@ -38,6 +40,7 @@ def test_cap_boundary_agrees_with_the_distances_to_the_neighbours(wall) -> None:
         assert np.all(wall.accessible(k) == expect)
 
 
+@pytest.mark.analytic
 def test_no_slip_gives_no_shear_and_an_elastic_wall_no_energy_flux() -> None:
     f = wall_fluxes(BumpyWall(), 0.0, 0.9)
     assert abs(float(f.shear_over_normal)) < 1e-15
@@ -46,6 +49,7 @@ def test_no_slip_gives_no_shear_and_an_elastic_wall_no_energy_flux() -> None:
     assert float(wall_fluxes(BumpyWall(), 0.0, 1.0).energy_over_normal) == 0.0
 
 
+@pytest.mark.analytic
 def test_shear_is_odd_and_energy_even_in_the_slip() -> None:
     wall = BumpyWall()
     plus, minus = wall_fluxes(wall, SLIPS, 0.8), wall_fluxes(wall, -SLIPS, 0.8)
@@ -54,6 +58,7 @@ def test_shear_is_odd_and_energy_even_in_the_slip() -> None:
     assert np.all(np.diff(plus.shear_over_normal) > 0)  # more slip, more drag
 
 
+@pytest.mark.analytic
 def test_tiny_bumps_are_a_flat_frictionless_wall() -> None:
     for e_w in (0.5, 0.9):
         f = wall_fluxes(BumpyWall(d_w=1e-4), SLIPS, e_w)
@@ -61,6 +66,7 @@ def test_tiny_bumps_are_a_flat_frictionless_wall() -> None:
         assert f.energy_over_normal == pytest.approx(-(1.0 - e_w) * math.sqrt(2.0 / math.pi), rel=1e-3)
 
 
+@pytest.mark.analytic
 def test_quadrature_is_converged() -> None:
     wall = BumpyWall(d_w=1.0, gap=0.1, row_angle=0.2)
     a = wall_fluxes(wall, SLIPS, 0.9)
@@ -69,6 +75,7 @@ def test_quadrature_is_converged() -> None:
         assert x == pytest.approx(y, rel=1e-10, abs=1e-13)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("slip, e_w, wall", [(0.5, 0.9, BumpyWall()), (1.5, 0.7, BumpyWall()),
                                              (1.0, 0.9, BumpyWall(d_w=0.6, gap=0.3, row_angle=0.5))])
 def test_monte_carlo_of_single_collisions_reproduces_the_ratios(slip, e_w, wall) -> None:
@@ -100,6 +107,7 @@ def test_monte_carlo_of_single_collisions_reproduces_the_ratios(slip, e_w, wall)
         assert se < 0.05 * abs(float(exact))  # and the check is sharp
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("kwargs, text", [
     ({"d_w": 0.0}, "wall-sphere diameter d_w = 0 is out of range"),
     ({"gap": 0.8}, "wall-sphere gap = 0.8 is out of range"),
@@ -113,6 +121,7 @@ def test_bad_walls_are_refused_in_one_line(kwargs, text) -> None:
         wall_fluxes(BumpyWall(), 0.5, 1.2)
 
 
+@pytest.mark.analytic
 def test_jax_values_and_slip_derivative() -> None:
     jax = pytest.importorskip("jax")
     jax.config.update("jax_enable_x64", True)
@@ -130,6 +139,7 @@ def test_jax_values_and_slip_derivative() -> None:
     assert float(dfds) == pytest.approx(float(fd), rel=1e-8)
 
 
+@pytest.mark.analytic
 def test_large_slip_tends_to_the_geometric_drag_of_the_upstream_faces() -> None:
     # v/√T → ∞: only faces with k_x < 0 are hit, at |w| ≈ v|k_x|, so S/N → ∫|k_x|³ dΩ / ∫ k_x² cos θ dΩ over them
     wall = BumpyWall()
@@ -142,6 +152,7 @@ def test_large_slip_tends_to_the_geometric_drag_of_the_upstream_faces() -> None:
     assert float(wall_fluxes(wall, 1e4, 0.9).shear_over_normal) == pytest.approx(limit, rel=5e-3)
 
 
+@pytest.mark.analytic
 def test_dimensional_conditions_scale_with_the_normal_stress_and_the_thermal_speed() -> None:
     wall = BumpyWall()
     f = wall_fluxes(wall, 1.5, 0.8)

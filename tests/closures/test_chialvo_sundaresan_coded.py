@@ -27,6 +27,9 @@ from ktgf.closures.rdf import ChialvoSundaresan
 PHI = np.array([0.05, 0.2, 0.35, 0.45, 0.5, 0.54])
 
 
+pytestmark = pytest.mark.published
+
+
 def coded_g0(alpha: np.ndarray, alpha_c: float) -> np.ndarray:
     return (1.0 - alpha / 2.0) / (1.0 - alpha) ** 3 + 0.58 * alpha * alpha / (alpha_c - alpha) ** 1.5
 

@@ -16,6 +16,7 @@ MODEL_NAMES = [m.name for m in list_models()]  # every registered model, not onl
 PHI = np.array([0.02, 0.1, 0.25, 0.4, 0.48, 0.5, 0.55, 0.6, 0.63])
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("key", sorted(RDFS))
 def test_rdf_derivative_matches_autodiff(key):
     rdf = get_rdf(key)
@@ -23,6 +24,7 @@ def test_rdf_derivative_matches_autodiff(key):
     assert np.allclose(rdf.dchi(PHI), auto, rtol=1e-12)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("key", sorted(RDFS))
 def test_rdf_derivative_matches_finite_difference(key):
     rdf = get_rdf(key)
@@ -31,6 +33,7 @@ def test_rdf_derivative_matches_finite_difference(key):
     assert np.allclose(rdf.dchi(PHI), fd, rtol=1e-6)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("key", sorted(RDFS))
 def test_rdf_dilute_limit_and_monotone(key):
     rdf = get_rdf(key)
@@ -39,6 +42,7 @@ def test_rdf_dilute_limit_and_monotone(key):
     assert np.all(np.diff(rdf.chi(phi)) > 0)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", MODEL_NAMES)
 def test_stability_derivatives_match_autodiff(name):
     """g = ∂ln ζ0/∂ln n and C = ∂(φp*)/∂φ from each model's own ζ0 and p* (model.md §8)."""
@@ -60,6 +64,7 @@ def test_stability_derivatives_match_autodiff(name):
     assert np.allclose(r.C, c, rtol=1e-12)
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("name", MODEL_NAMES)
 def test_jit_equals_numpy(name):
     m = get_model(name)
@@ -73,6 +78,7 @@ def test_jit_equals_numpy(name):
         assert np.allclose(np.broadcast_to(getattr(ref, k), (phi.size, 3)), getattr(got, k), rtol=1e-13), k
 
 
+@pytest.mark.contract
 def test_jax_concrete_arrays_are_still_checked():
     from ktgf import InputError
 
@@ -80,6 +86,7 @@ def test_jax_concrete_arrays_are_still_checked():
         get_model("ret").reduced(jnp.asarray([0.2, 1.2]), 0.9)
 
 
+@pytest.mark.analytic
 def test_broadcasting_over_phi_e_theta():
     m = get_model("proposed")
     phi = np.linspace(0.1, 0.6, 6)[:, None, None]
@@ -93,6 +100,7 @@ def test_broadcasting_over_phi_e_theta():
     assert np.allclose(c.p[..., 1] / c.p[..., 0], 10)
 
 
+@pytest.mark.analytic
 def test_custom_rdf_reproduces_carnahan_starling():
     custom = CustomRDF(chi_fn=lambda p: (1 - p / 2) / (1 - p) ** 3, dchi_fn=lambda p: (2.5 - p) / (1 - p) ** 4,
                        packing_limit=1.0, name="my-cs")
@@ -102,6 +110,7 @@ def test_custom_rdf_reproduces_carnahan_starling():
         assert np.allclose(getattr(a, k), getattr(b, k), rtol=1e-14), k
 
 
+@pytest.mark.contract
 def test_registry_has_the_paper_models_and_aliases():
     names = [m.name for m in list_models()]
     assert set(PAPER_MODELS) <= set(names)
@@ -111,6 +120,7 @@ def test_registry_has_the_paper_models_and_aliases():
     assert get_model("proposed", beta=2.0).rdf.beta == 2.0
 
 
+@pytest.mark.contract
 def test_every_registered_model_is_hashable_and_documented():
     for m in list_models():
         hash(m)
@@ -122,6 +132,7 @@ def test_every_registered_model_is_hashable_and_documented():
 QUARTER_EXPONENTS = [1.75, 0.75, -1.75, 2.5, 1.5, -3.0, 0.25, 4.0]
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("b", QUARTER_EXPONENTS)
 def test_power_quarter_exponents_match_pow(b):
     from ktgf._array import power
@@ -132,6 +143,7 @@ def test_power_quarter_exponents_match_pow(b):
     assert np.max(np.abs(np.asarray(power(jnp.asarray(x), b)) / exact - 1.0)) < 1e-15
 
 
+@pytest.mark.analytic
 def test_power_edge_values_and_fallback():
     from ktgf._array import power
 
@@ -143,6 +155,7 @@ def test_power_edge_values_and_fallback():
     assert np.array_equal(power(x, 40.0), x**40.0)          # beyond the multiplication range
 
 
+@pytest.mark.analytic
 def test_power_traced_exponent_differentiates():
     from ktgf._array import power
 
@@ -150,6 +163,7 @@ def test_power_traced_exponent_differentiates():
     assert float(g) == pytest.approx(2.0**1.75 * np.log(2.0), rel=1e-14)
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("name", ["proposed", "visc-div"])
 def test_dense_models_compile_without_pow(name):
     """The divergence exponents (β = 1.75, β − 1 = 0.75) cost no ``pow`` in the compiled closures

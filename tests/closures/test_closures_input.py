@@ -14,6 +14,7 @@ from ktgf.cli import app
 runner = CliRunner()
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(
     "model, phi, e, fragment",
     [
@@ -35,6 +36,7 @@ def test_out_of_range_state_raises(model, phi, e, fragment):
     assert isinstance(info.value, ValueError)
 
 
+@pytest.mark.contract
 def test_temperature_and_sizes_are_checked():
     m = get_model("ret")
     with pytest.raises(InputError, match="granular temperature theta = -1"):
@@ -43,6 +45,7 @@ def test_temperature_and_sizes_are_checked():
         m.coefficients(0.3, 0.9, 1.0, d=0.0, rho_s=1500.0)
 
 
+@pytest.mark.contract
 def test_unknown_model_and_option():
     with pytest.raises(UnknownModelError, match="registered models: enskog, ret"):
         get_model("navier")
@@ -52,6 +55,7 @@ def test_unknown_model_and_option():
         get_model("ret", zeta11="new")
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(
     "args, fragment",
     [
@@ -72,6 +76,7 @@ def test_cli_coefficients_errors_exit_2_with_one_line(args, fragment):
     assert len(lines) == 1 and lines[0].startswith("Error:") and fragment in lines[0]
 
 
+@pytest.mark.published
 def test_cli_coefficients_values_match_library():
     result = runner.invoke(app, ["coefficients", "-m", "ret", "--phi", "0.1:0.5:3", "--e", "0.9,0.7", "--format", "json"])
     assert result.exit_code == 0, result.output
@@ -82,12 +87,14 @@ def test_cli_coefficients_values_match_library():
     assert row["p [Pa]"] == pytest.approx(1500.0 * 0.5 * 1e-2 * 12.4, rel=1e-12)
 
 
+@pytest.mark.contract
 def test_cli_models_lists_registry():
     result = runner.invoke(app, ["models", "--format", "csv"])
     assert result.exit_code == 0
     assert {"enskog", "ret", "visc-div", "proposed"} <= {ln.split(",")[0] for ln in result.output.splitlines()}
 
 
+@pytest.mark.contract
 def test_cli_plot_coefficients(tmp_path):
     out = tmp_path / "fig" / "coefficients.png"
     result = runner.invoke(app, ["plot", "coefficients", "--e", "0.8", "--out", str(out)])

@@ -39,17 +39,20 @@ def close(a, b, rel=REL, abs_=1e-6):
     return np.allclose(np.asarray(a, float), np.asarray(b, float), rtol=rel, atol=abs_)
 
 
+@pytest.mark.published
 @pytest.mark.parametrize("e, expected", C_STAR)
 def test_c_star_table(e, expected):
     assert close(c_star(e), expected)
 
 
+@pytest.mark.published
 @pytest.mark.parametrize("phi, chi, dchi", CS_TABLE)
 def test_carnahan_starling_table(phi, chi, dchi):
     cs = CarnahanStarling()
     assert close(cs.chi(phi), chi) and close(cs.dchi(phi), dchi)
 
 
+@pytest.mark.published
 @pytest.mark.parametrize("row", RET_TABLE, ids=lambda r: f"phi{r[0]}-e{r[1]}")
 def test_ret_table(row):
     phi, e, p, zeta0, eta, lam, kappa, mu, zeta10 = row
@@ -60,6 +63,7 @@ def test_ret_table(row):
     assert close(z10, zeta10)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("variant", ["gd99", "ghd"])
 def test_zeta11_is_a_small_correction(variant):
     """model.md §3: ζ11 is at most 2.3 % of ζ10 (over 0 < φ ≤ 0.6, 0.05 ≤ e < 1)."""
@@ -76,6 +80,7 @@ def test_zeta11_is_a_small_correction(variant):
 PHI = np.array([0.0, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.55])
 
 
+@pytest.mark.analytic
 def test_ret_elastic_limit_is_chapman_cowling_enskog():
     chi = CarnahanStarling().chi(PHI)
     r = get_model("ret").reduced(PHI, 1.0)
@@ -85,6 +90,7 @@ def test_ret_elastic_limit_is_chapman_cowling_enskog():
     assert close(r.lambda_b, 256 / (5 * math.pi) * PHI**2 * chi, rel=1e-12)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("e", [0.5, 0.7, 0.9, 0.99])
 def test_ret_dilute_limit_without_sonine(e):
     r = get_model("ret", sonine=False).reduced(0.0, e)
@@ -93,6 +99,7 @@ def test_ret_dilute_limit_without_sonine(e):
     assert close(r.mu, 640 * (1 - e) / ((1 + e) * (19 - 3 * e) * (9 + 7 * e)), rel=1e-12)
 
 
+@pytest.mark.published
 @pytest.mark.parametrize("e", [0.5, 0.7, 0.9, 0.99])
 def test_ret_dilute_limit_with_sonine(e):
     """oracles.md: φ → 0 values with c* included (Brey et al. 1998 Boltzmann coefficients)."""
@@ -107,6 +114,7 @@ def test_ret_dilute_limit_with_sonine(e):
     assert close(r.mu, 2 * (zeta0 * kappa + cs / 3) / (2 * nu_kappa - 3 * zeta0), rel=1e-12)
 
 
+@pytest.mark.analytic
 def test_enskog_equals_ret_at_e_one():
     """Lun's coefficients are RET's with c* = 0 and ζ0* dropped: identical in the elastic limit."""
     a, b = get_model("enskog").reduced(PHI, 1.0), get_model("ret").reduced(PHI, 1.0)
@@ -114,6 +122,7 @@ def test_enskog_equals_ret_at_e_one():
         assert close(getattr(a, k), getattr(b, k), rel=1e-12), k
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("e", [0.6, 0.8, 0.95])
 def test_enskog_in_si_matches_lun_1984_dimensional_forms(e):
     """model.md §4 in its original SI form (K0, γ, λ_b with ρ_s d √θ) against Model.coefficients."""
@@ -139,6 +148,7 @@ def test_enskog_in_si_matches_lun_1984_dimensional_forms(e):
     assert np.all(c.omega == 0) and np.all(c.zeta_u == 0)
 
 
+@pytest.mark.analytic
 def test_lun_omega_option_matches_dimensional_form():
     e, d, rho_s, theta = 0.8, 1e-3, 1500.0, 0.01
     phi = np.array([0.1, 0.3, 0.5])
@@ -151,6 +161,7 @@ def test_lun_omega_option_matches_dimensional_form():
     assert close(c.omega, omega, rel=1e-12)
 
 
+@pytest.mark.analytic
 def test_reference_scales():
     theta, d, rho_s, phi = 0.02, 1e-3, 1500.0, 0.3
     assert close(kappa0(theta, d, rho_s), 3.75 * eta0(theta, d, rho_s), rel=1e-14)
@@ -158,6 +169,7 @@ def test_reference_scales():
     assert close(nu0(phi, theta, d), rho_s * phi * theta / eta0(theta, d, rho_s), rel=1e-12)
 
 
+@pytest.mark.analytic
 def test_ret_si_conversion():
     theta, d, rho_s, phi, e = 0.02, 1e-3, 1500.0, 0.3, 0.8
     m = get_model("ret")
@@ -170,12 +182,14 @@ def test_ret_si_conversion():
     assert close(c.zeta0, nu0(phi, theta, d) * r.zeta0, rel=1e-14)
 
 
+@pytest.mark.analytic
 def test_viscosity_divergence_rdf_is_cs_below_freezing():
     phi = np.linspace(0, 0.49, 50)
     assert np.array_equal(ViscosityDivergence().chi(phi), CarnahanStarling().chi(phi))
     assert np.array_equal(ViscosityDivergence().dchi(phi), CarnahanStarling().dchi(phi))
 
 
+@pytest.mark.analytic
 def test_visc_div_is_enskog_with_torquato_below_freezing():
     phi = np.linspace(0.01, 0.49, 30)[:, None]
     e = np.array([0.6, 0.9, 1.0])
@@ -185,6 +199,7 @@ def test_visc_div_is_enskog_with_torquato_below_freezing():
         assert np.allclose(getattr(a, k), getattr(b, k), rtol=1e-14, atol=0), k
 
 
+@pytest.mark.analytic
 def test_proposed_is_ret_below_freezing():
     phi = np.linspace(0.01, 0.49, 30)
     a, b = get_model("proposed").reduced(phi, 0.8), get_model("ret").reduced(phi, 0.8)
@@ -192,6 +207,7 @@ def test_proposed_is_ret_below_freezing():
         assert np.allclose(getattr(a, k), getattr(b, k), rtol=1e-14, atol=0), k
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", ["visc-div", "proposed"])
 def test_viscosity_diverges_with_exponent_beta(name):
     """Both dense models give η ∝ (φ_c − φ)^(−β), β = 1.75 (model.md §§5–6): local log slope."""

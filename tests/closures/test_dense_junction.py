@@ -18,6 +18,9 @@ KNOTS = [PHI_F, PHI_F + W]  # both ends of the bridge
 PIECEWISE = [Torquato, ViscosityDivergence]
 
 
+pytestmark = pytest.mark.analytic
+
+
 def _jump(f, x, eps=EPS):
     return float(abs(f(np.array(x + eps)) - f(np.array(x - eps))))
 

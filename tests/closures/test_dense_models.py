@@ -22,6 +22,7 @@ PHI = np.array([0.02, 0.1, 0.3, 0.45, 0.5, 0.55, 0.6, 0.63])
 
 
 # --- jamming power-law RDF -------------------------------------------------------------------
+@pytest.mark.analytic
 @pytest.mark.parametrize("b", [0.5, 1.0, 1.5, 2.0, 3.0])
 def test_jamming_power_law_slope_matches_autodiff(b):
     r = JammingPowerLaw(a=0.2, exponent=b)
@@ -29,6 +30,7 @@ def test_jamming_power_law_slope_matches_autodiff(b):
     np.testing.assert_allclose(r.dchi(PHI), auto, rtol=1e-12)
 
 
+@pytest.mark.analytic
 def test_jamming_power_law_reductions():
     """a = 0 is Carnahan–Starling; b = 1.5 is Chialvo–Sundaresan (2013); χ → 1 at φ → 0."""
     assert np.array_equal(JammingPowerLaw(a=0.0).chi(PHI), CarnahanStarling().chi(PHI))
@@ -36,6 +38,7 @@ def test_jamming_power_law_reductions():
     assert JammingPowerLaw(a=0.3, exponent=2.2).chi(0.0) == 1.0
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("b", [1.0, 1.5, 2.5])
 def test_jamming_power_law_diverges_with_its_exponent(b):
     r = JammingPowerLaw(a=0.1, phi_c=0.64, exponent=b)
@@ -45,11 +48,13 @@ def test_jamming_power_law_diverges_with_its_exponent(b):
 
 
 # --- EKT dissipation correction ---------------------------------------------------------------
+@pytest.mark.analytic
 def test_ekt_j_elastic_dense_limit():
     """At e = 1 and large G: J → 1 + (π/32)(8G)(8G)/(24G²) = 1 + π/12 (by hand)."""
     assert ekt_j(1.0, 1e8) == pytest.approx(1.0 + math.pi / 12, rel=1e-6)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("e", [1.0, 0.9, 0.7, 0.3])
 def test_ekt_j_is_the_garzo_dufty_viscosity_without_the_sonine_correction(e):
     """J is the shear viscosity of Garzó & Dufty (1999) with c* = 0 in units of (8/(5√π)) ρ_s d φ G √T.
@@ -67,6 +72,7 @@ def test_ekt_j_is_the_garzo_dufty_viscosity_without_the_sonine_correction(e):
                                ekt_j(e, G), rtol=1e-12)
 
 
+@pytest.mark.analytic
 def test_ekt_reduces_to_standard_theory_without_shear_and_when_l_equals_d():
     base = get_model("ret")
     ekt = base.replace(dissipation=CorrelationLength(c=1.0))
@@ -84,6 +90,7 @@ def test_ekt_reduces_to_standard_theory_without_shear_and_when_l_equals_d():
     assert NoDissipationCorrection().factor(PHI, 0.8, 1.0, 5.0) == 1.0
 
 
+@pytest.mark.analytic
 def test_ekt_uniform_shear_dilute_limit_is_standard():
     base = get_model("ret")
     ekt = base.replace(dissipation=CorrelationLength(c=3.0))
@@ -93,6 +100,7 @@ def test_ekt_uniform_shear_dilute_limit_is_standard():
     np.testing.assert_array_equal(s0.T, s1.T)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("c", [1.5, 3.0, 10.0])
 def test_ekt_uniform_shear_solves_the_energy_balance_consistently(c):
     """a*² η* (L/d) = (3/2) ζ0* with L/d = max(1, Λ s), s = dγ̇/√θ evaluated at the returned state."""
@@ -108,6 +116,7 @@ def test_ekt_uniform_shear_solves_the_energy_balance_consistently(c):
     assert np.any(s.L_over_d > 1.0)
 
 
+@pytest.mark.analytic
 def test_ekt_at_e_one_is_harmless():
     m = get_model("ret").replace(dissipation=CorrelationLength())
     r = m.reduced(PHI, 1.0, shear=5.0)
@@ -115,6 +124,7 @@ def test_ekt_at_e_one_is_harmless():
 
 
 # --- uniform shear in the DEM file's columns ------------------------------------------------
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", ["enskog", "ret", "visc-div", "proposed", "dense"])
 def test_shear_state_matches_model_md_closed_forms(name):
     """T = 25π η*/(13824 φ² ζ0*) and |P_xy|/p = √(3η*ζ0*/2)/p* (model.md §9) without a dissipation correction."""
@@ -129,6 +139,7 @@ def test_shear_state_matches_model_md_closed_forms(name):
     np.testing.assert_allclose(us.T, s.T, rtol=1e-13)
 
 
+@pytest.mark.dem
 def test_column_definitions_agree_with_the_dem_file_header(data_dir):
     """The DEM's own columns obey our conversions: eta_star/eta_over_eta0 = 5/(16√π), T = 25π/(9216 φ² a*²)."""
     rows = uniform_shear_records(data_dir / "dem_uniform_shear.csv")
@@ -136,6 +147,7 @@ def test_column_definitions_agree_with_the_dem_file_header(data_dir):
     np.testing.assert_allclose(25 * math.pi / (9216 * rows["phi"] ** 2 * rows["astar"] ** 2), rows["T"], rtol=1e-3)
 
 
+@pytest.mark.contract
 def test_cli_shear_json_matches_library():
     result = runner.invoke(app, ["shear", "--model", "proposed", "--phi", "0.3,0.5", "--e", "0.9", "--format", "json"])
     assert result.exit_code == 0, result.output
@@ -147,6 +159,7 @@ def test_cli_shear_json_matches_library():
             assert r[col] == pytest.approx(float(getattr(s, col)[i]), rel=1e-12)
 
 
+@pytest.mark.contract
 def test_cli_shear_options_and_csv():
     result = runner.invoke(app, ["shear", "-m", "ret", "--phi", "0.55", "--e", "0.7", "--format", "csv",
                                  "-O", "dissipation=jenkins-berzi-2010", "-O", "c=2"])
@@ -156,6 +169,7 @@ def test_cli_shear_options_and_csv():
     assert float(dict(zip(header.split(","), line.split(",")))["L_over_d"]) > 1
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(
     "args, fragment",
     [
@@ -174,6 +188,7 @@ def test_cli_shear_errors_exit_2_with_one_line(args, fragment):
 
 
 # --- the recommended dense model ---------------------------------------------------------------
+@pytest.mark.dem
 def test_dense_fit_reproduces_the_registered_parameters():
     """a, b, c of ``dense`` refit from the shipped frictionless uniform shear (base + extra file, e = 0.9)."""
     from ktgf.calibration.registry_fits import fit_frictionless
@@ -189,6 +204,7 @@ def test_dense_fit_reproduces_the_registered_parameters():
     assert get_model("dense").phi_max == pytest.approx(0.634, abs=5e-4)
 
 
+@pytest.mark.dem
 @pytest.mark.xfail(strict=True, reason="issue 33: the refitted dense (nothing chosen on the Couette file) predicts "
                    "the wall stresses 21-24 % low (theta ~25 % low across the cell); docs/dense.md §5.1")
 def test_dense_predicts_the_couette_wall_stresses_within_15_percent(data_dir):
@@ -204,6 +220,7 @@ def test_dense_predicts_the_couette_wall_stresses_within_15_percent(data_dir):
 GOALS = {"T": 0.15, "p_over_nT": 0.10, "tau_over_p": 0.10}  # issue 33: uniform shear
 
 
+@pytest.mark.dem
 def test_dense_meets_the_uniform_shear_goals_at_every_frictionless_state():
     """Issue 33 goal, frictionless φ 0.3–0.6 (e = 0.9, the fit set): T within 15 %, p/(nT) and τ/p within 10 %;
     the paper's ``proposed`` misses it (so the test can fail)."""
@@ -217,6 +234,7 @@ def test_dense_meets_the_uniform_shear_goals_at_every_frictionless_state():
         assert within is ok, name
 
 
+@pytest.mark.dem
 def test_dense_cross_validated_errors_meet_the_goals():
     """Leave-one-state-out refits of a, b, c predict each left-out frictionless state within the issue's goals."""
     from ktgf.calibration.registry_fits import OBSERVABLES, fit_frictionless, frictionless_states, leave_one_out
@@ -227,6 +245,7 @@ def test_dense_cross_validated_errors_meet_the_goals():
         assert np.all(np.abs(loo[k]) < GOALS[name]), (name, loo[k])
 
 
+@pytest.mark.dem
 def test_dense_predicts_the_held_out_e07_row():
     """The frictionless e = 0.7 row (never fitted): η* and p/(nT) within 10 % (the check of issue 9), T within 15 %."""
     held_out = uniform_shear_records(shipped(FRICTION_SHEAR), where={"mu": 0.0})
@@ -236,6 +255,7 @@ def test_dense_predicts_the_held_out_e07_row():
         assert abs(float(getattr(s, q)[0]) / held_out[q][0] - 1.0) < tol, q
 
 
+@pytest.mark.contract
 def test_load_uniform_shear_errors(tmp_path):
     from ktgf import InputError
 

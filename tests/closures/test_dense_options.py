@@ -20,6 +20,9 @@ from ktgf.closures.rdf import JammingPowerLaw, LunSavage, MaAhmadi, Torquato, Vi
 NAN, INF = float("nan"), float("inf")
 
 
+pytestmark = pytest.mark.contract
+
+
 @pytest.mark.parametrize(
     "name, options, fragment",
     [

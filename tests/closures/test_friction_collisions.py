@@ -21,6 +21,7 @@ jax = pytest.importorskip("jax")
 jnp = jax.numpy
 
 
+@pytest.mark.published
 def test_chialvo_sundaresan_published_form_and_limits():
     law = ChialvoSundaresanRestitution()
     # e_eff = e − (3/2) μ exp(−3μ): at μ = 0.5, e = 0.7 this is 0.7 − 0.75 e^(−1.5).
@@ -35,6 +36,7 @@ def test_chialvo_sundaresan_published_form_and_limits():
     assert red.max() == pytest.approx(1.5 / (3.0 * math.e), rel=1e-8)
 
 
+@pytest.mark.analytic
 def test_chialvo_sundaresan_derivative_matches_autodiff():
     law = ChialvoSundaresanRestitution()
     grad = jax.grad(lambda mu: law.effective_restitution(0.7, mu))
@@ -42,6 +44,7 @@ def test_chialvo_sundaresan_derivative_matches_autodiff():
         assert float(grad(mu)) == pytest.approx(float(law.d_effective_restitution_dmu(0.7, mu)), rel=1e-12, abs=1e-14)
 
 
+@pytest.mark.analytic
 def test_modified_cooling_rate_is_unchanged_without_friction():
     law = ChialvoSundaresanRestitution()
     z = np.array([0.2, 0.5])
@@ -79,6 +82,7 @@ def _monte_carlo(e, beta, T, R, n=400_000, seed=3, q=0.4, mu=None):
     return (rate * d_tr).mean() / norm, (rate * d_rot).mean() / norm
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("e, beta, R", [(0.7, 0.5, 0.0), (0.7, 0.5, 0.6), (0.9, 0.0, 0.3), (0.5, 0.9, 1.2)])
 def test_rough_sphere_coefficients_match_monte_carlo(e, beta, R):
     law = RoughSphereRestitution(beta=beta)
@@ -89,6 +93,7 @@ def test_rough_sphere_coefficients_match_monte_carlo(e, beta, R):
     assert rot == pytest.approx(4 * (B - C * R), rel=0.015, abs=0.01)
 
 
+@pytest.mark.analytic
 def test_rough_sphere_limits():
     smooth = RoughSphereRestitution(beta=-1.0)
     assert smooth.effective_restitution(0.7, 0.5) == pytest.approx(0.7, rel=1e-14)
@@ -107,6 +112,7 @@ def test_rough_sphere_limits():
         assert law.inelasticity(0.7, 0.5) > 1 - 0.7**2
 
 
+@pytest.mark.analytic
 def test_rotational_ratio_is_the_steady_state_of_the_collision_integrals():
     law = RoughSphereRestitution(beta=0.4)
     A, B, C = law.collision_coefficients(0.8, 0.5)
@@ -115,6 +121,7 @@ def test_rotational_ratio_is_the_steady_state_of_the_collision_integrals():
     assert law.inelasticity(0.8, 0.5) == pytest.approx(4 * (A - B * r), rel=1e-13)
 
 
+@pytest.mark.contract
 def test_bad_input_is_one_line():
     with pytest.raises(InputError, match="friction coefficient mu = -0.1"):
         ChialvoSundaresanRestitution().check(0.7, -0.1)
@@ -127,6 +134,7 @@ def test_bad_input_is_one_line():
     assert "\n" not in str(err.value)
 
 
+@pytest.mark.analytic
 def test_hcs_rotational_ratio_is_the_attractor_of_the_cooling_equations():
     """With dT/dτ = −A T + B R and dR/dτ = B T − C R (τ the collision time), r = R/T obeys
     dr/dτ = B + (A − C) r − B r²; integrated from r = 0 it must settle on the closed-form root."""
@@ -142,6 +150,7 @@ def test_hcs_rotational_ratio_is_the_attractor_of_the_cooling_equations():
     assert RoughSphereRestitution(beta=0.7).hcs_rotational_ratio(0.7, 0.0) == 0.0  # frictionless
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("e, mu, beta0, r", [(0.7, 0.5, 1.0, 0.5), (0.9, 0.2, 0.4, 0.2), (0.7, 1.5, 0.8, 1.0)])
 def test_walton_averages_match_monte_carlo(e, mu, beta0, r):
     m1, m2 = _walton_moments(e, mu, beta0, 0.4, r)
@@ -153,6 +162,7 @@ def test_walton_averages_match_monte_carlo(e, mu, beta0, r):
     assert mc_tr == pytest.approx(tr, rel=0.015, abs=0.005)
 
 
+@pytest.mark.analytic
 def test_walton_limits():
     law = WaltonRestitution(beta0=0.4)
     assert law.effective_restitution(0.7, 0.0) == 0.7 and law.rotational_ratio(0.7, 0.0) == 0.0
@@ -167,6 +177,7 @@ def test_walton_limits():
         WaltonRestitution(beta0=-1.0)
 
 
+@pytest.mark.analytic
 def test_walton_hcs_tends_to_the_rough_sphere_hcs_and_is_the_attractor():
     """μ → ∞ (always sticking): Huthmann & Zippelius's rough-sphere HCS ratio and cooling with β = β0; at finite μ the
     ratio is where the relative cooling rates of the two temperatures agree, reached from a rotation-free start."""

@@ -18,6 +18,7 @@ from ktgf.errors import InputError
 jax = pytest.importorskip("jax")
 
 
+@pytest.mark.published
 def test_end_points_and_monotonic():
     jam = JammingFraction()
     assert jam.phi_c(0.0) == 0.64  # frictionless: random close packing, exactly
@@ -30,18 +31,21 @@ def test_end_points_and_monotonic():
     assert 0.55 <= jam.phi_c(0.5) <= 0.59
 
 
+@pytest.mark.analytic
 def test_jamming_derivative_matches_autodiff():
     grad = jax.grad(jamming_fraction)
     for mu in (0.0, 0.05, 0.5, 2.0):
         assert float(grad(mu)) == pytest.approx(float(d_jamming_fraction_dmu(mu)), rel=1e-12)
 
 
+@pytest.mark.analytic
 def test_frictional_rdf_reduces_to_chialvo_sundaresan_at_zero_friction():
     phi = np.linspace(0.0, 0.62, 40)
     np.testing.assert_array_equal(FrictionalChialvoSundaresan(mu=0.0).chi(phi), ChialvoSundaresan().chi(phi))
     np.testing.assert_array_equal(FrictionalChialvoSundaresan(mu=0.0).dchi(phi), ChialvoSundaresan().dchi(phi))
 
 
+@pytest.mark.analytic
 def test_frictional_rdf_diverges_at_the_jamming_fraction():
     rdf = FrictionalChialvoSundaresan(mu=0.5)
     assert rdf.phi_max == pytest.approx(0.565, abs=1e-12)
@@ -53,6 +57,7 @@ def test_frictional_rdf_diverges_at_the_jamming_fraction():
     assert np.all(rdf.chi(np.array([0.3, 0.5])) > ChialvoSundaresan().chi(np.array([0.3, 0.5])))
 
 
+@pytest.mark.analytic
 def test_frictional_rdf_derivative_matches_autodiff():
     rdf = FrictionalChialvoSundaresan(mu=0.5)
     grad = jax.grad(lambda p: rdf.chi(p))
@@ -60,6 +65,7 @@ def test_frictional_rdf_derivative_matches_autodiff():
         assert float(grad(phi)) == pytest.approx(float(rdf.dchi(phi)), rel=1e-12)
 
 
+@pytest.mark.analytic
 def test_with_jamming_fraction_moves_other_families():
     for base in (Torquato(), ViscosityDivergence(), ChialvoSundaresan()):
         assert with_jamming_fraction(base, 0.0) == base  # φ_rcp = 0.64 = their default φ_c
@@ -67,6 +73,7 @@ def test_with_jamming_fraction_moves_other_families():
         assert moved.phi_max == pytest.approx(JammingFraction().phi_c(0.2))
 
 
+@pytest.mark.contract
 def test_bad_input_is_one_line():
     with pytest.raises(InputError, match="friction coefficient mu = -0.5"):
         FrictionalChialvoSundaresan(mu=-0.5)
@@ -80,6 +87,7 @@ def test_bad_input_is_one_line():
         with_jamming_fraction(Torquato(phi_f=0.58), 0.5)
 
 
+@pytest.mark.contract
 def test_frictional_rdf_fits_the_model_registry():
     """Flat, JSON-serialisable options; ``mu`` is routed to the RDF by Model.with_options."""
     import json

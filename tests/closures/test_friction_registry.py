@@ -13,7 +13,6 @@ from ktgf.calibration.model_file import dumps, load_model_file, part_choice_opti
 from ktgf.cli import app
 from ktgf.closures.friction import WaltonRestitution
 from ktgf.closures.friction.model_slot import Friction
-from ktgf.shear.compositions import frictional_uniform_shear, recommended_parts
 from ktgf.shear.steady import steady_shear
 from ktgf.calibration.registry_fits import fit_frictional, fit_frictionless, frictional_states
 from ktgf.closures.dense import DENSE_PARAMETERS
@@ -34,6 +33,7 @@ FRICTIONLESS = get_model("dense")
 PHI_J0 = 6.0 / (6.0 + 2.0 * 3.0**0.5)
 
 
+@pytest.mark.analytic
 def test_frictional_model_at_mu_zero_is_dense_bit_for_bit():
     """One family (issue 33, item 2): μ = 0 gives φ_J(0) and the μ = 0 amplitude exactly and ζ0 untouched: ``dense``."""
     fr = get_model("frictional", mu=0.0)
@@ -51,6 +51,7 @@ def test_frictional_model_at_mu_zero_is_dense_bit_for_bit():
                       get_model("ret").replace(rdf=core).reduced(PHI, 0.7))
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", [m.name for m in list_models() if m.friction.key == "none"])
 @pytest.mark.parametrize("law", ["walton", "rough-sphere", "chialvo-sundaresan-2013"])
 def test_every_model_with_a_friction_part_at_mu_zero_is_unchanged(name, law):
@@ -60,6 +61,7 @@ def test_every_model_with_a_friction_part_at_mu_zero_is_unchanged(name, law):
     assert _same_bits(fr.reduced(phi, 0.8), base.reduced(phi, 0.8))
 
 
+@pytest.mark.analytic
 def test_friction_changes_only_the_dissipation_by_the_walton_factor():
     fr = get_model("frictional", mu=0.5)
     ref = FRICTIONLESS.replace(rdf=fr.rdf)
@@ -72,6 +74,7 @@ def test_friction_changes_only_the_dissipation_by_the_walton_factor():
             assert np.array_equal(getattr(a, k), getattr(b, k)), k
 
 
+@pytest.mark.contract
 def test_mu_is_routed_to_the_friction_part_and_the_jamming_fraction():
     m = get_model("frictional", mu=0.1)
     assert m.friction.mu == 0.1 and m.rdf.mu == 0.1
@@ -81,15 +84,37 @@ def test_mu_is_routed_to_the_friction_part_and_the_jamming_fraction():
     assert m.metadata()["friction"] == "coulomb" and '"friction"' in m.metadata()["model_options"]
 
 
-def test_registered_model_is_the_documented_composition():
-    """``frictional`` = the parts of ktgf.shear.compositions.recommended_parts (docs/friction.md §6)."""
-    phi = [0.4, 0.5, 0.57]
-    s = steady_shear(get_model("frictional", mu=0.5), phi, 0.7)
-    parts = frictional_uniform_shear(recommended_parts(), phi, 0.7, 0.5)
-    for a, b in zip(s, parts):
-        np.testing.assert_allclose(a, b, rtol=1e-12)
+@pytest.mark.analytic
+def test_registered_model_is_its_documented_parts_checked_by_a_dilute_limit():
+    """``frictional`` (μ = 0.5, e = 0.7) against numbers that do not come from its own code path.
+
+    Analytic limit: as φ → 0 (χ → 1, L = d) uniform shear is the Boltzmann-limit closed form of
+    model.md §9 with ζ0* scaled by Walton's factor (1 − e_eff²)/(1 − e²):
+    φ²T → 25π η*/(13824 ζ0* F) and τ/p → √(3η*ζ0*F/2), p* → 1, where η*, ζ0* are the published φ = 0
+    RET values of oracles.md (e = 0.7) and F comes from Walton's rule, which
+    test_friction_collisions.py checks against a Monte Carlo of the collision rule.  Its RDF is the
+    Chialvo–Sundaresan (2013) form, written out here with the fitted a, b, k and μ_Z, diverging at φ_J(0.5) of the
+    contact-number law, Z_J = 4 + 2/(1 + μ/μ_Z), φ_J = Z_J/(Z_J + 2√3).
+    """
+    m = get_model("frictional", mu=0.5)
+    eta_star, zeta0_star = 1.147863, 0.212552  # oracles.md, RET at φ = 0, e = 0.7
+    factor = WaltonRestitution(beta0=1.0).inelasticity(0.7, 0.5) / (1 - 0.7**2)
+    assert factor > 1.1  # friction adds dissipation: the limit differs from the frictionless one
+    phi = 1e-7
+    s = steady_shear(m, [phi], 0.7)
+    assert s.L_over_d[0] == 1.0
+    assert phi**2 * s.T[0] == pytest.approx(25 * np.pi * eta_star / (13824 * zeta0_star * factor), rel=2e-5)
+    assert s.tau_over_p[0] == pytest.approx(np.sqrt(1.5 * eta_star * zeta0_star * factor), rel=2e-5)
+    assert s.p_over_nT[0] == pytest.approx(1.0, abs=1e-5)
+    x = np.array([0.1, 0.3, 0.45, 0.55])
+    mu_z, k = FRICTIONAL_PARAMETERS["mu_scale"], FRICTIONAL_PARAMETERS["amplitude_growth"]
+    z = 4.0 + 2.0 / (1.0 + 0.5 / mu_z)
+    phi_j, amp = z / (z + 2.0 * 3.0**0.5), DENSE_PARAMETERS["a"] * (1.0 + k * 0.5 / (0.5 + mu_z))
+    want = (1 - x / 2) / (1 - x) ** 3 + amp * x**2 / (phi_j - x) ** DENSE_PARAMETERS["exponent"]
+    np.testing.assert_allclose(m.rdf.chi(x), want, rtol=1e-12)
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(
     "options, field",
     [
@@ -111,11 +136,13 @@ def test_bad_friction_options_are_one_line_errors_naming_the_option(options, fie
     assert field in msg and "\n" not in msg
 
 
+@pytest.mark.contract
 def test_frictional_dissipation_needs_e_below_one():
     with pytest.raises(InputError, match="restitution coefficient e = 1"):
         get_model("frictional").reduced(0.3, 1.0)
 
 
+@pytest.mark.contract
 def test_model_files_round_trip_the_friction_part(tmp_path):
     cases = [
         ("frictional", {"mu": 0.3, "restitution": "rough-sphere", "tangential_beta": 0.699}),
@@ -138,6 +165,7 @@ def test_model_files_round_trip_the_friction_part(tmp_path):
         assert load_model_file(again).model.friction == mf.model.friction
 
 
+@pytest.mark.contract
 def test_model_file_friction_option_errors_name_the_field(tmp_path):
     path = tmp_path / "bad.toml"
     path.write_text(dumps("ret", {"mu": 0.3}))  # no friction part chosen: mu is not an option of ret
@@ -145,6 +173,7 @@ def test_model_file_friction_option_errors_name_the_field(tmp_path):
         load_model_file(path)
 
 
+@pytest.mark.contract
 def test_shear_cli_mu_prints_the_dem_columns():
     r = runner.invoke(app, ["shear", "--model", "frictional", "--mu", "0.5", "--phi", "0.4,0.5", "--e", "0.7", "--format", "json"])
     assert r.exit_code == 0, r.output
@@ -164,6 +193,7 @@ def test_shear_cli_mu_prints_the_dem_columns():
                                           "Trot_over_T,p_star,mu")  # the frictionless columns keep their places
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(
     "extra, word",
     [
@@ -182,6 +212,7 @@ def test_shear_cli_bad_friction_input_exits_2_with_one_line(extra, word):
     assert len(lines) == 1 and word in lines[0]
 
 
+@pytest.mark.analytic
 def test_shear_cli_frictional_stress_adds_to_the_pressure():
     """At φ = 0.55 > φ_min the Johnson–Jackson stress adds p_f/(ρ_s d²γ̇²) to p* and sin φ_fr p_f to τ."""
     scale = 2500.0 * 1e-6 * 100.0  # ρ_s d² γ̇² [Pa]: 2500 kg/m³, 1 mm, 10 /s
@@ -197,6 +228,7 @@ def test_shear_cli_frictional_stress_adds_to_the_pressure():
     assert fr["tau_over_p"] == pytest.approx(tau / fr["p_star"], rel=1e-12)
 
 
+@pytest.mark.contract
 def test_walton_under_jit_is_the_numpy_value():
     jax = pytest.importorskip("jax")
     m = get_model("frictional")
@@ -204,11 +236,13 @@ def test_walton_under_jit_is_the_numpy_value():
     assert float(got) == float(m.reduced(0.4, 0.7).zeta0)
 
 
+@pytest.mark.contract
 def test_friction_part_is_hashable_and_a_value():
     a, b = Friction(mu=0.3), Friction(mu=0.3)
     assert a == b and hash(a) == hash(b) and a.law == b.law
 
 
+@pytest.mark.dem
 def test_the_fitted_constants_are_the_registered_ones():
     """μ_Z and k of ``frictional`` refit from the shipped μ = 0.5 uniform shear (a, b, c from the frictionless set)."""
     step1 = fit_frictionless()
@@ -220,6 +254,7 @@ def test_the_fitted_constants_are_the_registered_ones():
     assert (rdf.mu_scale, rdf.amplitude_growth) == (FRICTIONAL_PARAMETERS["mu_scale"], FRICTIONAL_PARAMETERS["amplitude_growth"])
 
 
+@pytest.mark.dem
 def test_frictional_pressure_within_ten_percent_at_mu_half_and_phi_j_alone_is_not_enough():
     """Issue 33 goal for p/(nT) at μ = 0.5, φ 0.3–0.57 (the fit set of μ_Z, k); moving φ_J(μ) alone (k = 0, μ_Z
     refit) misses it by more than 20 %, so the second parameter is needed and the test can fail."""
@@ -231,6 +266,7 @@ def test_frictional_pressure_within_ten_percent_at_mu_half_and_phi_j_alone_is_no
     assert np.max(np.abs(np.expm1(alone.residuals[1]))) > 0.20
 
 
+@pytest.mark.dem
 def test_nothing_refused_where_the_particles_flow():
     """Issue 33 item 6: μ = 0.5, φ = 0.57 flows in the DEM (p* = 79): the model answers; above φ_J(μ) one line names it."""
     m = get_model("frictional", mu=0.5)

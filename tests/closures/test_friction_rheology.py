@@ -12,6 +12,7 @@ from ktgf.errors import InputError
 jax = pytest.importorskip("jax")
 
 
+@pytest.mark.published
 def test_published_glass_bead_constants():
     rheo = MuIRheology()
     # Jop et al. (2006): μ_s = tan 20.9°, μ_2 = tan 32.76°, I0 = 0.279; Basilisk's μ(I) examples
@@ -21,6 +22,7 @@ def test_published_glass_bead_constants():
     assert rheo.I0 == 0.279
 
 
+@pytest.mark.analytic
 def test_mu_of_i_limits_and_inverse():
     rheo = MuIRheology()
     assert rheo.friction(0.0) == rheo.mu_s
@@ -33,11 +35,13 @@ def test_mu_of_i_limits_and_inverse():
         assert float(grad(i)) == pytest.approx(float(rheo.dfriction(i)), rel=1e-12)
 
 
+@pytest.mark.analytic
 def test_inertial_number_definition():
     # I = γ̇ d/√(p/ρ_s): 10 1/s, 1 mm, 2500 kg/m³, 25 Pa -> 0.01/0.1
     assert inertial_number(10.0, 1e-3, 25.0, 2500.0) == pytest.approx(0.1, rel=1e-14)
 
 
+@pytest.mark.analytic
 def test_dilatancy_and_dense_temperature():
     dil = LinearDilatancy()
     assert dil.solid_fraction(0.0) == 0.6
@@ -46,6 +50,7 @@ def test_dilatancy_and_dense_temperature():
     assert dense.temperature_ratio(0.5, 0.5 + 0.04) == pytest.approx(0.06 / 0.2, rel=1e-14)
 
 
+@pytest.mark.contract
 def test_bad_input_is_one_line():
     with pytest.raises(InputError, match="limiting friction coefficient mu_2 = 0.2"):
         MuIRheology(mu_2=0.2)

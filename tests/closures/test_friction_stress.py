@@ -19,6 +19,7 @@ from ktgf.errors import InputError
 jax = pytest.importorskip("jax")
 
 
+@pytest.mark.analytic
 def test_johnson_jackson_zero_below_threshold_and_divergence_exponent():
     jj = JohnsonJacksonPressure(delta_min=0.0)
     np.testing.assert_array_equal(jj.pressure(np.linspace(0.0, 0.5, 11)), 0.0)  # no friction at φ ≤ φ_min
@@ -31,6 +32,7 @@ def test_johnson_jackson_zero_below_threshold_and_divergence_exponent():
     assert np.diff(np.log(p))[0] / np.diff(np.log(ex))[0] == pytest.approx(2.0, abs=1e-4)
 
 
+@pytest.mark.analytic
 def test_johnson_jackson_openfoam_floor_is_continuous():
     jj = JohnsonJacksonPressure()  # δ_min = 0.05: the denominator stops at 0.05^5
     edge = jj.phi_max - jj.delta_min
@@ -39,6 +41,7 @@ def test_johnson_jackson_openfoam_floor_is_continuous():
     assert np.isfinite(jj.pressure(0.7))
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("delta_min", [0.0, 0.05])
 def test_johnson_jackson_derivative_matches_autodiff(delta_min):
     jj = JohnsonJacksonPressure(delta_min=delta_min)
@@ -56,6 +59,7 @@ def _simple_shear_invariants(rate):
     return float(np.sum(s * s)), np.trace(d)
 
 
+@pytest.mark.analytic
 def test_schaeffer_gives_coulomb_stress_in_simple_shear():
     visc = SchaefferViscosity()
     ss, _ = _simple_shear_invariants(3.0)
@@ -66,6 +70,7 @@ def test_schaeffer_gives_coulomb_stress_in_simple_shear():
     assert visc.shear_stress_ratio() == pytest.approx(0.47715876, rel=1e-7)
 
 
+@pytest.mark.analytic
 def test_srivastava_sundaresan_limits():
     ss_visc = SrivastavaSundaresanViscosity()
     assert ss_visc.n_dilation == pytest.approx(math.sqrt(3) / (2 * math.sin(math.radians(28.5))), rel=1e-14)
@@ -85,6 +90,7 @@ def test_srivastava_sundaresan_limits():
     assert ss_visc.pressure_ratio(0.5, ss, 0.0) < 1.0
 
 
+@pytest.mark.published
 def test_tanh_blend_matches_mfix_definition():
     blend = TanhBlend(phi_star=0.58)
     assert blend.width == pytest.approx(0.02 * 0.42)
@@ -99,6 +105,7 @@ def test_tanh_blend_matches_mfix_definition():
         assert float(grad(phi)) == pytest.approx(float(smooth.dweight(phi)), rel=1e-10)
 
 
+@pytest.mark.analytic
 def test_sigmoid_blend_is_continuous_unlike_mfix():
     blend = SigmoidBlend(phi_star=0.58)
     end = blend.phi_end
@@ -113,6 +120,7 @@ def test_sigmoid_blend_is_continuous_unlike_mfix():
         assert float(grad(phi)) == pytest.approx(float(blend.dweight(phi)), rel=1e-10)
 
 
+@pytest.mark.contract
 def test_bad_input_is_one_line():
     with pytest.raises(InputError, match="friction threshold phi_min = 0.65 .*packing limit phi_max = 0.62"):
         JohnsonJacksonPressure(phi_min=0.65)

@@ -18,6 +18,7 @@ from ktgf.errors import InputError
 RDF = FrictionalPowerLaw(mu=0.5, a=0.12, exponent=1.9, mu_scale=0.62, amplitude_growth=5.8)
 
 
+@pytest.mark.published
 def test_frictionless_member_is_the_power_law_at_the_published_jamming_fraction():
     rdf = FrictionalPowerLaw(mu=0.0, a=0.12, exponent=1.9, mu_scale=0.62, amplitude_growth=5.8)
     assert rdf.phi_c == 6.0 / (6.0 + 2.0 * math.sqrt(3.0))
@@ -28,6 +29,7 @@ def test_frictionless_member_is_the_power_law_at_the_published_jamming_fraction(
     np.testing.assert_array_equal(rdf.dchi(phi), ref.dchi(phi))
 
 
+@pytest.mark.published
 def test_friction_moves_the_divergence_between_the_printed_end_points_and_grows_the_amplitude():
     lo, hi = 4.0 / (4.0 + 2.0 * math.sqrt(3.0)), 6.0 / (6.0 + 2.0 * math.sqrt(3.0))
     mus = [0.0, 0.1, 0.5, 2.0, 1e6]
@@ -38,6 +40,7 @@ def test_friction_moves_the_divergence_between_the_printed_end_points_and_grows_
     assert RDF.phi_max == RDF.phi_c
 
 
+@pytest.mark.analytic
 def test_carnahan_starling_limits():
     phi = np.array([1e-4, 0.1, 0.3])
     cs = CarnahanStarling().chi(phi)
@@ -45,6 +48,7 @@ def test_carnahan_starling_limits():
     assert RDF.chi(1e-4) == pytest.approx(CarnahanStarling().chi(1e-4), rel=1e-6)  # CS + O(φ²)
 
 
+@pytest.mark.analytic
 def test_divergence_exponent_and_derivative():
     gap = np.array([1e-6, 1e-7])
     chi = RDF.chi(RDF.phi_c - gap)
@@ -55,6 +59,7 @@ def test_divergence_exponent_and_derivative():
     np.testing.assert_allclose(RDF.dchi(phi), (RDF.chi(phi + h) - RDF.chi(phi - h)) / (2 * h), rtol=1e-6)
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("options, name", [({"mu": -0.1}, "mu"), ({"a": -1.0}, "option a"),
                                            ({"exponent": 0.0}, "option exponent"), ({"mu_scale": 0.0}, "mu_scale"),
                                            ({"amplitude_growth": -1.0}, "option amplitude_growth")])

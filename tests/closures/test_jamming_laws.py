@@ -35,6 +35,7 @@ from ktgf.errors import InputError
 MUS = np.array([0.0, 1e-3, 0.01, 0.1, 0.3, 0.5, 1.0, 10.0, 1e3])
 
 
+@pytest.mark.published
 def test_song_wang_makse_end_points_are_their_printed_rcp_and_rlp() -> None:
     # "4/(4 + 2√3) or 53.6% and 6/(6 + 2√3) or 63.4%, defining RLP and RCP" (abstract of "Jamming II:
     # Edwards' statistical mechanics of random packings of hard spheres", Makse group, arXiv)
@@ -45,6 +46,7 @@ def test_song_wang_makse_end_points_are_their_printed_rcp_and_rlp() -> None:
     assert law.phi_c(1e12) == pytest.approx(4.0 / (4.0 + 2.0 * math.sqrt(3.0)), rel=1e-10)
 
 
+@pytest.mark.analytic
 def test_contact_number_goes_from_isostatic_frictionless_to_isostatic_frictional() -> None:
     dim = 3
     law = CoordinationJamming()
@@ -54,11 +56,13 @@ def test_contact_number_goes_from_isostatic_frictionless_to_isostatic_frictional
     assert np.all(np.diff(z) < 0) and np.all((z > 4.0 - 1e-9) & (z <= 6.0))
 
 
+@pytest.mark.analytic
 def test_volume_function_and_its_inverse() -> None:
     z = np.linspace(3.0, 7.0, 9)
     assert coordination_of_packing_fraction(packing_fraction_of_coordination(z)) == pytest.approx(z, rel=1e-14)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("law", [JammingFraction(), CoordinationJamming(), CoordinationJamming(mu_scale=0.3),
                                  TabulatedJamming(mu=(0.0, 0.1, 1.0), phi=(0.64, 0.6, 0.56))])
 def test_every_law_decreases_with_friction_and_its_derivative_is_the_slope(law) -> None:
@@ -70,6 +74,7 @@ def test_every_law_decreases_with_friction_and_its_derivative_is_the_slope(law) 
     assert law.dphi_c(mu) == pytest.approx(fd, rel=1e-6, abs=1e-12)
 
 
+@pytest.mark.analytic
 def test_derivatives_agree_with_jax_grad() -> None:
     jax = pytest.importorskip("jax")
     jax.config.update("jax_enable_x64", True)
@@ -80,6 +85,7 @@ def test_derivatives_agree_with_jax_grad() -> None:
             assert float(jax.grad(law.phi_c)(jnp.asarray(mu))) == pytest.approx(float(law.dphi_c(mu)), rel=1e-12)
 
 
+@pytest.mark.analytic
 def test_tabulated_law_returns_its_nodes_and_is_flat_outside() -> None:
     law = TabulatedJamming(mu=(0.0, 0.1, 0.5, 1.0), phi=(0.636, 0.61, 0.585, 0.58))
     assert law.phi_c(np.array([0.0, 0.1, 0.5, 1.0])) == pytest.approx([0.636, 0.61, 0.585, 0.58], abs=0)
@@ -87,6 +93,7 @@ def test_tabulated_law_returns_its_nodes_and_is_flat_outside() -> None:
     assert law.phi_c(0.3) == pytest.approx(0.5975, rel=1e-14)
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("kwargs, text", [
     ({"mu": (0.0, 0.5, 0.4), "phi": (0.64, 0.6, 0.58)}, "must increase strictly"),
     ({"mu": (0.0, 0.5), "phi": (0.6, 0.62)}, "must not increase"),
@@ -100,6 +107,7 @@ def test_tabulated_law_refuses_bad_tables_in_one_line(kwargs, text) -> None:
     assert text in str(err.value) and "\n" not in str(err.value)
 
 
+@pytest.mark.contract
 def test_registry_builds_each_law_and_refuses_unknown_names() -> None:
     assert set(JAMMING_LAWS) == {"interpolation", "coordination", "tabulated"}
     assert isinstance(get_jamming_law("coordination", mu_scale=0.2), CoordinationJamming)
@@ -110,6 +118,7 @@ def test_registry_builds_each_law_and_refuses_unknown_names() -> None:
         CoordinationJamming(z_infinite=7.0)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("law", [JammingFraction(), CoordinationJamming()])
 def test_mu_scale_for_puts_the_law_through_a_given_point(law) -> None:
     import dataclasses
@@ -138,6 +147,7 @@ def _log_slope(chi, phi_j: float, gap: float) -> float:
     return float((math.log(chi(phi_j - hi)) - math.log(chi(phi_j - lo))) / (2 * h))
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("rdf, exponent", FAMILIES, ids=lambda x: getattr(x, "key", str(x)))
 @pytest.mark.parametrize("law", [JammingFraction(), CoordinationJamming(mu_scale=0.3)],
                          ids=["interpolation", "coordination"])
@@ -152,6 +162,7 @@ def test_rdf_moved_to_phi_j_diverges_there_with_its_published_exponent(rdf, expo
     assert slope == pytest.approx(-b, rel=2e-3)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("rdf", [Torquato(), ViscosityDivergence()], ids=["torquato", "viscosity-divergence"])
 def test_moved_piecewise_rdfs_are_carnahan_starling_below_freezing(rdf) -> None:
     moved = at_jamming(rdf, 0.5, CoordinationJamming(mu_scale=0.3))
@@ -159,6 +170,7 @@ def test_moved_piecewise_rdfs_are_carnahan_starling_below_freezing(rdf) -> None:
     assert moved.chi(phi) == pytest.approx(_cs_chi(phi), rel=1e-15)
 
 
+@pytest.mark.analytic
 def test_chialvo_sundaresan_is_carnahan_starling_plus_order_phi_squared_at_low_density() -> None:
     moved = at_jamming(ChialvoSundaresan(), 0.5, CoordinationJamming(mu_scale=0.3))
     phi = np.array([1e-5, 1e-4, 1e-3])
@@ -166,6 +178,7 @@ def test_chialvo_sundaresan_is_carnahan_starling_plus_order_phi_squared_at_low_d
     assert excess == pytest.approx(0.58 / moved.phi_c**1.5, rel=3e-3)
 
 
+@pytest.mark.analytic
 def test_viscosity_law_and_rdf_share_the_jamming_point() -> None:
     law = CoordinationJamming(mu_scale=0.3)
     visc = at_jamming(ViscosityDivergenceLaw(), 0.5, law)
@@ -175,6 +188,7 @@ def test_viscosity_law_and_rdf_share_the_jamming_point() -> None:
     assert _log_slope(visc.factor, visc.phi_c, 1e-7) == pytest.approx(-(visc.beta - 1.0), rel=1e-6)
 
 
+@pytest.mark.contract
 def test_at_jamming_refuses_parts_without_a_divergence_and_freezing_above_phi_j() -> None:
     from ktgf.closures.rdf import CarnahanStarling
 
@@ -186,6 +200,7 @@ def test_at_jamming_refuses_parts_without_a_divergence_and_freezing_above_phi_j(
         at_jamming(ViscosityDivergenceLaw(), -0.1)
 
 
+@pytest.mark.contract
 def test_check_below_jamming_names_phi_j_in_one_line() -> None:
     law = CoordinationJamming()
     check_below_jamming(np.array([0.3, 0.55]), 0.5, law)

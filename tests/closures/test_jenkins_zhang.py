@@ -32,6 +32,7 @@ def sedfoam_f_mu(e: float, mu: float) -> tuple[float, float]:
     return 1.0 / 2 * (a1 - a2 * b1 / b2), b1 / b2
 
 
+@pytest.mark.published
 @pytest.mark.parametrize("e", [0.7, 0.9, 0.99])
 @pytest.mark.parametrize("mu", [0.01, 0.1, 0.5, 2.0])
 def test_effective_restitution_is_the_coded_one(e, mu) -> None:
@@ -40,12 +41,14 @@ def test_effective_restitution_is_the_coded_one(e, mu) -> None:
     assert JZ.rotational_ratio(e, mu) == pytest.approx(ratio, rel=1e-14)
 
 
+@pytest.mark.analytic
 def test_frictionless_is_the_normal_restitution() -> None:
     for e in (0.5, 0.9):
         assert JZ.effective_restitution(e, 0.0) == e
         assert JZ.rotational_ratio(e, 0.0) == 0.0
 
 
+@pytest.mark.analytic
 def test_limits_of_the_closed_form() -> None:
     for e in (0.7, 1.0):
         mu = 1e-7
@@ -62,6 +65,7 @@ def test_limits_of_the_closed_form() -> None:
         4 * (1 / 343) / (0.4 - 1 / 7), rel=1e-4)  # the energy that rotation returns, absent from the closed form
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("beta0", [1e-12, 1.0])
 def test_walton_average_meets_the_closed_form_for_nearly_elastic_weak_friction(beta0) -> None:
     walton = WaltonRestitution(beta0=beta0)
@@ -78,6 +82,7 @@ def test_walton_average_meets_the_closed_form_for_nearly_elastic_weak_friction(b
     assert np.all((ratios > 2.0) & (ratios < 4.5))
 
 
+@pytest.mark.analytic
 def test_jax_derivative() -> None:
     jax = pytest.importorskip("jax")
     jax.config.update("jax_enable_x64", True)

@@ -30,6 +30,7 @@ def _first_integral_error(ds):
 
 # Frictionless models: `frictional` (stress ratio 0.6-0.7 in dense flow, above tan 19° = 0.34) has
 # no steady layer found at this angle (Newton and pseudo-transient both fail; docs/chute.md).
+@pytest.mark.analytic
 @pytest.mark.parametrize("model", [m.name for m in list_models() if m.friction.key == "none"])
 def test_column_carries_its_weight(model):
     """Base traction = ρ_s g sin ζ × solid depth, p(0) − p(H) = ρ_s g cos ζ × solid depth, energy closes."""
@@ -44,6 +45,7 @@ def test_column_carries_its_weight(model):
     assert _first_integral_error(ds) < 0.03  # τ/(p − p(H)) = tan ζ, to the O(h²) error of 32 cells
 
 
+@pytest.mark.analytic
 def test_first_integral_and_fields_converge_at_second_order():
     """τ/(p − p(H)) → tan ζ pointwise, and u, θ, φ converge at second order on nested grids (RET)."""
     runs = {n: _layer("ret", n) for n in (16, 32, 64, 128)}
@@ -56,6 +58,7 @@ def test_first_integral_and_fields_converge_at_second_order():
         assert math.log2(e[0] / e[1]) > 1.7, (name, e)
 
 
+@pytest.mark.contract
 def test_bad_inputs_name_the_field():
     with pytest.raises(InputError, match="angle_deg"):
         InclinedLayer(0.03, 90.0)
@@ -67,6 +70,7 @@ def test_bad_inputs_name_the_field():
         build_chute("ret", InclinedLayer(0.03, 20.0), 1.2, MAT)
 
 
+@pytest.mark.analytic
 def test_chute_jacobian_matches_directional_derivatives():
     """The coloured Jacobian also sees the body force and the difference form of the normal balance."""
     pr = build_chute("proposed", InclinedLayer(0.03, 20.0), 0.3, MAT, n_cells=24)
@@ -79,6 +83,7 @@ def test_chute_jacobian_matches_directional_derivatives():
         np.testing.assert_allclose(J @ v, fd, rtol=1e-4, atol=1e-6 * np.abs(fd).max())
 
 
+@pytest.mark.contract
 def test_cli_writes_the_layer_and_refuses_bad_input(tmp_path):
     """``ktgf chute`` writes a netCDF whose base traction is the weight; a bad angle exits 2 with the field named."""
     import xarray as xr
@@ -100,6 +105,7 @@ def test_cli_writes_the_layer_and_refuses_bad_input(tmp_path):
     assert bad.exit_code == 2 and "angle_deg" in bad.output
 
 
+@pytest.mark.analytic
 def test_deep_layers_approach_bagnold_scaling():
     """u(H) ∝ H^{3/2} in deep layers (uniform-shear interior, docs/chute.md): the local exponent
     d ln u(H)/d ln H of RET falls towards 3/2 with depth (1.64 at 30 d, within 0.01 of 1.5 beyond 90 d).

@@ -40,6 +40,7 @@ def _root(mu):
     return cbrt(mu / 2.0 + s) + cbrt(mu / 2.0 - s)
 
 
+@pytest.mark.analytic
 def test_follows_an_s_curve_through_both_folds():
     """μ = 8λ − 4: from the lower branch at λ = 0 to the upper one at λ = 1, through the folds at λ = 3/4 and 1/4."""
     family = lambda lam: _Cubic(8.0 * lam - 4.0)  # noqa: E731
@@ -52,6 +53,7 @@ def test_follows_an_s_curve_through_both_folds():
     assert any(-0.9 < X[0] < 0.9 for X in path.X)
 
 
+@pytest.mark.analytic
 def test_says_when_the_curve_turns_back():
     """x² = 1/2 − λ has no solution beyond the fold at λ = 1/2: the path comes back and says so."""
 
@@ -76,6 +78,7 @@ def _dem_cell(spec, n_cells):
                          Material(1.0, 6 / math.pi, 0.7), n_cells, 1.5)
 
 
+@pytest.mark.contract
 def test_dem_cell_e07_converges_and_its_continuation_passes_the_folds():
     """A case natural-parameter continuation stalled on (docs/dense.md §5.2).
 
@@ -100,6 +103,7 @@ def test_dem_cell_e07_converges_and_its_continuation_passes_the_folds():
         assert np.abs(Xc - X).max() < 1e-9 * np.abs(X).max()
 
 
+@pytest.mark.regression
 def test_unjammed_branch_ends_at_a_fold_in_specularity():
     """At mean φ 0.5 the unjammed solution (spec 0.245) folds back near spec 0.232 onto a near-jammed branch.
 
@@ -118,6 +122,7 @@ def test_unjammed_branch_ends_at_a_fold_in_specularity():
     assert pr0.unpack(X0)[2].max() < 0.99 * 0.64 < pr0.unpack(back)[2].max()
 
 
+@pytest.mark.regression
 @pytest.mark.slow
 def test_dem_cell_e07_every_specularity_converges():
     """All 12 specularities 0.16–0.245 at 200 cells converge; below the fold only a jammed plug exists.

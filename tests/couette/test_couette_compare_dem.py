@@ -22,6 +22,9 @@ runner = CliRunner()
 CELLS = "60"
 
 
+pytestmark = pytest.mark.contract
+
+
 @pytest.fixture
 def dem(data_dir):
     return data_dir / "dem_couette_e0.9_phi0.50.csv"

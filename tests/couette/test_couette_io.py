@@ -36,6 +36,7 @@ def _with(path: str, value):
     return data
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(
     "path,value,words",
     [
@@ -55,6 +56,7 @@ def test_bad_config_names_the_field(path, value, words):
         assert w in str(exc.value)
 
 
+@pytest.mark.contract
 def test_inventory_above_the_models_packing_limit():
     data = _with("model", "visc-div")
     data["mean_solid_fraction"] = 0.645  # above Torquato's χ limit 0.64
@@ -68,6 +70,7 @@ def test_inventory_above_the_models_packing_limit():
     parse_config(data)
 
 
+@pytest.mark.contract
 def test_bad_input_to_library_functions():
     with pytest.raises(InputError, match="gap"):
         PlanarCell(-0.01, 1.0)
@@ -81,6 +84,7 @@ def test_bad_input_to_library_functions():
         run("visc-div", PlanarCell(0.02, 1.0), Wall(), Wall(), 0.66, Material(1e-3, 2500.0, 0.9))
 
 
+@pytest.mark.contract
 def test_run_config_dataset_contents(tmp_path):
     cfg = load_config(EXAMPLE)
     ds = run_config(cfg)
@@ -99,6 +103,7 @@ def test_run_config_dataset_contents(tmp_path):
     assert back.attrs["validity"] == ds.attrs["validity"]
 
 
+@pytest.mark.contract
 def test_runs_above_random_close_packing_are_flagged():
     """Enskog (CS χ) in a 20 d cell at mean φ 0.56 overshoots φ_rcp = 0.64 in the core (model.md §9)."""
     wall = Wall(specularity=0.1, restitution=0.9)
@@ -109,6 +114,7 @@ def test_runs_above_random_close_packing_are_flagged():
     assert ds2.attrs["physically_valid"] == 1
 
 
+@pytest.mark.contract
 def test_failure_raises_convergence_error_with_history_and_saved_iterate(tmp_path):
     """With an iteration budget too small for this case the run stops with a diagnosis, not a traceback."""
     wall = Wall(specularity=1e-3, restitution=0.9)
@@ -125,6 +131,7 @@ def test_failure_raises_convergence_error_with_history_and_saved_iterate(tmp_pat
 runner = CliRunner()
 
 
+@pytest.mark.contract
 def test_cli_run_and_bad_config(tmp_path):
     out = tmp_path / "run.nc"
     r = runner.invoke(app, ["couette", "run", str(EXAMPLE), "-o", str(out), "--format", "json"])
@@ -137,6 +144,7 @@ def test_cli_run_and_bad_config(tmp_path):
     assert "geometry.gap" in r.output and "Traceback" not in r.output
 
 
+@pytest.mark.contract
 def test_cli_sweep_through_executor(tmp_path):
     cfg = tmp_path / "c.toml"
     cfg.write_text(EXAMPLE.read_text().replace("n_cells = 200", "n_cells = 60"))
@@ -158,6 +166,7 @@ def dem_file(data_dir: Path) -> Path:
     return data_dir / "dem_couette_e0.9_phi0.50.csv"
 
 
+@pytest.mark.dem
 def test_dem_couette_calibrated_ret_profile(dem_file):
     """RET with the specularity fitted to the DEM slip (one number) predicts the DEM profiles (physical validation).
 
@@ -173,6 +182,7 @@ def test_dem_couette_calibrated_ret_profile(dem_file):
     assert r["rms_u/U"] < 0.02 and r["rms_phi"] < 0.05 and r["rms_sqrt(theta)/U"] < 0.01
 
 
+@pytest.mark.contract
 @pytest.mark.slow
 def test_cli_compare_four_models_with_dem(tmp_path, dem_file):
     dem = dem_file
@@ -182,6 +192,7 @@ def test_cli_compare_four_models_with_dem(tmp_path, dem_file):
     assert out.exists()
 
 
+@pytest.mark.dem
 def test_uniform_shear_closed_forms_against_dem_uniform_shear(data_dir):
     """dem_uniform_shear.csv (Lees–Edwards DEM, e = 0.9): at φ = 0.3 every model is within 10 % in T, η*, p*
     (physical validation; at φ = 0.5 the models underpredict p* and η* by 11–22 %, reported, not asserted)."""
@@ -197,6 +208,7 @@ def test_uniform_shear_closed_forms_against_dem_uniform_shear(data_dir):
             assert abs(r["dT"]) < 0.1 and abs(r["deta*"]) < 0.1 and abs(r["dp*"]) < 0.1, r
 
 
+@pytest.mark.analytic
 def test_annular_example_config_torque_is_uniform():
     cfg = load_config(ROOT / "examples" / "couette_annular.toml")
     ds = run_config(cfg)

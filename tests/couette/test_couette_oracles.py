@@ -24,6 +24,7 @@ D, RHO = 1e-3, 2500.0
 NO_SLIP_ADIABATIC = Wall.of_type("no-slip-adiabatic")
 
 
+@pytest.mark.published
 @pytest.mark.parametrize("phi,e,a,ratio,temp", USF_TABLE)
 def test_uniform_shear_closed_forms_match_oracle_table(phi, e, a, ratio, temp):
     r = steady_shear(get_model("ret"), phi, e)
@@ -32,6 +33,7 @@ def test_uniform_shear_closed_forms_match_oracle_table(phi, e, a, ratio, temp):
     assert float(r.T) == pytest.approx(temp, rel=3e-5)
 
 
+@pytest.mark.published
 @pytest.mark.parametrize("phi,e,a,ratio,temp", USF_TABLE)
 def test_solver_between_no_slip_adiabatic_walls_is_uniform_shear(phi, e, a, ratio, temp):
     """Adiabatic no-slip walls admit exactly the uniform state: the solver must find the oracle θ."""
@@ -46,6 +48,7 @@ def test_solver_between_no_slip_adiabatic_walls_is_uniform_shear(phi, e, a, rati
     np.testing.assert_allclose(gdot / nu0, a, rtol=3e-5)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", PAPER_MODELS)
 def test_uniform_shear_every_model(name):
     """Same check for every model against the closed form evaluated from its coefficients."""
@@ -61,6 +64,7 @@ def _jj_case(name="ret", n_cells=200, stretch=1.5, mean_phi=0.4, geometry=None, 
     return run(name, geometry, wall, wall, mean_phi, Material(D, RHO, 0.9), n_cells=n_cells, stretch=stretch)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize(
     "geometry,heat_flux",
     [(PlanarCell(0.02, 1.0), "total"), (AnnularCell(0.2, 0.22, 5.0), "total"), (PlanarCell(0.02, 1.0), "conductive")],
@@ -83,6 +87,7 @@ def test_mesh_refinement_second_order(geometry, heat_flux):
         assert o[-1] == pytest.approx(2.0, abs=0.15), (var, o)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", PAPER_MODELS)
 @pytest.mark.parametrize("geometry", [PlanarCell(0.02, 1.0), AnnularCell(0.2, 0.22, 5.0)], ids=["planar", "annular"])
 def test_conservation_wall_stress_equals_bulk_and_energy_budget(name, geometry):
@@ -101,6 +106,7 @@ def test_conservation_wall_stress_equals_bulk_and_energy_budget(name, geometry):
     assert np.max(np.abs(tau_bulk[5:-5] / wall[0] - 1)) < 2e-2
 
 
+@pytest.mark.analytic
 def test_annular_cell_tends_to_planar_cell_when_the_radius_grows():
     """R_i → ∞ at fixed gap: the annular profile (shifted by U/2) approaches the planar one, error ∝ H/R."""
     H, U = 0.01, 1.0
@@ -117,6 +123,7 @@ def test_annular_cell_tends_to_planar_cell_when_the_radius_grows():
     assert errs[1] / errs[2] == pytest.approx(2.0, rel=0.1)
 
 
+@pytest.mark.analytic
 def test_annular_radial_balance():
     """dp/dr = ρ_s φ u²/r (model.md §9) holds to discretisation accuracy in a fast annular cell."""
     ds = _jj_case(geometry=AnnularCell(0.02, 0.04, 60.0), n_cells=200)
@@ -135,6 +142,7 @@ def _local_exponent(model, phi):
     return 2 * dln_eta * phi * r1.p / r1.C - 1
 
 
+@pytest.mark.analytic
 def test_visc_div_dense_layer_scaling():
     """Visc.div.: across the dense shear band √θ ∝ γ̇^(1/(2β−1)); the exponent tends to 1/(2β−1) = 0.4 as φ → φ_c.
 

@@ -20,6 +20,7 @@ def _problem(name="ret", mean_phi=0.45, e=0.8, spec=0.2, geometry=None, n=40, wa
     return Problem(get_model(name), g, bottom, top, mean_phi, e, stretched_nodes(x0, x1, n, 1.5), v_scale=1.0)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("heat_flux", ["total", "conductive"])
 @pytest.mark.parametrize("geometry", [PlanarCell(20.0, 1.0), AnnularCell(30.0, 50.0, 1 / 30.0)], ids=["planar", "annular"])
 @pytest.mark.parametrize("name", PAPER_MODELS)
@@ -37,12 +38,14 @@ def test_coloured_jacobian_matches_directional_derivatives(name, geometry, heat_
         np.testing.assert_allclose(J @ v, fd, rtol=1e-4, atol=1e-6 * np.abs(fd).max())
 
 
+@pytest.mark.analytic
 def test_phi_transform_round_trip_and_bounds():
     phi = np.array([1e-6, 0.1, 0.5, 0.6399999])
     np.testing.assert_allclose(phi_from_psi(psi_from_phi(phi, 0.64), 0.64), phi, rtol=1e-9)
     assert np.all(phi_from_psi(np.array([-800.0, 800.0]), 0.64) <= 0.64)
 
 
+@pytest.mark.analytic
 def test_independent_walls_mixed_conditions():
     """Bottom JJ wall, top wall with prescribed no-slip and temperature: conditions hold where imposed."""
     top = Wall(momentum="prescribed", energy="prescribed", temperature=0.001)
@@ -61,6 +64,7 @@ CORNERS = [
 ]
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("name,mean_phi,e,spec", CORNERS)
 def test_converges_from_naive_start_at_corners(name, mean_phi, e, spec):
     pr = _problem(name, mean_phi, e, spec, n=200)
@@ -71,6 +75,7 @@ def test_converges_from_naive_start_at_corners(name, mean_phi, e, spec):
     assert pr.V @ phi / pr.V.sum() == pytest.approx(mean_phi, abs=1e-10)
 
 
+@pytest.mark.contract
 @pytest.mark.slow
 @pytest.mark.parametrize("name", PAPER_MODELS)
 @pytest.mark.parametrize("e", [0.7, 0.9, 0.99])
@@ -96,6 +101,7 @@ def test_converges_over_the_practical_range(name, e):
 KNOWN_FAILURES_E05 = {("visc-div", 0.62, 1e-3), ("visc-div", 0.62, 0.1)}
 
 
+@pytest.mark.contract
 @pytest.mark.slow
 @pytest.mark.parametrize("name", PAPER_MODELS)
 @pytest.mark.parametrize("mean_phi", [0.1, 0.3, 0.5, 0.62])
@@ -108,6 +114,7 @@ def test_converges_at_strong_inelasticity(name, mean_phi, spec, request):
     assert info["residual"] < 1e-8
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", ["enskog", "ret"])
 def test_literal_jj_heat_flux_option(name):
     """heat_flux="conductive" imposes JJ on κ∂θ/∂n literally; identical to "total" when ω = 0 (Enskog)."""

@@ -21,6 +21,7 @@ def _problem(model, mean_phi=0.5, e=0.9, spec=0.13, n=40):
     return Problem(model, g, w, w, mean_phi, e, stretched_nodes(x0, x1, n, 1.5), v_scale=10.0)
 
 
+@pytest.mark.analytic
 def test_ekt_with_negligible_length_is_the_standard_residual():
     """c → 0 makes L = d everywhere: the residual is the standard theory's, bit for bit."""
     base = _problem(get_model("dense", dissipation="none"))
@@ -29,6 +30,7 @@ def test_ekt_with_negligible_length_is_the_standard_residual():
     np.testing.assert_array_equal(base.residual(X), tiny.residual(X))
 
 
+@pytest.mark.analytic
 def test_ekt_reduces_the_dissipation_source_by_d_over_l():
     """γ = (3/2)φθζ0 at the nodes is divided by L/d = max(1, Λ s), s = |du/dy|/√θ (planar cell)."""
     base = _problem(get_model("dense", dissipation="none"), n=60)
@@ -45,6 +47,7 @@ def test_ekt_reduces_the_dissipation_source_by_d_over_l():
     np.testing.assert_allclose(t1["gamma"], t0["gamma"] / length, rtol=1e-12)
 
 
+@pytest.mark.analytic
 def test_ekt_jacobian_matches_directional_derivatives():
     pr = _problem(get_model("dense", c=2.0))
     rng = np.random.default_rng(2)
@@ -62,6 +65,7 @@ def test_ekt_jacobian_matches_directional_derivatives():
 # φ_f); the arclength fallback passes it (docs/dense.md §5.2, tests/couette/test_couette_arclength.py).  The solution
 # it reaches is a jammed plug: below specularity ≈ 0.232 the model has no unjammed solution, and the run's
 # validity flag says so.
+@pytest.mark.contract
 @pytest.mark.slow
 def test_visc_div_dem_cell_at_e07_converges_to_a_flagged_jammed_plug():
     from ktgf.couette.run import Material, run

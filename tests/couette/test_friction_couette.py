@@ -32,6 +32,7 @@ def _problem(mu, mean_phi, stress="schaeffer", eps=1e-3, n=80, e=0.7):
     return frictional_wall_problem(mu, mean_phi, 0.0, stress, eps, n, e)
 
 
+@pytest.mark.analytic
 def test_frictional_terms_are_the_closures():
     """At a (non-solution) state the shear flux is (η + μ_f) γ̇ with Schaeffer's μ_f, and p includes w p_f."""
     pr = _problem(0.5, 0.52)
@@ -51,6 +52,7 @@ def test_frictional_terms_are_the_closures():
     assert np.any(t["p_frictional"] > 0)  # the state reaches above φ_min = 0.5
 
 
+@pytest.mark.analytic
 def test_jacobian_with_the_frictional_stress_matches_directional_derivatives():
     for stress in ("schaeffer", "srivastava-sundaresan"):
         pr = _problem(0.25, 0.5, stress=stress, n=30)
@@ -63,6 +65,7 @@ def test_jacobian_with_the_frictional_stress_matches_directional_derivatives():
         np.testing.assert_allclose(J @ v, fd, rtol=1e-4, atol=1e-6 * np.abs(fd).max())
 
 
+@pytest.mark.contract
 def test_a_model_with_a_frictional_stress_needs_the_stress_scale():
     g = PlanarCell(20.0, 1.0)
     w = Wall()
@@ -71,6 +74,7 @@ def test_a_model_with_a_frictional_stress_needs_the_stress_scale():
 
 
 # cheap points of the convergence map (docs/friction.md §8): Newton from the naive start, < 1 s each
+@pytest.mark.contract
 @pytest.mark.parametrize("mu,mean_phi,stress", [(0.0, 0.3, "schaeffer"), (0.5, 0.5, "schaeffer"),
                                                  (0.25, 0.4, "srivastava-sundaresan")])
 def test_converges_from_a_naive_start(mu, mean_phi, stress):
@@ -83,6 +87,7 @@ def test_converges_from_a_naive_start(mu, mean_phi, stress):
     assert np.ptp(F) < 1e-8 * np.abs(F).max()  # the shear stress (kinetic + frictional) is uniform
 
 
+@pytest.mark.analytic
 def test_energy_budget_closes_with_the_frictional_work(tmp_path):
     """Wall power = collisional dissipation + frictional work + slip work (the frictional work does not feed θ)."""
     model = get_model("frictional", mu=0.5, stress="schaeffer")
@@ -117,12 +122,14 @@ def _halving(mu, mean_phi, eps):
     return c["du"], c["dphi"], c["dlnt"], c["dtau"]
 
 
+@pytest.mark.analytic
 def test_halving_the_regularisation_does_not_change_a_sheared_profile():
     """Sheared everywhere (μ = 0.5, φ̄ = 0.5: min γ̇ = 0.4 U/H): the change is O(ε²), below 1e-4 at ε = 1e-3."""
     du, dphi, dlnt, dtau = _halving(0.5, 0.5, 1e-3)
     assert du < 1e-4 and dphi < 1e-5 and dlnt < 1e-3 and dtau < 2e-4
 
 
+@pytest.mark.analytic
 def test_halving_the_regularisation_with_a_creeping_plug():
     """μ = 0, φ̄ = 0.5: a creeping core (γ̇ ~ ε U/H) where the frictional stress dominates.  The change is O(ε):
     velocity 1e-3 U, φ 1e-4, wall stress 0.4 %, the temperature of the core ~1 % at ε = 1e-3 (docs/friction.md §8)."""
@@ -130,6 +137,7 @@ def test_halving_the_regularisation_with_a_creeping_plug():
     assert du < 1.5e-3 and dphi < 1e-4 and dlnt < 1e-2 and dtau < 4e-3
 
 
+@pytest.mark.contract
 @pytest.mark.slow
 def test_convergence_map_from_a_naive_start():
     """Mean φ 0.3–0.6 × μ 0–0.5 × {no, Schaeffer, Srivastava–Sundaresan} frictional stress: every state below φ_c(μ)

@@ -47,6 +47,7 @@ def check_wall_conditions(pr, X, tol=1e-8):
     return t, ds
 
 
+@pytest.mark.analytic
 def test_frictional_wall_case_converges_from_the_naive_start_and_meets_its_wall_conditions():
     """μ = 0.5, φ̄ = 0.55, Schaeffer, δ_w = 25°: Newton fails from the naive start; the solver continues tan δ_w from
     the δ_w = 0 solution (3 s at load 6; 24–46 s by its generic homotopies, same solution to 1e-12)."""
@@ -63,6 +64,7 @@ def test_frictional_wall_case_converges_from_the_naive_start_and_meets_its_wall_
     assert time.perf_counter() - t0 < 60.0  # generous bound for a loaded machine (measured 3 s at load 6)
 
 
+@pytest.mark.analytic
 def test_a_wall_rougher_than_the_bulk_sticks_with_a_slip_set_by_the_regularisation():
     """μ = 0, φ̄ = 0.6, Srivastava–Sundaresan, δ_w = 30°: p_f tan δ_w at the wall exceeds the traction the medium
     transmits, so the wall sticks (Coulomb: no sliding below the friction limit); the regularised slip is then
@@ -77,6 +79,7 @@ def test_a_wall_rougher_than_the_bulk_sticks_with_a_slip_set_by_the_regularisati
     assert c["du"] < 1.5e-3 and c["dphi"] < 1e-4 and c["dtau"] < 4e-3
 
 
+@pytest.mark.analytic
 def test_halving_the_regularisation_with_a_sliding_frictional_wall():
     """μ = 0.5, φ̄ = 0.55, Schaeffer, δ_w = 25° (sliding, u_sl ≈ 0.27 U, creeping core): ε and ε_w halved together
     change the profiles by O(ε), within the §8 tolerance of the default (measured 8.7e-4, 5.6e-5, 5.1e-4)."""
@@ -84,6 +87,7 @@ def test_halving_the_regularisation_with_a_sliding_frictional_wall():
     assert c["du"] < 1.5e-3 and c["dphi"] < 1e-4 and c["dtau"] < 4e-3
 
 
+@pytest.mark.contract
 def test_an_inventory_above_the_jamming_fraction_is_refused_in_one_line():
     phi_j = get_model("frictional", mu=0.5).phi_max  # φ_J(0.5) of the model's jamming law
     with pytest.raises(InputError, match=rf"mean_phi = 0.6 is out of range: valid 0 < mean_phi < {phi_j:.6g} .*no steady state") as e:
@@ -91,6 +95,7 @@ def test_an_inventory_above_the_jamming_fraction_is_refused_in_one_line():
     assert "\n" not in str(e.value)
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_frictional_wall_map_from_a_naive_start():
     """Schaeffer and Srivastava–Sundaresan × μ {0, 0.25, 0.5} × δ_w {15°, 25°, 30°} × φ̄ {0.3, 0.4, 0.5, 0.55, 0.6}:
@@ -120,6 +125,7 @@ def test_frictional_wall_map_from_a_naive_start():
     assert len(refused) == 12  # φ̄ = 0.6 at μ = 0.25 and 0.5, both stresses, three angles
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_the_solution_curve_approaches_the_jamming_fraction_without_a_fold():
     """μ = 0.5, δ_w = 25°, Srivastava–Sundaresan: continuing φ̄ towards φ_c = 0.565 the wall pressure rises
@@ -157,6 +163,7 @@ n_cells = 80
 """
 
 
+@pytest.mark.contract
 def test_cli_sets_particle_and_wall_friction(tmp_path):
     """``ktgf couette run --mu 0.5 --wall-friction-angle 25``: the naive start converges; the file records δ_w and μ."""
     import json
@@ -181,6 +188,7 @@ def test_cli_sets_particle_and_wall_friction(tmp_path):
     assert json.loads(ds.attrs["solver_state"])["path"].startswith("delta_w-continuation")
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("args,words", [
     (["--wall-friction-angle", "90"], ["--wall-friction-angle = 90", "< 90"]),
     (["--wall-friction-angle", "-5"], ["--wall-friction-angle = -5", "0 <="]),
@@ -200,6 +208,7 @@ def test_cli_bad_friction_is_a_one_line_error(tmp_path, args, words):
     assert len(msg.splitlines()) == 1, msg
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_a_wall_rougher_than_the_bulk_has_a_stuck_and_a_sliding_state():
     """Schaeffer, μ = 0.25, φ̄ = 0.55, δ_w = 30° (tan δ_w > sin φ_fr: the wall can hold more than the bulk yields):

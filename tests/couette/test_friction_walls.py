@@ -30,6 +30,7 @@ def _problem(wall, mean_phi=0.5, n=80, **options):
     return Problem(model, g, wall, wall, mean_phi, 0.7, stretched_nodes(x0, x1, n, 1.5), v_scale=1.0, stress_scale=SCALE)
 
 
+@pytest.mark.analytic
 def test_frictional_wall_stress_formula_and_limits():
     wall = Wall(friction_angle=30.0)
     slip = np.array([-2.0, -1e-9, 0.0, 1e-9, 2.0])
@@ -39,6 +40,7 @@ def test_frictional_wall_stress_formula_and_limits():
     assert np.all(jj_frictional_wall_stress(Wall(), 3.0, slip, 1e-4) == 0.0)  # δ_w = 0: nothing
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("angle", [-1.0, 90.0, 120.0, float("nan")])
 def test_wall_friction_angle_out_of_range_is_a_one_line_error(angle):
     with pytest.raises(InputError, match="friction_angle") as info:
@@ -46,11 +48,13 @@ def test_wall_friction_angle_out_of_range_is_a_one_line_error(angle):
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.contract
 def test_wall_friction_needs_a_frictional_stress():
     with pytest.raises(InputError, match="bottom wall friction_angle = 20"):
         _problem(Wall(friction_angle=20.0), stress="none", jj_phi_min=0.5)
 
 
+@pytest.mark.analytic
 def test_zero_wall_friction_is_the_present_wall_exactly():
     base = _problem(Wall(specularity=0.2, restitution=0.85))
     zero = _problem(Wall(specularity=0.2, restitution=0.85, friction_angle=0.0))
@@ -58,6 +62,7 @@ def test_zero_wall_friction_is_the_present_wall_exactly():
     assert np.array_equal(base.residual(X), zero.residual(X))
 
 
+@pytest.mark.analytic
 def test_converged_wall_traction_is_collisional_plus_frictional_and_slip_drops():
     """μ = 0.5, φ̄ = 0.55 (p_f > 0 at the walls): the shear flux at the wall face equals c u_sl + p_f tan δ_w.
 

@@ -15,6 +15,9 @@ from ktgf.couette.run import validity
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "couette_planar.toml"
 
 
+pytestmark = pytest.mark.contract
+
+
 def _run(model: str, mean_phi: float):
     data = copy.deepcopy(tomllib.loads(EXAMPLE.read_text()))
     data.update(model=model, mean_solid_fraction=mean_phi)

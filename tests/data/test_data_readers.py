@@ -12,6 +12,7 @@ from ktgf.data import read_couette, read_data, read_uniform_shear
 from ktgf.errors import InputError
 
 
+@pytest.mark.regression
 def test_shared_uniform_shear_file(data_dir):
     d = read_data(data_dir / "dem_uniform_shear.csv")
     assert d.kind == "uniform-shear"
@@ -21,6 +22,7 @@ def test_shared_uniform_shear_file(data_dir):
     assert len(d.labels) == 6
 
 
+@pytest.mark.regression
 def test_friction_file_keeps_only_frictionless_rows(data_dir):
     d = read_uniform_shear(data_dir / "dem_uniform_shear_friction.csv")
     np.testing.assert_array_equal(d.phi, [0.5])
@@ -29,6 +31,7 @@ def test_friction_file_keeps_only_frictionless_rows(data_dir):
     assert "2 frictional row(s)" in d.notes[0]
 
 
+@pytest.mark.regression
 def test_shared_couette_file_case_from_header(data_dir):
     d = read_couette(data_dir / "dem_couette_e0.9_phi0.50.csv")
     c = d.case
@@ -47,12 +50,14 @@ def test_shared_couette_file_case_from_header(data_dir):
     assert sem[-9.25] == 0.00944467
 
 
+@pytest.mark.contract
 def test_modified_header_gives_another_case(data_dir, tmp_path):
     f = with_header(data_dir / "dem_couette_e0.9_phi0.50.csv", tmp_path / "c.csv", couette_header(e=0.8, phi=0.45, H=16.0, U=6.0))
     c = read_couette(f).case
     assert (c.e, c.mean_phi, c.gap, c.wall_speed) == (0.8, 0.45, 15.0, 6.0)
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("field", ["e", "mean_phi", "H", "U", "tau", "p_yy", "units"])
 def test_couette_header_missing_field_is_one_line_error(data_dir, tmp_path, field):
     f = with_header(data_dir / "dem_couette_e0.9_phi0.50.csv", tmp_path / "c.csv", couette_header(drop=field))
@@ -67,6 +72,7 @@ def _shear(tmp_path, **kw):
     return write_uniform_shear(tmp_path / "s.csv", [0.3, 0.5], [0.9, 0.9], [1.0, 0.9], [3.0, 20.0], [4.0, 14.0], **kw)
 
 
+@pytest.mark.contract
 def test_uniform_shear_missing_column(tmp_path):
     f = _shear(tmp_path)
     f.write_text(f.read_text().replace("dp_over_nT", "dp_nT"))
@@ -74,6 +80,7 @@ def test_uniform_shear_missing_column(tmp_path):
         read_data(f)
 
 
+@pytest.mark.contract
 def test_uniform_shear_nan(tmp_path):
     f = _shear(tmp_path)
     lines = f.read_text().splitlines()
@@ -84,6 +91,7 @@ def test_uniform_shear_nan(tmp_path):
         read_data(f)
 
 
+@pytest.mark.contract
 def test_uniform_shear_units_mismatch(tmp_path):
     f = _shear(tmp_path, header="# units d = 1 mm, m = 1 g; shear rate gdot = 1\n")
     with pytest.raises(InputError, match="do not match the shared format"):
@@ -93,6 +101,7 @@ def test_uniform_shear_units_mismatch(tmp_path):
         read_data(g)
 
 
+@pytest.mark.contract
 def test_missing_file(tmp_path):
     with pytest.raises(InputError, match="does not exist"):
         read_data(tmp_path / "nope.csv")

@@ -16,6 +16,7 @@ from ktgf.errors import InputError
 SHARED = Path(__file__).resolve().parents[3] / "shared" / "data"
 
 
+@pytest.mark.regression
 def test_every_shipped_file_is_read_by_its_reader() -> None:
     """Regression (format): each file of the shared formats parses, with the rows its README lists."""
     assert list(read_uniform_shear(shipped(UNIFORM_SHEAR)).phi) == [0.3, 0.5]
@@ -31,6 +32,7 @@ def test_every_shipped_file_is_read_by_its_reader() -> None:
         assert name.split(".csv")[0].split("_extra")[0] in readme
 
 
+@pytest.mark.contract
 def test_shipped_copies_are_those_of_shared_data() -> None:
     """The package carries byte-identical copies of ``shared/data`` (copy them again when they change)."""
     if not SHARED.is_dir():  # a clone without shared/: nothing to compare the copies with
@@ -40,6 +42,7 @@ def test_shipped_copies_are_those_of_shared_data() -> None:
     assert {p.name for p in SHARED.glob("*.csv")} == set(DEM_FILES), "a new file in shared/data: ship it (ktgf.data.files)"
 
 
+@pytest.mark.contract
 def test_runs_find_the_shipped_files_unless_told_otherwise(tmp_path, monkeypatch) -> None:
     monkeypatch.delenv("KTGF_DATA", raising=False)
     found, why = locate_data_dir(None)
@@ -49,6 +52,7 @@ def test_runs_find_the_shipped_files_unless_told_otherwise(tmp_path, monkeypatch
     assert locate_data_dir(tmp_path / "absent")[0] is None  # an explicit folder that is not there: said, not raised
 
 
+@pytest.mark.contract
 def test_one_parser_gives_one_line_errors(tmp_path) -> None:
     bad = tmp_path / "bad.csv"
     bad.write_text("# units d = m = 1, gdot = 1\nphi,e,T\n0.3,0.9\n")
@@ -61,6 +65,7 @@ def test_one_parser_gives_one_line_errors(tmp_path) -> None:
         read_friction_shear(tmp_path / "c.csv")
 
 
+@pytest.mark.contract
 def test_a_shipped_file_is_read_by_its_bare_name(tmp_path, monkeypatch) -> None:
     """``--data dem_uniform_shear.csv`` works from any folder; a file of that name in the folder wins."""
     monkeypatch.chdir(tmp_path)

@@ -59,6 +59,7 @@ def check_haff_after_transient(model, T, Tr, t, r_expected, rtol):
     return t0
 
 
+@pytest.mark.analytic
 def test_rough_sphere_hcs_is_haffs_law_with_the_predicted_rate():
     beta, mu = 0.4, 0.5
     model = get_model("frictional", restitution="rough-sphere", tangential_beta=beta, mu=mu)
@@ -76,6 +77,7 @@ def test_rough_sphere_hcs_is_haffs_law_with_the_predicted_rate():
     assert shear > 1.05
 
 
+@pytest.mark.analytic
 def test_walton_hcs_is_haffs_law_with_the_predicted_rate():
     mu = 0.5
     model = get_model("frictional", mu=mu)
@@ -92,6 +94,7 @@ def test_walton_hcs_is_haffs_law_with_the_predicted_rate():
     assert 1.4 < shear < 1.6
 
 
+@pytest.mark.analytic
 def test_mu_zero_is_the_frictionless_hcs_bit_for_bit():
     frictional = get_model("frictional", mu=0.0)
     smooth = frictional.replace(friction=NoFriction())
@@ -104,6 +107,7 @@ def test_mu_zero_is_the_frictionless_hcs_bit_for_bit():
     assert np.array_equal(integrate_cooling(frictional, 0.3, 0.7, THETA0, t, d=D), integrate_cooling(smooth, 0.3, 0.7, THETA0, t, d=D))
 
 
+@pytest.mark.analytic
 def test_the_correlation_length_is_inactive_in_the_hcs():
     ekt = get_model("frictional")  # with the EKT correlation length (c fitted in shear)
     plain = get_model("frictional", dissipation="none")
@@ -112,6 +116,7 @@ def test_the_correlation_length_is_inactive_in_the_hcs():
         ekt.reduced(0.5, 0.7, hcs=True, shear=1.0)
 
 
+@pytest.mark.contract
 def test_no_finite_hcs_ratio_is_a_one_line_error():
     model = get_model("frictional", mu=0.3)
     with pytest.raises(InputError) as info:
@@ -125,6 +130,7 @@ def test_no_finite_hcs_ratio_is_a_one_line_error():
         cooling_rate(get_model("frictional", restitution="chialvo-sundaresan-2013"), 0.3, 0.7, THETA0, d=D)
 
 
+@pytest.mark.contract
 def test_hcs_cli_without_a_finite_ratio_exits_2_with_one_line(tmp_path):
     from typer.testing import CliRunner
 

@@ -32,6 +32,7 @@ def _fails(args, *fragments):
     return lines[0]
 
 
+@pytest.mark.published
 def test_stability_json_matches_oracle_table():
     rows = json.loads(_ok(["hcs", "stability", "--model", "ret", "--phi", "0.1,0.3", "--e", "0.9", "--format", "json"]).stdout)
     assert [r["phi"] for r in rows] == [0.1, 0.3]
@@ -39,6 +40,7 @@ def test_stability_json_matches_oracle_table():
     assert rows[1]["L_perp/d"] == pytest.approx(12.101, abs=5e-4) and rows[1]["L_par/d"] == pytest.approx(23.987, abs=5e-4)
 
 
+@pytest.mark.published
 def test_stability_box_growth_rates_and_verdicts():
     """L = 40 d at e = 0.9: homogeneous at φ = 0.05 (L⊥ = 57.3), vortices only at φ = 0.1 (28.5 < 40 < 51.2)."""
     out = _ok(["hcs", "stability", "-m", "ret", "--phi", "0.05,0.1,0.3", "--e", "0.9", "--box", "40", "--format", "csv"]).stdout
@@ -49,6 +51,7 @@ def test_stability_box_growth_rates_and_verdicts():
         assert (float(r["s_perp"]) > 0) == (float(r["L_perp/d"]) < 40)
 
 
+@pytest.mark.analytic
 def test_stability_eig_method_agrees_and_reports_no_crossing():
     closed = json.loads(_ok(["hcs", "stability", "-m", "proposed", "--phi", "0.2:0.5:4", "--e", "0.8", "--format", "json"]).stdout)
     eig = json.loads(_ok(["hcs", "stability", "-m", "proposed", "--phi", "0.2:0.5:4", "--e", "0.8", "--format", "json",
@@ -60,6 +63,7 @@ def test_stability_eig_method_agrees_and_reports_no_crossing():
     assert list(csv.DictReader(io.StringIO(result.stdout)))[0]["k_par*"] == "inf"
 
 
+@pytest.mark.published
 def test_haff_table_netcdf_and_figure(tmp_path):
     import xarray as xr
 
@@ -74,6 +78,7 @@ def test_haff_table_netcdf_and_figure(tmp_path):
     assert (tmp_path / "haff.png").stat().st_size > 10_000
 
 
+@pytest.mark.contract
 def test_map_writes_netcdf(tmp_path):
     import xarray as xr
 
@@ -83,6 +88,7 @@ def test_map_writes_netcdf(tmp_path):
     assert ds["L_par"].shape == (4, 20, 5) and json.loads(ds.attrs["parameters"])["e"]["n"] == 5
 
 
+@pytest.mark.contract
 def test_plots(tmp_path):
     _ok(["hcs", "map", "--out", str(tmp_path / "m.nc"), "--n-phi", "30", "--n-e", "3", "--e-min", "0.7", "--e-max", "0.9"])
     _ok(["plot", "stability-map", "--from", str(tmp_path / "m.nc"), "--e", "0.9,0.7", "--out", str(tmp_path / "a.png")])
@@ -92,6 +98,7 @@ def test_plots(tmp_path):
         assert (tmp_path / name).stat().st_size > 5_000
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(
     "args,fragments",
     [
@@ -119,12 +126,14 @@ def test_bad_input_exits_2_with_one_line(args, fragments, tmp_path, monkeypatch)
     _fails(args, *fragments)
 
 
+@pytest.mark.contract
 def test_unwritable_output_is_one_line(tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("x")
     _fails(["hcs", "map", "--out", str(blocker / "map.nc"), "--n-phi", "5", "--n-e", "2"], "cannot write output file")
 
 
+@pytest.mark.contract
 def test_progress_bar_only_for_sweeps_longer_than_a_second():
     from rich.console import Console
 

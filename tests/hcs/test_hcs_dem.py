@@ -24,6 +24,9 @@ from ktgf.hcs import cooling_rate
 DEFICIT_BAND = (0.89, 1.01)  # A_DEM/A_model: 1–10 % deficit widened by the ±1 % DEM uncertainty
 
 
+pytestmark = pytest.mark.dem
+
+
 def _rows(data_dir):
     with open(data_dir / "dem_hcs_cooling.csv") as fh:
         return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(line for line in fh if not line.startswith("#"))]

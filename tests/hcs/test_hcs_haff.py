@@ -15,6 +15,7 @@ from ktgf.io import write_netcdf
 ORACLE_REL = 1e-5  # oracles.md: 6-digit values, 1e-5 relative
 
 
+@pytest.mark.published
 def test_haff_oracle_numbers_ret():
     """oracles.md 'Haff's law': d = 1, θ0 = 1, RET with CS χ."""
     assert nu0(0.1, 1.0, 1.0) == pytest.approx(1.083244, rel=ORACLE_REL)
@@ -24,6 +25,7 @@ def test_haff_oracle_numbers_ret():
     assert cooling_time("ret", 0.3, 0.7, 1.0, d=1.0) == pytest.approx(1.168402, rel=ORACLE_REL)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", PAPER_MODELS)
 @pytest.mark.parametrize("phi,e", [(0.1, 0.9), (0.3, 0.7), (0.55, 0.5)])
 def test_integrated_cooling_follows_haff(name, phi, e):
@@ -37,18 +39,21 @@ def test_integrated_cooling_follows_haff(name, phi, e):
     assert integrate_cooling(name, phi, e, theta0, [t0], d=d)[0] == pytest.approx(theta0 / 4, rel=1e-8)
 
 
+@pytest.mark.analytic
 def test_cooling_time_scales_as_inverse_sqrt_theta0_and_linear_in_d():
     t1 = cooling_time("enskog", 0.2, 0.8, 1e-2, d=1e-3)
     assert cooling_time("enskog", 0.2, 0.8, 4e-2, d=1e-3) == pytest.approx(t1 / 2, rel=1e-12)
     assert cooling_time("enskog", 0.2, 0.8, 1e-2, d=3e-3) == pytest.approx(3 * t1, rel=1e-12)
 
 
+@pytest.mark.analytic
 def test_elastic_gas_does_not_cool():
     t = np.linspace(0.0, 10.0, 5)
     np.testing.assert_allclose(integrate_cooling("ret", 0.2, 1.0, 1.0, t, d=1.0), 1.0, rtol=0, atol=1e-14)
     assert math.isinf(cooling_time("ret", 0.2, 1.0, 1.0, d=1.0))
 
 
+@pytest.mark.published
 def test_haff_history_dataset_and_netcdf(tmp_path):
     import xarray as xr
 
@@ -63,6 +68,7 @@ def test_haff_history_dataset_and_netcdf(tmp_path):
     np.testing.assert_array_equal(back["theta_numeric"].values, ds["theta_numeric"].values)
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(
     "kwargs,match",
     [

@@ -31,6 +31,7 @@ def _assert_same(a, b):
     assert list(a["model"].values) == list(b["model"].values)
 
 
+@pytest.mark.contract
 def test_map_structure_and_metadata(in_process):
     ds = in_process
     assert ds["L_perp"].dims == ("model", "phi", "e")
@@ -44,6 +45,7 @@ def test_map_structure_and_metadata(in_process):
     assert models["visc-div"]["rdf"].startswith("torquato") and "model_options" in models["ret"]
 
 
+@pytest.mark.analytic
 def test_map_values_match_the_eigenvalue_thresholds(in_process):
     """Spot checks of the vectorised closed form against root-finding on the eigenvalues."""
     for name in PAPER_MODELS:
@@ -59,6 +61,7 @@ def test_map_values_match_the_eigenvalue_thresholds(in_process):
         )
 
 
+@pytest.mark.contract
 def test_states_beyond_the_packing_limit_are_nan(in_process):
     for name in PAPER_MODELS:
         beyond = PHI >= get_model(name).phi_max
@@ -68,6 +71,7 @@ def test_states_beyond_the_packing_limit_are_nan(in_process):
     assert np.isnan(in_process["L_par"].sel(model="visc-div", phi=0.68).values).all()
 
 
+@pytest.mark.contract
 def test_chunked_with_progress_is_identical(in_process):
     calls = []
     ds = stability_map(PAPER_MODELS, PHI, E, progress=lambda done, total: calls.append((done, total)), phi_chunks=5)
@@ -75,6 +79,7 @@ def test_chunked_with_progress_is_identical(in_process):
     assert calls[-1] == (20, 20) and len(calls) == 20  # 4 models x 5 blocks
 
 
+@pytest.mark.contract
 def test_process_pool_gives_identical_results(in_process):
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
@@ -84,6 +89,7 @@ def test_process_pool_gives_identical_results(in_process):
     _assert_same(in_process, ds)
 
 
+@pytest.mark.contract
 def test_dask_local_cluster_gives_identical_results(in_process):
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cluster:
@@ -92,6 +98,7 @@ def test_dask_local_cluster_gives_identical_results(in_process):
     _assert_same(in_process, ds)
 
 
+@pytest.mark.contract
 def test_netcdf_round_trip(in_process, tmp_path):
     import xarray as xr
 
@@ -101,12 +108,14 @@ def test_netcdf_round_trip(in_process, tmp_path):
     assert list(back["model_label"].values) == ["Enskog", "RET", "Visc.div.", "Proposed"]
 
 
+@pytest.mark.analytic
 def test_unstable_everywhere_and_elastic_states_are_marked():
     ds = stability_map(["ret"], [0.1], [0.1, 1.0]).squeeze()
     assert float(ds["L_par"].sel(e=0.1)) == 0.0 and np.isinf(float(ds["k_par"].sel(e=0.1)))
     assert np.isinf(float(ds["L_perp"].sel(e=1.0))) and np.isinf(float(ds["L_par"].sel(e=1.0)))
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(
     "args,match",
     [
@@ -122,6 +131,7 @@ def test_bad_input(args, match):
         stability_map(*args)
 
 
+@pytest.mark.contract
 def test_unknown_model_is_named():
     from ktgf import UnknownModelError
 
@@ -129,6 +139,7 @@ def test_unknown_model_is_named():
         stability_map(["nope"], PHI, E)
 
 
+@pytest.mark.contract
 def test_user_model_objects_run_on_a_process_pool():
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor

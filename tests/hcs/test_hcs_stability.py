@@ -42,6 +42,7 @@ def _grid(model, n_phi=12, n_e=10, e_min=0.05):
     return phi, e
 
 
+@pytest.mark.published
 @pytest.mark.parametrize("method", ["closed", "eig"])
 def test_critical_box_oracle_table(method):
     ret = get_model("ret")
@@ -53,6 +54,7 @@ def test_critical_box_oracle_table(method):
     np.testing.assert_allclose(critical_box_size(phi, k_par), [row[3] for row in ORACLE_BOXES], rtol=0, atol=HALF_LAST_DIGIT)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", PAPER_MODELS)
 def test_root_finding_on_eigenvalues_agrees_with_closed_form(name):
     """Over a (φ, e) grid incl. strong inelasticity: the last zero of the largest growth rate is the closed form.
@@ -75,6 +77,7 @@ def test_root_finding_on_eigenvalues_agrees_with_closed_form(name):
     assert all("no crossing found" in str(w.message) for w in caught)
 
 
+@pytest.mark.analytic
 def test_unstable_at_every_wavenumber_in_strongly_inelastic_ret():
     r = get_model("ret").reduced(0.1, 0.1)
     assert r.kappa * r.C - r.mu * r.p < 0
@@ -87,6 +90,7 @@ def test_unstable_at_every_wavenumber_in_strongly_inelastic_ret():
     assert (s > 0).all() and s[1] == pytest.approx(s[0], rel=1e-3)
 
 
+@pytest.mark.analytic
 def test_elastic_gas_is_stable_at_every_size():
     r = get_model("enskog").reduced(0.2, 1.0)
     assert critical_wavenumbers_eig(r) == (0.0, 0.0)
@@ -94,6 +98,7 @@ def test_elastic_gas_is_stable_at_every_size():
     assert critical_box_size(0.2, 0.0) == np.inf
 
 
+@pytest.mark.contract
 def test_last_crossing_reports_failures_clearly():
     with pytest.raises(NoCrossingError, match="no crossing found"):
         last_crossing(lambda k: 1.0 - 0.0 * k, what="constant")
@@ -107,6 +112,7 @@ def test_last_crossing_reports_failures_clearly():
         critical_wavenumbers_eig(get_model("ret").reduced(0.1, 0.9), k_min=1.0, k_max=0.5)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", PAPER_MODELS)
 def test_small_k_limit_of_the_longitudinal_modes(name):
     """At k* → 0 the longitudinal rates are ζ0*/2 (velocity), 0 (density) and −ζ0*/2 (heat)."""
@@ -116,6 +122,7 @@ def test_small_k_limit_of_the_longitudinal_modes(name):
     np.testing.assert_allclose(s.imag, 0.0, atol=1e-14)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", PAPER_MODELS)
 def test_shear_mode_closed_form_and_zero_eigenvalue_at_threshold(name):
     """s⊥ = ζ0*/2 − η*k*²/2 vanishes at k⊥*; det M(k∥*) = 0 (a zero longitudinal eigenvalue)."""
@@ -132,6 +139,7 @@ def test_shear_mode_closed_form_and_zero_eigenvalue_at_threshold(name):
     assert below.largest_longitudinal[1] > 0 > above.largest_longitudinal[1]
 
 
+@pytest.mark.published
 @pytest.mark.parametrize("e, zeta0, kappa, mu", [(0.9, 0.078951, 1.068491, 0.115695), (0.7, 0.212552, 1.357967, 0.483735)])
 def test_dilute_limit_of_the_cluster_threshold(e, zeta0, kappa, mu):
     """φ → 0: k∥*² = 2ζ0*/(5(κ* − μ*)) with the φ = 0 RET values of oracles.md, from the eigenvalues."""
@@ -140,6 +148,7 @@ def test_dilute_limit_of_the_cluster_threshold(e, zeta0, kappa, mu):
     assert k_par**2 == pytest.approx(2 * zeta0 / (5 * (kappa - mu)), rel=2e-5)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", PAPER_MODELS)
 def test_dilute_limit_every_model(name):
     """φ → 0 for every model with its own dilute coefficients (g → 1, C → 1, p* → 1)."""
@@ -149,6 +158,7 @@ def test_dilute_limit_every_model(name):
     np.testing.assert_allclose(k_par**2, 2 * r.zeta0 / (5 * (r.kappa - r.mu)), rtol=1e-7)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", PAPER_MODELS)
 def test_vortices_appear_before_clusters_where_the_theory_says_so(name):
     """For 0.4 ≤ e < 1 and φ ≤ 0.5 every model has k⊥* > k∥*: the eigenvalue thresholds give L⊥ < L∥.
@@ -168,6 +178,7 @@ def test_vortices_appear_before_clusters_where_the_theory_says_so(name):
     np.testing.assert_array_equal(critical_box_size(phi, n_perp) < critical_box_size(phi, n_par), theory)
 
 
+@pytest.mark.analytic
 def test_order_reverses_where_the_theory_says_so():
     """RET at e = 0.3 (dilute) and Visc.div. at φ = 0.6: clusters first, L∥ < L⊥, from the eigenvalues."""
     for name, phi, e in (("ret", 0.02, 0.3), ("visc-div", 0.6, 0.9)):
@@ -175,6 +186,7 @@ def test_order_reverses_where_the_theory_says_so():
         assert critical_box_size(phi, k_par) < critical_box_size(phi, k_perp)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", PAPER_MODELS)
 def test_g_and_C_agree_with_autodiff_of_the_models_own_zeta0_and_pressure(name):
     """g = ∂ln ζ0/∂ln n (ζ0 = ν0ζ0* with ν0 ∝ φ at fixed θ) and C = ∂(φp*)/∂φ, by jax.grad."""
@@ -200,6 +212,7 @@ def test_g_and_C_agree_with_autodiff_of_the_models_own_zeta0_and_pressure(name):
         np.testing.assert_allclose(np.asarray(dphip(jnp.asarray(phis), e)), r.C, rtol=1e-12)
 
 
+@pytest.mark.contract
 def test_dispersion_shapes_and_box_mode():
     r = get_model("ret").reduced(np.array([0.1, 0.2, 0.3]), 0.9)
     from ktgf.hcs import expand_states
@@ -221,6 +234,7 @@ def _user_models():
     ]
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("model", _user_models(), ids=lambda m: m.name + str(m.options()))
 def test_user_defined_models_closed_form_agrees_with_eigenvalues(model):
     """Any model, not only the registered four: compositions with other RDFs and options."""

@@ -31,6 +31,9 @@ LONG = settings(max_examples=3000, deadline=None, suppress_health_check=[HealthC
 MODELS = {name: get_model(name) for name in PAPER_MODELS}
 
 
+pytestmark = pytest.mark.contract
+
+
 @st.composite
 def states(draw):
     """(model, phi, e) inside the model's domain."""

@@ -12,6 +12,9 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 
 
+pytestmark = pytest.mark.contract
+
+
 def test_docs_site_builds_with_api_reference(tmp_path) -> None:
     pytest.importorskip("mkdocs")
     pytest.importorskip("mkdocstrings")

@@ -9,6 +9,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 SRC = Path(__file__).resolve().parents[2] / "src"
 ROOT = SRC / "ktgf"
 
@@ -27,6 +29,9 @@ LAYERS = (
     ("cli", "__main__", "__init__"),
 )
 RANK = {room: i for i, rooms in enumerate(LAYERS) for room in rooms}
+
+
+pytestmark = pytest.mark.contract
 
 
 def _module_name(path: Path) -> str:

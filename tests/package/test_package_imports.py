@@ -34,6 +34,9 @@ print(json.dumps(out))
 """
 
 
+pytestmark = pytest.mark.contract
+
+
 def test_import_leaves_x64_off_and_runs_keep_their_precision() -> None:
     proc = subprocess.run([sys.executable, "-W", "error::UserWarning", "-c", SCRIPT], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr[-3000:]

@@ -13,6 +13,8 @@ import pytest
 
 from ktgf.report import ReportSettings, build_report, check_report, framework
 
+pytestmark = pytest.mark.contract
+
 
 def _counting(monkeypatch: pytest.MonkeyPatch, key: str) -> list[int]:
     sec = framework._SECTIONS[key]

@@ -17,6 +17,8 @@ from ktgf.errors import InputError
 from ktgf.report import ReportInterrupted, ReportSettings, build_report, check_report, framework, locate_data_dir
 from ktgf.report.page import PAGE_NAME
 
+pytestmark = pytest.mark.contract
+
 
 def small(out: Path, **kw) -> ReportSettings:
     """The ``--quick`` settings (so the CLI test finds the module's report cached)."""

@@ -19,6 +19,7 @@ from ktgf.report import ReportSettings, check_report, dense, framework
 from ktgf.data import read_table
 
 
+@pytest.mark.contract
 def test_section_models_default_and_dense_when_registered(monkeypatch):
     s = ReportSettings.preset(quick=True)
     monkeypatch.delitem(registry._REGISTRY, "dense", raising=False)
@@ -28,6 +29,7 @@ def test_section_models_default_and_dense_when_registered(monkeypatch):
     assert dense.section_models(ReportSettings.preset(quick=True, dense_models=("ret",))) == ("ret",)
 
 
+@pytest.mark.contract
 def test_bad_dense_model_setting_names_the_field():
     from ktgf.errors import InputError
 
@@ -42,6 +44,7 @@ def _ctx(tmp_path, data_dir, **kw):
     return framework.SectionContext(sec, s, tmp_path / "r", data_dir, sec.inputs(s))
 
 
+@pytest.mark.dem
 def test_dem_points_reproduce_the_files_own_columns(tmp_path, data_dir):
     pts = dense.dem_points(_ctx(tmp_path, data_dir))
     main = read_table(data_dir / "dem_uniform_shear.csv").as_dict()
@@ -50,6 +53,7 @@ def test_dem_points_reproduce_the_files_own_columns(tmp_path, data_dir):
     assert pts["e"][2] == 0.7 and pts["p_star"][2] == pytest.approx(fric["p_star"][0], rel=2e-4)
 
 
+@pytest.mark.analytic
 def test_shear_state_matches_the_closed_forms():
     m = get_model("ret")
     st = dense.shear_state(m, np.array([0.5]), 0.9)
@@ -58,6 +62,7 @@ def test_shear_state_matches_the_closed_forms():
     assert st["eta_star"][0] == pytest.approx(float(r.eta) * 5 / (16 * math.sqrt(math.pi)), rel=1e-12)
 
 
+@pytest.mark.dem
 def test_section_outputs_and_couette_wall_stresses(tmp_path, data_dir):
     ctx = _ctx(tmp_path, data_dir, dense_models=("ret", "proposed"))
     dense.run(ctx)
@@ -80,6 +85,7 @@ def test_section_outputs_and_couette_wall_stresses(tmp_path, data_dir):
     assert any("Couette wall shear stress" in s for s in dense.discuss(res.numbers))
 
 
+@pytest.mark.contract
 def test_quick_report_has_the_dense_section(quick_report):
     st = quick_report.statuses
     assert st["dense"] == "computed"

@@ -17,6 +17,9 @@ from ktgf.report import ReportSettings, framework
 from ktgf.report import friction as section
 
 
+pytestmark = pytest.mark.dem
+
+
 def _ctx(tmp_path, data_dir):
     s = ReportSettings.preset(quick=True, out=tmp_path / "r")
     sec = framework._SECTIONS["friction"]

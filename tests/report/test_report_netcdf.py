@@ -11,6 +11,9 @@ from helpers.cf_units import valid_units
 from ktgf.io import CONVENTIONS, NETCDF_ENGINE, open_netcdf, write_netcdf
 
 
+pytestmark = pytest.mark.contract
+
+
 @pytest.mark.parametrize("units, ok", [("1", True), ("m2 s-2", True), ("m/s", True), ("W/m2", True), ("1/s", True),
                                        ("Pa", True), ("d", False), ("s-1 d", False), ("", False), ("reduced", False)])
 def test_unit_checker_itself(units: str, ok: bool) -> None:

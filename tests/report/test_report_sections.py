@@ -44,6 +44,7 @@ def copy_of(report, tmp_path):
     return tmp_path / "r"
 
 
+@pytest.mark.published
 def test_report_stability_data_reproduce_oracle_box_sizes(quick_report) -> None:
     """The netCDF behind the report's stability map holds the oracle critical sizes (grid step 0.01 hits them)."""
     rep = quick_report
@@ -58,6 +59,7 @@ def test_report_stability_data_reproduce_oracle_box_sizes(quick_report) -> None:
             assert float(got.L_par) == pytest.approx(ll, abs=1.5e-3)
 
 
+@pytest.mark.analytic
 def test_eigenvalue_threshold_matches_closed_form() -> None:
     ds = dispersion(("enskog", "ret", "visc-div", "proposed"), 0.3, 0.9, 60)
     np.testing.assert_allclose(ds.k_par_eigen, ds.k_par, rtol=1e-9)
@@ -67,6 +69,7 @@ def test_eigenvalue_threshold_matches_closed_form() -> None:
         assert float(ds.s_perp[i, 0]) == pytest.approx(0.5 * float(get_model(str(n)).reduced(0.3, 0.9).zeta0))
 
 
+@pytest.mark.dem
 def test_ret_cooling_rate_matches_the_dem_files_enskog_column(dem_dir) -> None:
     t = read_table(dem_dir / HCS_COOLING).as_dict()
     cmp = cooling_comparison(("ret",), t)
@@ -74,6 +77,7 @@ def test_ret_cooling_rate_matches_the_dem_files_enskog_column(dem_dir) -> None:
     np.testing.assert_allclose(cmp.error_early.sel(model="ret"), 1.0 / t["ratio_early"] - 1.0, atol=3e-4)
 
 
+@pytest.mark.analytic
 def test_ret_and_proposed_critical_sizes_agree_where_their_rdfs_do() -> None:
     ds = stability_map(("ret", "proposed"), np.linspace(0.02, 0.6, 59), [0.7, 0.9])  # φ step 0.01
     c = compare_pair(ds, "ret", "proposed")
@@ -94,6 +98,7 @@ def _enable(monkeypatch, key: str, module, fake) -> None:
     monkeypatch.setitem(framework._SECTIONS, key, dataclasses.replace(sec, available=lambda: None))
 
 
+@pytest.mark.analytic
 def test_couette_section_errors_of_a_known_solution(monkeypatch, tmp_path, dem_dir, quick_report) -> None:
     dem = read_table(dem_dir / COUETTE).as_dict()
     calls = []
@@ -119,6 +124,7 @@ def test_couette_section_errors_of_a_known_solution(monkeypatch, tmp_path, dem_d
     assert "couette_profiles.png" in (rep.out / "index.html").read_text()
 
 
+@pytest.mark.contract
 def test_cooling_gas_section_through_its_contract(monkeypatch, tmp_path, quick_report) -> None:
     calls = []
 

@@ -25,6 +25,8 @@ from ktgf.report.overlap import coincide_below, overlap_groups, overlap_sentence
 from ktgf.report.page import PAGE_NAME
 from ktgf.report.summary import summarise
 
+pytestmark = pytest.mark.contract
+
 
 def _without_solvers(monkeypatch) -> None:
     for key in ("couette", "cooling_gas"):

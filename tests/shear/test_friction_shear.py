@@ -38,6 +38,7 @@ DOCS = Path(__file__).resolve().parents[2] / "docs" / "friction.md"
 ORACLES = [(0.1, 0.9, 0.29279, 6.85769), (0.3, 0.7, 0.45795, 0.39587), (0.5, 0.9, 0.29366, 0.89526)]
 
 
+@pytest.mark.published
 @pytest.mark.parametrize("law", [None, RoughSphereRestitution(beta=0.7)])
 @pytest.mark.parametrize("phi, e, ratio, temp", ORACLES)
 def test_zero_friction_reproduces_the_frictionless_oracles(law, phi, e, ratio, temp):
@@ -49,6 +50,7 @@ def test_zero_friction_reproduces_the_frictionless_oracles(law, phi, e, ratio, t
     assert s.p_star[0] == pytest.approx(phi * s.p_over_nT[0] * s.T[0], rel=1e-12)
 
 
+@pytest.mark.analytic
 def test_zero_friction_frictional_rdf_is_the_frictionless_model():
     phi = np.array([0.2, 0.45, 0.6])
     fr = frictional_uniform_shear(FrictionalShearParts(get_model("ret").replace(rdf=FrictionalChialvoSundaresan())), phi, 0.7, 0.0)
@@ -57,12 +59,14 @@ def test_zero_friction_frictional_rdf_is_the_frictionless_model():
         np.testing.assert_array_equal(a, b)
 
 
+@pytest.mark.analytic
 def test_friction_cools_and_raises_the_stress_ratio():
     parts = FrictionalShearParts(get_model("ret").replace(rdf=FrictionalChialvoSundaresan()))
     smooth, rough = (frictional_uniform_shear(parts, 0.4, 0.7, mu) for mu in (0.0, 0.5))
     assert rough.T[0] < smooth.T[0] and rough.tau_over_p[0] > smooth.tau_over_p[0]
 
 
+@pytest.mark.analytic
 def test_frictional_stress_is_zero_below_threshold_and_coulomb_far_above():
     base = FrictionalShearParts(get_model("ret").replace(rdf=FrictionalChialvoSundaresan()))
     jj = JohnsonJacksonPressure(phi_max=0.565)
@@ -80,6 +84,7 @@ def test_frictional_stress_is_zero_below_threshold_and_coulomb_far_above():
     assert frictional_uniform_shear(blended, 0.56, 0.7, 0.5).p_star[0] < dense.p_star[0]
 
 
+@pytest.mark.analytic
 def test_dense_floor_only_raises_the_temperature():
     base = FrictionalShearParts(get_model("ret").replace(rdf=FrictionalChialvoSundaresan()))
     floor = FrictionalShearParts(base.model, dense_temperature=DenseInertialTemperature())
@@ -88,6 +93,7 @@ def test_dense_floor_only_raises_the_temperature():
     assert np.all(b.T >= a.T) and b.T[0] == a.T[0] and b.T[-1] > a.T[-1]
 
 
+@pytest.mark.contract
 def test_bad_input_is_one_line():
     parts = FrictionalShearParts(get_model("ret").replace(rdf=FrictionalChialvoSundaresan()))
     with pytest.raises(InputError, match="friction coefficient mu = -0.2"):
@@ -108,6 +114,7 @@ def dem_rows(data_dir):
     return read_friction_shear(data_dir / DEM_FILE)
 
 
+@pytest.mark.dem
 def test_fit_uses_only_the_fit_row(dem_rows):
     row = fit_row(dem_rows)
     assert (row["mu"], row["phi"]) == (0.5, 0.4)
@@ -116,6 +123,7 @@ def test_fit_uses_only_the_fit_row(dem_rows):
     assert beta == pytest.approx(0.699, abs=5e-4)
 
 
+@pytest.mark.dem
 def test_rough_sphere_prediction_of_the_dense_row(dem_rows):
     """Fitted at φ = 0.4 (T_rot/T only); at φ = 0.5 the measured errors documented in docs/friction.md."""
     name, fitted, parts = compositions(dem_rows)[3]
@@ -128,6 +136,7 @@ def test_rough_sphere_prediction_of_the_dense_row(dem_rows):
     assert recs[(0.5, 0.4)]["Trot_over_T_err"] == pytest.approx(0.0, abs=1e-9)
 
 
+@pytest.mark.regression
 def test_docs_table_is_current(dem_rows):
     text = DOCS.read_text()
     m = re.search(r"<!-- friction-table-start -->\n(.*?)<!-- friction-table-end -->", text, re.S)
@@ -137,6 +146,7 @@ def test_docs_table_is_current(dem_rows):
     )
 
 
+@pytest.mark.dem
 def test_a_second_fitted_parameter_does_not_rescue_the_dense_row(dem_rows):
     """docs/friction.md §6: fitting μ_J (hence φ_c) to p* at the fit row fails or mispredicts φ = 0.5."""
     from scipy.optimize import brentq
@@ -164,6 +174,7 @@ def test_a_second_fitted_parameter_does_not_rescue_the_dense_row(dem_rows):
     assert p_star("enskog", law, 10**log_scale, phi=0.5) / dense["p_star"] - 1 == pytest.approx(-0.35, abs=0.01)
 
 
+@pytest.mark.regression
 def test_docs_jamming_sensitivity_is_current(dem_rows):
     """docs/friction.md §2: the μ_J table, and T, τ/p moving by less than 2 % across it."""
     text = DOCS.read_text()
@@ -177,6 +188,7 @@ def test_docs_jamming_sensitivity_is_current(dem_rows):
         assert np.all(v.max(0) / v.min(0) - 1 < 0.02)
 
 
+@pytest.mark.analytic
 def test_recommended_parts_reduce_to_the_dense_model():
     from ktgf.shear.compositions import recommended_parts
 
@@ -188,6 +200,7 @@ def test_recommended_parts_reduce_to_the_dense_model():
     np.testing.assert_array_equal(rec.Trot_over_T, 0.0)
 
 
+@pytest.mark.contract
 def test_closures_run_under_jit():
     jax = pytest.importorskip("jax")
     from ktgf.closures.friction import ChialvoSundaresanRestitution, MuIRheology, SigmoidBlend

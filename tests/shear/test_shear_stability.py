@@ -24,6 +24,7 @@ def _rates(name, phi, ky, kz=0.0, e=E):
     return shear_modes(name, phi, e, GDOT, ky, kz, d=D, rho_s=RHO_S)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", MODELS)
 @pytest.mark.parametrize("phi", [0.1, 0.5])
 def test_long_waves_relax_temperature_at_the_cooling_rate(name, phi):
@@ -39,6 +40,7 @@ def test_long_waves_relax_temperature_at_the_cooling_rate(name, phi):
     assert abs(v[4]) / m.base.theta == pytest.approx(1.0, abs=1e-6)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", MODELS)
 def test_shear_waves_decay_at_the_viscous_rate(name):
     """k ∥ z: δu_x alone is a mode, σ = −ηk²/ρ; k ∥ y: δu_z alone, same rate (model.md §1 stress)."""
@@ -59,6 +61,7 @@ def _stress_ratio_and_pressure(model, phi):
     return us.tau_over_p, phi * model.reduced(phi, E).p * us.T
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", MODELS)
 @pytest.mark.parametrize("phi", [0.1, 0.3, 0.5])
 def test_layering_mode_follows_the_slope_of_the_stress_ratio(name, phi):
@@ -83,12 +86,14 @@ def test_layering_mode_follows_the_slope_of_the_stress_ratio(name, phi):
     assert errors[0] / errors[1] > 3.0  # the O(k²) correction: the asymptote is approached at second order
 
 
+@pytest.mark.analytic
 def test_enskog_layering_instability_switches_on_with_density():
     """Stable dilute (φ = 0.1) and unstable dense (φ = 0.4) to long layering waves, as dμ/dφ changes sign."""
     assert _rates("enskog", 0.1, ky=0.01 / D).growth_rates[0].real < 0
     assert _rates("enskog", 0.4, ky=0.01 / D).growth_rates[0].real > 0
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", MODELS)
 @pytest.mark.parametrize("phi", [0.3, 0.55])
 def test_vorticity_direction_transport_terms_are_those_of_the_hcs_analysis(name, phi):
@@ -150,6 +155,7 @@ def _nonlinear_rhs(model, base, n_hat, length, fields):
     return np.stack([dphi_dt, *dv_dt, dtheta_dt])
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", MODELS)
 @pytest.mark.parametrize("k_hat", [(0.0, 1.0, 0.0), (0.0, 0.6, 0.8), (0.5, 0.5, math.sqrt(0.5))], ids=["y", "yz", "xyz"])
 def test_matrix_is_the_derivative_of_the_nonlinear_equations(name, k_hat):
@@ -178,6 +184,7 @@ def test_matrix_is_the_derivative_of_the_nonlinear_equations(name, k_hat):
 # --- time integration -----------------------------------------------------------------------------------
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("name", ["enskog", "proposed"])
 def test_integrated_modes_evolve_as_their_eigenvalues(name):
     """k_x = 0: integrating dy/dt = Ay from each eigenvector gives exp(σt) times it (φ = 0.4, oblique k)."""
@@ -193,6 +200,7 @@ def test_integrated_modes_evolve_as_their_eigenvalues(name):
         assert np.abs(y - exact).max() / scale < 1e-8, j
 
 
+@pytest.mark.analytic
 def test_kelvin_spanwise_velocity_decays_with_the_sheared_wavenumber():
     """k_z = 0: δu_z decouples exactly, δu_z(t) = δu_z(0) exp(−(η/ρ) ∫ |k(t)|² dt) with k_y(t) = k_y0 − γ̇k_x t."""
     base = shear_base_state("proposed", 0.4, E, GDOT, d=D, rho_s=RHO_S)
@@ -207,6 +215,7 @@ def test_kelvin_spanwise_velocity_decays_with_the_sheared_wavenumber():
     assert np.abs(np.delete(y, 3, axis=1)).max() < 1e-15
 
 
+@pytest.mark.analytic
 def test_kelvin_mode_matches_a_product_of_matrix_exponentials():
     """k_x ≠ 0: the sheared wavevector; DOP853 against midpoint exponentials exp(A(k(t+h/2))h), error O(h²)."""
     base = shear_base_state("ret", 0.3, E, GDOT, d=D, rho_s=RHO_S)
@@ -228,6 +237,7 @@ def test_kelvin_mode_matches_a_product_of_matrix_exponentials():
     assert 3.0 < errs[0] / errs[1] < 5.0  # second order of the midpoint product: the two integrators agree
 
 
+@pytest.mark.contract
 def test_bad_inputs_name_the_field():
     with pytest.raises(InputError, match="shear rate"):
         shear_base_state("ret", 0.3, E, 0.0, d=D, rho_s=RHO_S)

@@ -55,6 +55,7 @@ def case(tmp_path_factory):
     return out, info
 
 
+@pytest.mark.contract
 def test_dictionaries_hold_the_config(case) -> None:
     root, info = case
     read = lambda rel: (root / rel).read_text()  # noqa: E731
@@ -81,6 +82,7 @@ def test_dictionaries_hold_the_config(case) -> None:
     assert info["drag_over_collisional_dissipation"] < 1e-4
 
 
+@pytest.mark.contract
 def test_initial_fields_are_the_ktgf_seed(case) -> None:
     """φ: mean φ0 (mass) and rms perturbation = amplitude (ktgf's definition of the random seed);
     θ uniform θ0; the velocity has rms ≈ amplitude·√θ0 per component."""
@@ -98,6 +100,7 @@ def test_initial_fields_are_the_ktgf_seed(case) -> None:
     assert np.allclose(np.sqrt(np.mean(u**2, axis=0)), 0.05 * np.sqrt(THETA0), rtol=0.1)
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("axis", [0, 2])
 def test_cell_order_is_openfoams(tmp_path, axis: int) -> None:
     """A longitudinal HCS mode along x (or z) varies with the fastest (or slowest) OpenFOAM cell index only."""
@@ -111,6 +114,7 @@ def test_cell_order_is_openfoams(tmp_path, axis: int) -> None:
     assert spread > 1e-4 * PHI and across < 1e-12 * PHI, (spread, across)
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 @pytest.mark.skipif(shutil.which("twoPhaseEulerFoam") is None, reason="OpenFOAM twoPhaseEulerFoam is not installed")
 def test_tiny_case_runs_in_both_codes_and_follows_haff(tmp_path) -> None:

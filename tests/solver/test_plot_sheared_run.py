@@ -10,6 +10,9 @@ import pytest
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
+pytestmark = pytest.mark.contract
+
+
 def _timeseries(example: str, tmp_path: Path) -> tuple[Path, float]:
     """Write the history file a run of ``example`` would write, with made-up values on 3 outputs."""
     pytest.importorskip("jax")

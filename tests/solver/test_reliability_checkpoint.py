@@ -25,6 +25,8 @@ from ktgf.cli import app
 from ktgf.solver.io import load_checkpoint, save_checkpoint
 from ktgf.solver.outdir import LOCK
 
+pytestmark = pytest.mark.contract
+
 
 def case_text(end: float = 4.0, vtk_every: int = 2) -> str:
     return tiny_case(end=end, output=f"checkpoint_every = 1\nvtk_every = {vtk_every}")

@@ -29,6 +29,9 @@ from ktgf.solver.outdir import LOCK
 CASE = tiny_case(time="max_steps_per_call = 1", output='directory = "run"\ncheckpoint_every = 2\nvtk_every = 2')
 
 
+pytestmark = pytest.mark.contract
+
+
 def _cli(*args: str, fault: str | None = None, monkeypatch: pytest.MonkeyPatch) -> tuple[int, str]:
     """``ktgf ARGS`` in this process; (exit code, stderr)."""
     from typer.testing import CliRunner

@@ -26,6 +26,9 @@ from ktgf.solver.stepping import Numerics, advance
 PHI0, E, D, RHO_S, THETA0 = 0.3, 0.7, 1e-3, 2500.0, 1e-4
 
 
+pytestmark = pytest.mark.analytic
+
+
 def _physics(model: str = "ret") -> Physics:
     m = get_model(model)
     return Physics(m, E, D, RHO_S, 0.99 * m.phi_max)

@@ -47,6 +47,7 @@ def acoustic_step(U, grid: Grid, phys: Physics) -> float:
     return float(np.asarray(limits(U, grid, phys, Numerics(cfl=1.0)))[0])
 
 
+@pytest.mark.analytic
 def test_sound_mode_rate_at_acoustic_courant_number_near_one() -> None:
     phi = 0.25
     phys, grid, U, s, vec = _box(phi, (64,), 0.1, 1e-6)
@@ -67,6 +68,7 @@ def test_sound_mode_rate_at_acoustic_courant_number_near_one() -> None:
     assert abs(measured - s) <= 0.02 * abs(s), (measured, s)
 
 
+@pytest.mark.analytic
 def test_implicit_acoustics_is_second_order_in_time_beyond_the_acoustic_limit() -> None:
     phi = 0.5
     phys, grid, U0, s, _ = _box(phi, (64,), 0.1, 0.05)
@@ -79,6 +81,7 @@ def test_implicit_acoustics_is_second_order_in_time_beyond_the_acoustic_limit() 
     assert np.all(orders > 1.8), orders
 
 
+@pytest.mark.analytic
 def test_mass_and_momentum_are_conserved_to_round_off_at_large_acoustic_courant_numbers() -> None:
     m = get_model("ret")
     phys = Physics(m, E, D, RHO_S, 0.99 * m.phi_max)
@@ -108,6 +111,7 @@ def _config(**numerics: object) -> dict:
             "numerics": numerics}
 
 
+@pytest.mark.contract
 def test_bad_acoustics_options_are_refused_in_one_line_naming_the_field() -> None:
     with pytest.raises(InputError, match="numerics.acoustics") as exc:
         parse_config(_config(acoustics="fast"))
@@ -124,6 +128,7 @@ def test_bad_acoustics_options_are_refused_in_one_line_naming_the_field() -> Non
         Numerics(acoustics="fast")
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_dense_couette_with_implicit_acoustics_reaches_the_1d_solver_within_one_percent() -> None:
     """examples/couette_dense.toml (φ̄ 0.5, 4×64×4) with implicit acoustics: the criteria of the

@@ -36,6 +36,9 @@ RTOL64 = 1e-13
 TOL32 = 128 * float(np.finfo(np.float32).eps)
 
 
+pytestmark = pytest.mark.contract
+
+
 def _states(phys: Physics, n: int, dtype) -> tuple:
     rng = np.random.default_rng(7)
     phi = rng.uniform(0.05, min(0.6, 0.98 * phys.model.phi_max), n)

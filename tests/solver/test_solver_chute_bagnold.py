@@ -26,6 +26,9 @@ MAT = Material(d=1e-3, rho_s=2500.0, e=0.9)
 ANGLE = 18.0
 
 
+pytestmark = pytest.mark.analytic
+
+
 def _series(angle: float, depths: list[float]) -> list:
     """1D layers at the depths (in d), each continued from the previous one, 2 cells per d (≥ 256)."""
     out, ds = [], None

@@ -24,6 +24,9 @@ from ktgf.solver.run import Simulation
 CELLS_PER_D = 3.2  # the chute example's resolution (32 cells over 10 d)
 
 
+pytestmark = pytest.mark.analytic
+
+
 def _config(depth_d: float) -> dict:
     """The chute of tests/solver/test_solver_shear.py at another depth: the same resolution, time ∝ H²."""
     scale = (depth_d / 10.0) ** 2

@@ -32,6 +32,7 @@ def _example(name: str, **changes: object) -> dict:
     return data
 
 
+@pytest.mark.contract
 def test_steady_change_is_the_largest_relative_change_of_the_monitors_between_the_last_two_outputs() -> None:
     h = {"time": [0.0, 1.0], "theta_mean": [2.0, 2.002], "viscosity": [1.0, 1.0], "pressure": [4.0, 3.996]}
     assert steady_change("uniform-shear", h) == pytest.approx(max(0.002 / 2.002, 0.004 / 3.996))
@@ -43,6 +44,7 @@ def test_steady_change_is_the_largest_relative_change_of_the_monitors_between_th
     assert steady_change("couette", p) == pytest.approx(0.01)
 
 
+@pytest.mark.contract
 def test_steady_tol_is_refused_for_the_cooling_box_in_one_line_naming_the_field() -> None:
     data = tomllib.loads((ROOT / "examples" / "hcs_3d.toml").read_text())
     data["time"]["steady_tol"] = 1e-4
@@ -66,12 +68,14 @@ def _check_uniform_shear(sim: Simulation, tolerance: float) -> dict:
     return ver
 
 
+@pytest.mark.analytic
 def test_dense_uniform_shear_small_box_reaches_the_closed_form_and_stops_when_steady() -> None:
     """The 64³ example's path (dense model, φ 0.55, IMEX, mixed precision, steady stop) on 4³ (8 d)."""
     sim = Simulation(parse_config(_example("uniform_shear_dense", grid__cells=[4, 4, 4], grid__length_d=8.0)))
     _check_uniform_shear(sim, 1e-3)
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 @pytest.mark.parametrize("phi, precision", [(0.55, "mixed"), (0.5, "float64")])
 def test_dense_uniform_shear_32_cubed_reaches_the_closed_form(phi: float, precision: str) -> None:
@@ -82,12 +86,14 @@ def test_dense_uniform_shear_32_cubed_reaches_the_closed_form(phi: float, precis
     _check_uniform_shear(sim, 1e-3)
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_dense_uniform_shear_example_64_cubed_reaches_the_closed_form() -> None:
     """examples/uniform_shear_dense.toml as shipped (64³; about 10 min wall on 2 loaded cores)."""
     _check_uniform_shear(Simulation(load_config(ROOT / "examples" / "uniform_shear_dense.toml")), 1e-3)
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_dense_couette_example_reaches_the_1d_solver_within_one_percent() -> None:
     """examples/couette_dense.toml (φ̄ 0.5, 64 cells across the gap) against the 1D Couette solver."""

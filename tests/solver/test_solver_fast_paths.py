@@ -28,6 +28,9 @@ D, RHO_S, PHI = 1e-3, 2500.0, 0.3
 RTOL = 1e-13
 
 
+pytestmark = pytest.mark.contract
+
+
 def _grid(kind: str) -> Grid:
     cells, lengths = (8, 8, 6), (8 * D, 8 * D, 6 * D)
     if kind == "periodic":

@@ -91,6 +91,7 @@ STEP_CASES = [pytest.param(s, m, marks=() if (s, m) in FAST_STEPS else pytest.ma
               for s in ("ssprk3", "imex") for m in ("ret", "proposed")]
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(("limiter", "riemann", "viscous", "dtype"), RHS_CASES)
 def test_kernel_rhs_matches_jax(limiter: str, riemann: str, viscous: bool, dtype) -> None:
     grid, phys = _grid(), _physics("ret")
@@ -103,6 +104,7 @@ def test_kernel_rhs_matches_jax(limiter: str, riemann: str, viscous: bool, dtype
     assert _close(new, ref) < RTOL[dtype]
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(("scheme", "model"), STEP_CASES)
 def test_kernel_steps_match_jax(scheme: str, model: str) -> None:
     grid, phys = _grid(), _physics(model)
@@ -114,6 +116,7 @@ def test_kernel_steps_match_jax(scheme: str, model: str) -> None:
     assert _close(new[0], ref[0]) < RTOL[jnp.float64]
 
 
+@pytest.mark.contract
 def test_kernel_is_in_the_compiled_rhs_only_where_it_applies() -> None:
     phys = _physics("ret")
     periodic = _grid()
@@ -131,6 +134,7 @@ def test_kernel_is_in_the_compiled_rhs_only_where_it_applies() -> None:
     assert flux_kernel.TARGET not in _with_kernel(True, lambda: hlo(flat))
 
 
+@pytest.mark.contract
 def test_without_a_compiler_the_jax_path_runs_with_one_warning(monkeypatch, tmp_path) -> None:
     monkeypatch.setenv("CXX", "no-such-compiler-ktgf")
     monkeypatch.setenv("KTGF_CACHE_DIR", str(tmp_path))
@@ -163,6 +167,7 @@ STAGE_CASES = [("ret", {}, 0.3, 0.2, jnp.float64), ("ret", {}, 0.3, 0.2, jnp.flo
                ("proposed", {}, 0.52, 0.05, jnp.float64), ("frictional", {"stress": "schaeffer"}, 0.53, 0.01, jnp.float64)]
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(("model", "options", "phi", "amplitude", "dtype"), STAGE_CASES)
 def test_fused_stage_steps_match_jax(model: str, options: dict, phi: float, amplitude: float, dtype) -> None:
     grid = _grid()
@@ -185,6 +190,7 @@ def test_fused_stage_steps_match_jax(model: str, options: dict, phi: float, ampl
     assert _close(fused[0], U) > 100 * RTOL[dtype]  # the steps changed the state
 
 
+@pytest.mark.contract
 def test_fused_stage_on_few_planes_matches_jax() -> None:
     """The fused sweep's ring of planes on a grid of the fewest planes (4: planes -2, -1 are planes 2, 3, and
     the periodic images n0, n0 + 1 the kept planes 0, 1) and rows split unevenly over the threads (13 rows)."""
@@ -219,6 +225,7 @@ print(hashlib.sha256(np.asarray(out[0]).tobytes()).hexdigest())
 """
 
 
+@pytest.mark.contract
 def test_row_length_is_fixed_for_rows_of_16_to_1024_cells_in_multiples_of_8() -> None:
     """Which grids get a library for their row length (the last axis), and what each variant is called."""
     lengths = (8, 10, 16, 20, 24, 64, 1024, 1032)
@@ -231,6 +238,7 @@ def test_row_length_is_fixed_for_rows_of_16_to_1024_cells_in_multiples_of_8() ->
         flux_kernel.Variant("float64", "vanleer", "hll", "stage", 1)
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("dtype", [jnp.float64, jnp.float32])
 def test_a_library_for_the_row_length_gives_the_same_bits(monkeypatch, dtype) -> None:
     """A grid with rows of 16 cells runs the libraries built for that row length (:func:`.flux_kernel.row_length`:
@@ -262,6 +270,7 @@ def test_a_library_for_the_row_length_gives_the_same_bits(monkeypatch, dtype) ->
     assert _close(fixed[0], U) > 100 * RTOL[dtype]
 
 
+@pytest.mark.contract
 def test_fused_stage_does_not_depend_on_the_threads(tmp_path) -> None:
     """Every cell does the same operations whatever the threads' split of the rows (and which thread computes
     a ghost row): six steps with 1, 2 and 3 OpenMP threads are bit for bit the same.  41 rows: 20/21 and
@@ -293,6 +302,7 @@ print(getenv(b"OMP_WAIT_POLICY").decode(), getenv(b"GOMP_SPINCOUNT").decode())
 """
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("user", [{}, {"GOMP_SPINCOUNT": "100", "OMP_WAIT_POLICY": "ACTIVE"}])
 def test_openmp_threads_spin_briefly_then_sleep_unless_told_otherwise(tmp_path, user: dict) -> None:
     """libgomp reads its wait settings from the environment (the C one) once, when it loads: the kernel's
@@ -307,6 +317,7 @@ def test_openmp_threads_spin_briefly_then_sleep_unless_told_otherwise(tmp_path, 
     assert run.stdout.split() == expected
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize(("stop", "accepted", "budget"), [(0.362, 3, 10), (0.362, 3, 4), (0.345, 0, 10), (0.345, 0, 1)])
 def test_fused_loop_returns_the_last_good_state(stop: float, accepted: int, budget: int) -> None:
     """The fused loop writes each step over the one before and checks a step's state in the next step's
@@ -339,6 +350,7 @@ def test_fused_loop_returns_the_last_good_state(stop: float, accepted: int, budg
     assert np.array_equal(np.asarray(fused[0]), np.asarray(alone[0]))
 
 
+@pytest.mark.contract
 def test_fused_stage_refuses_a_small_ring(monkeypatch) -> None:
     """The fused stage's workspace (its threads' rings) is sized by the kernel (KtgfRingElements): one element
     short, the call is an error, not a write past the buffer."""
@@ -350,6 +362,7 @@ def test_fused_stage_refuses_a_small_ring(monkeypatch) -> None:
         _with_kernel(True, lambda: np.asarray(_steps(U, grid, phys, Numerics(scheme="ssprk3"))[0]))
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("model", [m.name for m in list_models()])
 def test_stage_source_is_the_cooling_source(model: str) -> None:
     """s0 + s1∇·u (what the fused stage adds) equals −(3/2)ρθζ for any ∇·u, for every registered model."""
@@ -368,6 +381,7 @@ def test_stage_source_is_the_cooling_source(model: str) -> None:
     assert float(jnp.max(jnp.abs(s0 + s1 * divu - exact))) < 1e-13 * scale
 
 
+@pytest.mark.contract
 def test_fused_stage_is_in_the_compiled_step_only_where_it_applies() -> None:
     grid, phys = _grid(), _physics("ret")
     U = _state(grid, phys, jnp.float64)
@@ -396,6 +410,7 @@ def test_fused_stage_is_in_the_compiled_step_only_where_it_applies() -> None:
     assert flux_kernel.STAGE_TARGET not in text and flux_kernel.TARGET in text
 
 
+@pytest.mark.contract
 def test_closures_once_per_stage(monkeypatch) -> None:
     """Tracing one SSP-RK3 step of ``advance`` evaluates the closures twice: at the step start (shared by
     the step limits and the first stage) and in the stage loop (the two later stages) — 3 per step.
@@ -420,6 +435,7 @@ def test_closures_once_per_stage(monkeypatch) -> None:
     assert len(calls) == 0  # the kernel evaluates the closures and reduces the step limits' terms
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("dtype", [jnp.float64, jnp.float32])
 @pytest.mark.parametrize("model", ["ret", "proposed", "frictional"])
 def test_step_limits_reduced_in_the_kernel(model: str, dtype) -> None:
@@ -478,6 +494,7 @@ def _sweeps(library) -> set[tuple[str, ...]]:
     return set(re.findall(r"sweep<(\w+), (\d), (\d), (true|false), \(anonymous namespace\)::(\w+)<", symbols))
 
 
+@pytest.mark.contract
 @pytest.mark.skipif(shutil.which("nm") is None, reason="needs nm (binutils)")
 def test_a_variant_library_compiles_the_sweep_once() -> None:
     """Each library holds the one face sweep of its variant (a build compiles one, not 64) and the entries of
@@ -498,6 +515,7 @@ def test_a_variant_library_compiles_the_sweep_once() -> None:
         assert fused == ({sweep[:3]} if stage else set()), v
 
 
+@pytest.mark.contract
 def test_a_library_refuses_a_call_of_another_variant(monkeypatch) -> None:
     """Every call goes to the float64 vanleer/hll viscous library here: a call that asks for another
     precision, limiter, Riemann solver or viscous flag is an error, never that library's result."""
@@ -532,6 +550,7 @@ def test_a_library_refuses_a_call_of_another_variant(monkeypatch) -> None:
         jax.block_until_ready(divergence(jnp.float64, "vanleer", "hll", True))
 
 
+@pytest.mark.contract
 def test_two_processes_build_a_variant_once(tmp_path) -> None:
     """Two processes that need the same variant at the same time: one compiles, the other waits and loads it."""
     script = ("import logging; logging.basicConfig(level=logging.INFO, format='%(message)s')\n"
@@ -550,6 +569,7 @@ def test_two_processes_build_a_variant_once(tmp_path) -> None:
     assert len(re.findall(r"^compiled ", logs, re.M)) == 1, logs
 
 
+@pytest.mark.contract
 def test_a_build_is_announced_once(monkeypatch, tmp_path, caplog) -> None:
     """A build logs that it starts (what, and that it is once per machine) and its time; the cache hit after it,
     nothing."""
@@ -567,6 +587,7 @@ def test_a_build_is_announced_once(monkeypatch, tmp_path, caplog) -> None:
     assert re.fullmatch(r"compiled the CPU flux kernel for float32 mc/rusanov stage in \d+\.\d s", messages[1])
 
 
+@pytest.mark.contract
 def test_the_command_line_shows_the_build_messages(capsys) -> None:
     """Library use is silent at INFO; the ``ktgf`` command's entry shows the ``ktgf`` INFO records on stderr."""
     from ktgf.cli import show_info

@@ -43,6 +43,7 @@ def _shear_grid(n: int = 4) -> Grid:
 
 # --- 1. the case's dissipation ---------------------------------------------------------------------
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("scheme, order", [("imex", 2), ("ssprk3", 3)])
 def test_frictional_cooling_box_follows_the_frictional_haff_law_at_the_scheme_order(scheme: str, order: int) -> None:
     """The cooling case takes the HCS dissipation: θ(t) is ktgf.hcs's frictional Haff law, the error
@@ -68,6 +69,7 @@ def test_frictional_cooling_box_follows_the_frictional_haff_law_at_the_scheme_or
     assert errors[-1] < 0.005 and np.all(orders > order - 0.2), (errors, orders)
 
 
+@pytest.mark.contract
 def test_sheared_cases_take_the_steady_shear_dissipation_and_the_shear_rate_scale() -> None:
     m = get_model("frictional")
     phys = _physics(m, "uniform-shear", _shear_grid())
@@ -89,6 +91,7 @@ def _sheared_run(model: Model, phi: float, scheme: str, steps: int = 6) -> np.nd
 
 
 # IMEX variants are ``slow`` (their compile dominates); the explicit ones cover the same closures.
+@pytest.mark.analytic
 @pytest.mark.parametrize("scheme", [pytest.param("imex", marks=pytest.mark.slow), "ssprk3"])
 def test_mu_zero_is_bit_for_bit_the_frictionless_run(scheme: str) -> None:
     """``frictional`` at μ = 0 and the same composition without a friction part: identical states."""
@@ -98,6 +101,7 @@ def test_mu_zero_is_bit_for_bit_the_frictionless_run(scheme: str) -> None:
     np.testing.assert_array_equal(_sheared_run(frictional, 0.4, scheme), _sheared_run(frictionless, 0.4, scheme))
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("scheme", [pytest.param("imex", marks=pytest.mark.slow), "ssprk3"])
 def test_a_frictional_stress_that_vanishes_changes_nothing_but_round_off(scheme: str) -> None:
     """Below φ_min the Johnson–Jackson p_f (and so μ_f and its work) is 0: the run is the one without a stress.
@@ -127,6 +131,7 @@ def _closed_form(m: Model, phi: float) -> tuple[float, float, float]:
     return float(s.T[0]) * (RATE * D) ** 2, float(s.tau_over_p[0]) * p, p
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("options, phi", CASES)
 def test_closed_form_frictional_uniform_shear_is_a_steady_state_with_its_stresses(options: dict, phi: float) -> None:
     m = get_model("frictional", mu=0.5, **options)
@@ -150,6 +155,7 @@ def test_closed_form_frictional_uniform_shear_is_a_steady_state_with_its_stresse
 
 # IMEX is not here: its steady θ is biased by O(ζΔt) (0.8 % at cfl 0.4, measured), because the EKT factor
 # of ζ0 is frozen at the stage-start θ (docs/friction.md §7, what is missing).
+@pytest.mark.analytic
 @pytest.mark.parametrize("options, phi, scheme", [({}, 0.5, "ssprk3"), ({"stress": "schaeffer", "jj_phi_min": 0.45}, 0.5, "ssprk3")])
 def test_homogeneous_frictional_shear_relaxes_to_the_closed_form(options: dict, phi: float, scheme: str) -> None:
     """From 1.3 θ the homogeneous sheared box relaxes to the closed-form θ, τ and p (to 1e-6)."""
@@ -169,6 +175,7 @@ def test_homogeneous_frictional_shear_relaxes_to_the_closed_form(options: dict, 
 
 # --- 4. planar Couette: the 1D solver with the same frictional model and walls --------------------------
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_frictional_couette_keeps_the_1d_solution_within_one_percent() -> None:
     """``frictional`` (μ = 0.5, e = 0.7) with a Schaeffer stress at φ̄ = 0.5 (p_f is 98 % of the pressure),
@@ -217,6 +224,7 @@ unit = "s"
 """)
 
 
+@pytest.mark.analytic
 def test_frictional_shear_example_runs_to_the_closed_form() -> None:
     from pathlib import Path
 
@@ -229,11 +237,13 @@ def test_frictional_shear_example_runs_to_the_closed_form() -> None:
     assert max(err.values()) < 1e-5, err
 
 
+@pytest.mark.contract
 def test_frictional_models_are_accepted_by_the_3d_solver() -> None:
     assert parse_config(_config("cooling")).model.name == "frictional"
     assert parse_config(_config("uniform-shear", 'stress = "schaeffer"')).case.kind == "uniform-shear"
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("case, options, field", [
     ("cooling", 'stress = "schaeffer"', "model.options.stress"),  # no shear-rate scale for ε
     ("cooling", "mu = 0.2", "model.options.mu"),  # Walton's rule has no HCS at weak friction (e = 0.7)
@@ -245,6 +255,7 @@ def test_what_the_3d_solver_still_refuses_is_one_line_naming_it(case: str, optio
     assert "\n" not in msg and field in msg, msg
 
 
+@pytest.mark.contract
 def test_a_frictional_wall_is_refused_in_3d() -> None:
     data = tomllib.loads("""
 [case]

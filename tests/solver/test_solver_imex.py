@@ -30,6 +30,7 @@ from ktgf.solver.stepping import Numerics, limits
 PHI0, E, D, RHO_S, THETA0 = 0.5, 0.7, 1e-3, 2500.0, 1e-4
 
 
+@pytest.mark.analytic
 def test_imex_is_second_order_in_time_beyond_the_diffusive_limit() -> None:
     m = get_model("ret")
     phys = Physics(m, E, D, RHO_S, 0.99 * m.phi_max)
@@ -58,6 +59,7 @@ def _base(**numerics: float) -> dict:
     }
 
 
+@pytest.mark.contract
 def test_unconverged_stage_solve_stops_with_diagnosis(tmp_path, monkeypatch) -> None:
     # Strong density variation on a fine grid (η varies several-fold between cells, Δt ≫ the
     # diffusive limit): one Krylov iteration per solve cannot reach a relative residual of 1e-12.
@@ -77,6 +79,7 @@ def test_unconverged_stage_solve_stops_with_diagnosis(tmp_path, monkeypatch) -> 
     assert float(ck["t"]) == err.time
 
 
+@pytest.mark.contract
 def test_auto_scheme_follows_the_step_limits() -> None:
     dense = Simulation(parse_config({**_base(), "time": {"end": 1.0, "scheme": "auto"},
                                      "initial": {"solid_fraction": 0.5, "temperature": 1e-4},
@@ -87,6 +90,7 @@ def test_auto_scheme_follows_the_step_limits() -> None:
     assert dense.num.scheme == "imex" and dilute.num.scheme == "ssprk3"
 
 
+@pytest.mark.contract
 def test_auto_scheme_weighs_the_cost_of_the_explicit_step() -> None:
     """``auto`` takes IMEX where its step is more than twice the break-even longer than SSP-RK3's: 2 × 3 for the
     SSP-RK3 of the JAX path (a 1D grid), 2 × 9 where SSP-RK3 runs the fused kernel loop (a 3D periodic grid on

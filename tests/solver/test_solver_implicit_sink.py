@@ -37,6 +37,7 @@ def _theta(U) -> float:
     return float(np.mean(np.asarray(primitive(U))[4]))
 
 
+@pytest.mark.analytic
 def test_haff_law_second_order_beyond_the_cooling_limit() -> None:
     grid, phys, U0 = _cooling_box()
     t_h = haff_time(phys, PHI0, THETA0)
@@ -54,6 +55,7 @@ def test_haff_law_second_order_beyond_the_cooling_limit() -> None:
     assert np.all(orders > 1.8) and errors[-1] < 1e-3, (errors, orders)
 
 
+@pytest.mark.analytic
 def test_steps_at_the_implicit_sink_limit_keep_theta_positive_and_cooling() -> None:
     grid, phys, U0 = _cooling_box()
     explicit = float(np.asarray(limits(U0, grid, phys, Numerics()))[3])
@@ -71,6 +73,7 @@ def test_steps_at_the_implicit_sink_limit_keep_theta_positive_and_cooling() -> N
     assert 0.3 < theta[-1] / float(haff_temperature(float(t), THETA0, t_h)) < 3.0
 
 
+@pytest.mark.contract
 def test_implicit_sink_needs_imex_and_is_refused_in_one_line() -> None:
     base = {"model": {"name": "ret", "restitution": 0.7}, "initial": {"solid_fraction": 0.3, "temperature": 1e-4},
             "grid": {"cells": [8, 8], "length_d": 8.0}, "time": {"end": 1.0, "outputs": 1, "scheme": "ssprk3"},
@@ -84,6 +87,7 @@ def test_implicit_sink_needs_imex_and_is_refused_in_one_line() -> None:
         Numerics(scheme="ssprk3", sink="implicit")
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_dense_couette_with_implicit_sink_and_acoustics_reaches_the_1d_solver() -> None:
     """examples/couette_dense.toml (φ̄ 0.5, 4×64×4) with the sink and the pressure waves implicit: the
@@ -109,6 +113,7 @@ def test_dense_couette_with_implicit_sink_and_acoustics_reaches_the_1d_solver() 
     assert np.max(np.abs(tau - 1.0)) < 0.01, ver["wall_shear_stress_Pa"]
 
 
+@pytest.mark.analytic
 def test_couette_3d_perturbation_measure() -> None:
     """benchmarks/couette_3d_perturbation.py (the 3D part of a Couette state, docs/solver.md): zero for a
     state uniform in x and z, the rms of an added x–z mode otherwise."""
@@ -132,6 +137,7 @@ def test_couette_3d_perturbation_measure() -> None:
     assert dev["u_z"] == pytest.approx(1e-3 / np.sqrt(2.0), rel=1e-12) and dev["phi"] < 1e-12
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_dense_couette_at_64_cubed_reaches_the_1d_solver_in_minutes(tmp_path, monkeypatch) -> None:
     """The shipped chain examples/couette_dense.toml → couette_dense_3d.toml (implicit acoustics and sink):

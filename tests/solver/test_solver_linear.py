@@ -30,6 +30,9 @@ from ktgf.solver.stepping import Numerics, advance, limits
 PHI0, E, D, RHO_S, THETA0 = 0.25, 0.8, 1e-3, 2500.0, 1e-4
 
 
+pytestmark = pytest.mark.analytic
+
+
 def measure_rate(model: str, cells: tuple[int, ...], mode: tuple[int, ...], kstar: float, kind: str,
                  branch: int = 0, tau_end: float | None = None, scheme: str = "imex", mixed: bool = False,
                  amplitude: float = 1e-6) -> tuple[complex, complex]:

@@ -26,12 +26,14 @@ from test_solver_linear import measure_rate
 EPS32 = float(np.finfo(np.float32).eps)
 
 
+@pytest.mark.contract
 def test_precision_option_is_validated() -> None:
     assert NumericsSection(precision="mixed").precision == "mixed"
     with pytest.raises((ValueError, InputError), match="precision"):
         NumericsSection(precision="float16")
 
 
+@pytest.mark.analytic
 @pytest.mark.slow  # 43 s under load (compilation of the mixed IMEX step)
 def test_mixed_uniform_gas_follows_haff_at_second_order() -> None:
     phys = _physics("ret")
@@ -51,6 +53,7 @@ def test_mixed_uniform_gas_follows_haff_at_second_order() -> None:
     assert np.all(orders > 1.8), orders
 
 
+@pytest.mark.analytic
 @pytest.mark.slow  # 80 s under load
 def test_mixed_dense_box_conserves_mass_to_float32_round_off() -> None:
     """φ = 0.5, Δx = ℓ, 8³, 20 IMEX steps whose stage solves use float64 inner products: every solve
@@ -69,6 +72,7 @@ def test_mixed_dense_box_conserves_mass_to_float32_round_off() -> None:
     assert drift < 4.0 * EPS32 * math.sqrt(2 * 20 / grid.size) + 1e-12
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_mixed_growth_rate_of_a_vortex_mode() -> None:
     """The k* = 0.2 vortex mode of tests/solver/test_solver_linear.py, 2 % of the eigenvalue, in mixed precision.
@@ -79,6 +83,7 @@ def test_mixed_growth_rate_of_a_vortex_mode() -> None:
     assert abs(measured - theory) <= 0.02 * abs(theory), (measured, theory)
 
 
+@pytest.mark.analytic
 def test_float64_inner_product_krylov_solvers_solve_float32_systems() -> None:
     """_bicgstab64 and _cg64 (float32 vectors, float64 scalars) against a dense NumPy solve in float64:
     a non-symmetric diagonally dominant system and a symmetric positive definite one, Jacobi-preconditioned."""
@@ -103,6 +108,7 @@ def test_float64_inner_product_krylov_solvers_solve_float32_systems() -> None:
         assert err < 1e-5, err
 
 
+@pytest.mark.contract
 @pytest.mark.slow  # 18 s under load (two compiled runs)
 def test_mixed_run_follows_the_float64_run(tmp_path) -> None:
     """The whole run (config → Simulation → history) in mixed precision: float32 state, and the
@@ -142,6 +148,7 @@ def _float64_cell_ops(jaxpr) -> list[str]:
     return found
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("model", [m.name for m in list_models()])
 def test_float32_right_hand_side_computes_no_float64_cell_field(model: str) -> None:
     """A float32 state is stepped in float32: no closure promotes a cell field to float64 (a NumPy

@@ -36,6 +36,7 @@ def _check(model: str, dim: int, precision: str) -> None:
         assert r["verdict"] == "pass", (r["box"], r["verdict"], r["kperp_ratio"], r["var_ratio"])
 
 
+@pytest.mark.contract
 def test_verdicts_are_the_papers() -> None:
     """The three verdicts: decay below L⊥; vortices without clusters between L⊥ and L∥; clusters above L∥."""
     assert verdict("transverse", 0.7, 1e-10, 1e-10) == "pass"
@@ -47,11 +48,13 @@ def test_verdicts_are_the_papers() -> None:
     assert verdict("longitudinal", 1.3, 1e6, 1.0) != "pass"
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("model", ["ret", "proposed"])
 def test_critical_box_sizes_2d(model: str) -> None:
     _check(model, 2, "float64")
 
 
+@pytest.mark.analytic
 @pytest.mark.slow  # mixed precision: 5.2 min for both models under load 5-7 (docs/solver.md, "Dense paper test timing")
 @pytest.mark.parametrize("model", ["ret", "proposed"])
 def test_critical_box_sizes_3d(model: str) -> None:

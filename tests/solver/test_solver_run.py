@@ -25,6 +25,9 @@ BASE = {
 }
 
 
+pytestmark = pytest.mark.contract
+
+
 def _cfg(**changes: dict) -> dict:
     cfg = {k: dict(v) for k, v in BASE.items()}
     for section, values in changes.items():

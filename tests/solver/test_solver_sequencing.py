@@ -34,6 +34,7 @@ def _cell_averages(F, n: int) -> np.ndarray:
     return np.diff(F(x)) * n
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("periodic", [True, False])
 @pytest.mark.parametrize("n_old, n_new", [(12, 24), (12, 36), (24, 12), (12, 7), (7, 12), (16, 5)])
 def test_remap_conserves_the_integral_to_round_off(periodic: bool, n_old: int, n_new: int) -> None:
@@ -45,6 +46,7 @@ def test_remap_conserves_the_integral_to_round_off(periodic: bool, n_old: int, n
         np.testing.assert_allclose(g.sum(axis=1) / n_new, f.sum(axis=1) / n_old, rtol=1e-14)
 
 
+@pytest.mark.analytic
 def test_remap_of_a_linear_profile_gives_its_exact_cell_averages() -> None:
     """Bounded axis (one-sided end slopes): refinement, coarsening and a non-integer ratio are exact."""
     F = lambda x: 0.3 * x + 0.7 * x * x / 2  # antiderivative of 0.3 + 0.7 x  # noqa: E731
@@ -53,6 +55,7 @@ def test_remap_of_a_linear_profile_gives_its_exact_cell_averages() -> None:
         np.testing.assert_allclose(got, _cell_averages(F, n_new), rtol=1e-13, atol=1e-15)
 
 
+@pytest.mark.analytic
 def test_remap_of_a_smooth_profile_converges_at_second_order() -> None:
     """sin(2πx) on a periodic axis, refined 2×: the error against the exact averages falls as h²."""
     F = lambda x: -np.cos(2 * np.pi * x) / (2 * np.pi)  # noqa: E731
@@ -64,6 +67,7 @@ def test_remap_of_a_smooth_profile_converges_at_second_order() -> None:
     assert np.all(orders > 1.8), (errs, orders)
 
 
+@pytest.mark.analytic
 def test_refinement_then_restriction_is_the_identity() -> None:
     f = 1.0 + np.random.default_rng(0).random((5, 9))
     for r in (2, 3):
@@ -82,6 +86,7 @@ def _state(cells: tuple[int, ...], seed: int = 1) -> np.ndarray:
     return np.stack([rho, *(rho * u), rho * (0.5 * np.sum(u * u, axis=0) + 1.5 * theta)])
 
 
+@pytest.mark.analytic
 def test_map_state_conserves_mass_momentum_and_energy_and_tiles_periodic_axes() -> None:
     """x periodic tiled 2× and coarsened, y (walls) refined 3×, z periodic 8 → 5: totals per tile to round-off."""
     old, L = (8, 8, 8), (4e-3, 1e-2, 4e-3)
@@ -95,6 +100,7 @@ def test_map_state_conserves_mass_momentum_and_energy_and_tiles_periodic_axes() 
     assert np.array_equal(same, U)  # the same grid: the state itself, bit for bit
 
 
+@pytest.mark.analytic
 def test_map_state_falls_back_to_the_first_order_remap_when_the_slopes_would_make_theta_negative() -> None:
     """A cold cell next to a fast stream: the linear reconstruction of E − k overshoots below 0."""
     rho = np.full((8,), 1000.0)
@@ -148,6 +154,7 @@ def _initial(data: dict) -> np.ndarray:
         return np.asarray(sim.initial_state())
 
 
+@pytest.mark.contract
 def test_the_same_grid_gives_the_earlier_state_bit_for_bit(earlier, tmp_path: Path) -> None:
     folder, _ = earlier
     data = _couette([4, 8], [4.0, 10.0], tmp_path / "b", from_run=str(folder), perturbation="none")
@@ -157,6 +164,7 @@ def test_the_same_grid_gives_the_earlier_state_bit_for_bit(earlier, tmp_path: Pa
     assert np.array_equal(_initial(data), load_checkpoint(folder / "checkpoint.npz")["U"])
 
 
+@pytest.mark.analytic
 def test_a_run_mapped_onto_a_finer_wider_grid_keeps_the_totals_and_records_the_sequence(earlier, tmp_path: Path) -> None:
     folder, _ = earlier
     U = load_checkpoint(folder / "checkpoint.npz")["U"]
@@ -177,6 +185,7 @@ def test_a_run_mapped_onto_a_finer_wider_grid_keeps_the_totals_and_records_the_s
     assert sim.started_from["cells"] == [4, 8] and sim.started_from["remap_order"] in (1, 2)
 
 
+@pytest.mark.contract
 @pytest.mark.slow
 def test_verification_json_records_the_earlier_run_and_the_cost_of_the_whole_sequence(tmp_path: Path) -> None:
     _write_run(_couette([4, 8], [4.0, 10.0], tmp_path / "a"), tmp_path / "a", run=True)
@@ -191,6 +200,7 @@ def test_verification_json_records_the_earlier_run_and_the_cost_of_the_whole_seq
     assert ver["run"]["sequence"]["cpu_time_s"] == pytest.approx(sum(v["run"]["cpu_time_s"] for v in (first, second, ver)))
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("change, field", [
     (lambda d: d["boundaries"]["y"].update(wall_speed=2.0), "boundaries.y.wall_speed"),
     (lambda d: d["model"].update(restitution=0.8), "model.restitution"),
@@ -214,6 +224,7 @@ def test_an_earlier_run_of_another_flow_is_refused_in_one_line_naming_the_field(
     assert "\n" not in str(exc.value) and "from_run" in str(exc.value)
 
 
+@pytest.mark.contract
 def test_a_missing_or_unusable_source_is_refused_in_one_line(earlier, tmp_path: Path) -> None:
     folder, data = earlier
     for source, what in ((tmp_path / "nowhere", "does not exist"), (tmp_path, "holds no checkpoint.npz"),
@@ -253,6 +264,7 @@ def _uniform_shear_mapped(tmp_path: Path) -> tuple[Simulation, np.ndarray, np.nd
     return sim, old, V, rate, ref
 
 
+@pytest.mark.analytic
 def test_a_mapped_uniform_shear_steady_state_keeps_the_linear_profile_and_loses_the_resolved_shear_energy(
         tmp_path: Path) -> None:
     """Mapped onto 16 cells, u stays the linear profile and θ drops by exactly (γ̇h)²/48 away from the
@@ -266,6 +278,7 @@ def test_a_mapped_uniform_shear_steady_state_keeps_the_linear_profile_and_loses_
     np.testing.assert_allclose(th(V)[2:-2], np.mean(th(old)) - drop, rtol=1e-9)
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_a_mapped_uniform_shear_steady_state_returns_to_the_closed_form(tmp_path: Path) -> None:
     """... and θ, η, p are the closed form's within 1e-4 after 10 strains (164 s under load 15)."""
@@ -279,6 +292,7 @@ def test_a_mapped_uniform_shear_steady_state_returns_to_the_closed_form(tmp_path
 SEQUENCE = ("couette_dense_seq32", "couette_dense_seq64", "couette_dense_seq128")
 
 
+@pytest.mark.contract
 def test_ktgf_run_help_lists_every_solver_example() -> None:
     """Every example config of the 3D solver (a [grid] table) is named in the help of `ktgf run`."""
     import inspect
@@ -292,6 +306,7 @@ def test_ktgf_run_help_lists_every_solver_example() -> None:
     assert not missing, missing
 
 
+@pytest.mark.contract
 def test_the_sequencing_examples_chain_their_output_folders() -> None:
     configs = [parse_config(tomllib.loads((ROOT / "examples" / f"{n}.toml").read_text())) for n in SEQUENCE]
     assert [c.grid.cells[1] for c in configs] == [32, 64, 128]
@@ -303,6 +318,7 @@ def test_the_sequencing_examples_chain_their_output_folders() -> None:
     assert dense[1].initial.from_run == dense[0].output.directory and dense[1].grid.cells == [64, 64, 64]
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_the_sequenced_dense_couette_at_128_cells_reaches_the_1d_solver_within_one_percent(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -325,6 +341,7 @@ def test_the_sequenced_dense_couette_at_128_cells_reaches_the_1d_solver_within_o
     assert np.max(np.abs(tau - 1.0)) < 0.01, ver["wall_shear_stress_Pa"]
 
 
+@pytest.mark.contract
 def test_the_cost_of_a_sequence_counts_every_earlier_run_once(tmp_path: Path) -> None:
     """Stage 3 of a chain: the earlier run's verification.json already holds the sum of stages 1–2."""
     from ktgf.solver.sequencing import _earlier_cost

@@ -40,6 +40,9 @@ print(json.dumps(out))
 """
 
 
+pytestmark = pytest.mark.contract
+
+
 def test_two_device_sharding_matches_single_device() -> None:
     env = dict(os.environ)
     env["XLA_FLAGS"] = (env.get("XLA_FLAGS", "") + " --xla_force_host_platform_device_count=2").strip()

@@ -57,6 +57,7 @@ def _ghost_error(n: int, t: float) -> tuple[float, float]:
     return float(np.max(np.abs(P - field(X, Y)))), float(amplitude)
 
 
+@pytest.mark.analytic
 def test_lees_edwards_ghosts_image_a_shearing_periodic_field_by_linear_interpolation() -> None:
     t = 0.0123  # Δ = 0.3075 L_x: a fractional number of cells on every grid
     for n in (16, 32, 64):
@@ -67,6 +68,7 @@ def test_lees_edwards_ghosts_image_a_shearing_periodic_field_by_linear_interpola
     assert _ghost_error(16, 0.0)[0] < 1e-13  # no displacement: plain periodic images
 
 
+@pytest.mark.analytic
 def test_lees_edwards_ghosts_carry_the_velocity_jump_on_the_flow_component_only() -> None:
     grid = Grid((8, 6), (1.0, 0.6), Boundaries(("periodic", "lees-edwards"), shear_rate=RATE, flow=0))
     y = grid.mesh()[1]
@@ -85,6 +87,7 @@ def _shear_state(grid: Grid, phys: Physics, theta: float) -> jnp.ndarray:
     return add_base_flow(U, grid)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("model", ["ret", pytest.param("visc-div", marks=pytest.mark.slow)])
 def test_closed_form_uniform_shear_is_a_steady_state_of_the_discrete_equations(model: str) -> None:
     m = get_model(model)
@@ -142,6 +145,7 @@ def _parse(text: str):
     return parse_config(tomllib.loads(text))
 
 
+@pytest.mark.analytic
 def test_uniform_shear_run_relaxes_to_the_closed_form_and_conserves_mass() -> None:
     # 1D grid along the gradient x, flow along y (no image displacement: the velocity jump only).
     sim = Simulation(_parse(_case([8], "x", "y", 40.0)))
@@ -157,6 +161,7 @@ def test_uniform_shear_run_relaxes_to_the_closed_form_and_conserves_mass() -> No
     assert ds.attrs["case"] == "uniform-shear" and "tau" not in ds
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize("scheme", ["ssprk3", pytest.param("imex", marks=pytest.mark.slow)])
 def test_lees_edwards_box_with_fractional_image_shift_conserves_mass_and_cross_flow_momentum(scheme: str) -> None:
     """The lower Lees–Edwards face flux is the upper one handed back through the boundary
@@ -184,6 +189,7 @@ def test_lees_edwards_box_with_fractional_image_shift_conserves_mass_and_cross_f
     assert abs(s1[1] - s0[1]) > 1e-3 * momentum_scale  # the flow component is not conserved
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("text, field", [
     ('[case]\nkind = "cooling"\n[boundaries]\ny = { kind = "lees-edwards", shear_rate = 5.0, flow = "x" }',
      "boundaries.y.kind"),
@@ -208,11 +214,13 @@ def test_bad_case_or_boundary_config_is_one_line_naming_the_field(text: str, fie
     assert "\n" not in msg and field in msg, msg
 
 
+@pytest.mark.contract
 def test_haff_clock_is_refused_for_a_sheared_case() -> None:
     with pytest.raises(InputError, match="time.unit = 'tau' is for the cooling case"):
         _parse(_case([8], "x", "y", 1.0).replace('unit = "strain"', 'unit = "tau"'))
 
 
+@pytest.mark.contract
 def test_uniform_shear_example_parses() -> None:
     cfg = load_config(ROOT / "examples" / "uniform_shear.toml")
     assert cfg.case.kind == "uniform-shear" and cfg.boundaries.y.kind == "lees-edwards"
@@ -249,6 +257,7 @@ vtk = false
 """
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_one_d_couette_solution_is_kept_by_the_3d_solver_within_one_percent() -> None:
     """Started from the 1D solver's steady profile, the 3D solver (32 cells across the gap) stays
@@ -285,6 +294,7 @@ def run_from_profile_within_one_percent(sim: Simulation, ref, phi_mean: float):
     return U0
 
 
+@pytest.mark.analytic
 def test_wall_ghosts_make_the_face_fluxes_the_johnson_jackson_conditions() -> None:
     """The central viscous and heat fluxes through the wall faces equal c u_sl and D − G of
     ktgf.couette.walls at the wall state (the ghost cells solve the Robin conditions)."""
@@ -332,6 +342,7 @@ def test_wall_ghosts_make_the_face_fluxes_the_johnson_jackson_conditions() -> No
         assert P[1][c] == -P[1][g]  # no flow through the wall (normal component odd)
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_couette_transient_converges_to_the_1d_solver_with_resolution() -> None:
     """From the linear profile, the transient (strain 150) reaches the 1D steady state; the
@@ -351,6 +362,7 @@ def test_couette_transient_converges_to_the_1d_solver_with_resolution() -> None:
     assert np.all(orders > 1.7), (errors, orders)
 
 
+@pytest.mark.contract
 def test_couette_example_parses() -> None:
     cfg = load_config(ROOT / "examples" / "couette_2d.toml")
     assert cfg.case.kind == "couette" and cfg.boundaries.y.kind == "wall"
@@ -360,6 +372,7 @@ def test_couette_example_parses() -> None:
 
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("text, field", [
     ('kind = "chute"\ninclination_deg = 25.0', "boundaries"),
     ('kind = "couette"\ninclination_deg = 25.0', "case.inclination_deg"),
@@ -376,6 +389,7 @@ def test_chute_config_errors_name_the_field(text: str, field: str) -> None:
     assert field in str(exc.value) and "\n" not in str(exc.value), str(exc.value)
 
 
+@pytest.mark.contract
 def test_chute_example_parses_and_its_gravity_points_down_the_slope() -> None:
     from ktgf.solver.flows import gravity
 
@@ -385,6 +399,7 @@ def test_chute_example_parses_and_its_gravity_points_down_the_slope() -> None:
     np.testing.assert_allclose(g, (9.81 * math.sin(z), -9.81 * math.cos(z), 0.0), rtol=1e-15)
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_chute_reaches_the_1d_inclined_layer() -> None:
     """32 cells across the column, t = 2.5 s: u, φ, θ within 1 % of the 1D solver and the base
@@ -397,6 +412,7 @@ def test_chute_reaches_the_1d_inclined_layer() -> None:
     assert abs(ver["base_shear_stress_Pa"]["run"] / weight - 1) < 1e-3, ver["base_shear_stress_Pa"]
 
 
+@pytest.mark.contract
 @pytest.mark.slow
 @pytest.mark.parametrize("case", ["uniform-shear", "couette", "chute"])
 def test_sheared_case_resumes_bit_for_bit_and_writes_its_files(tmp_path: Path, case: str) -> None:
@@ -445,6 +461,7 @@ def test_sheared_case_resumes_bit_for_bit_and_writes_its_files(tmp_path: Path, c
     assert "solid_fraction" in read_vti(tmp_path / "full" / "fields_00004.vti")
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 @pytest.mark.parametrize("example, tolerance", [("uniform_shear", 1e-4), ("couette_2d", 0.01), ("chute_2d", 0.01)])
 def test_example_runs_to_its_reference(tmp_path: Path, example: str, tolerance: float) -> None:

@@ -75,6 +75,7 @@ def measure_shear_rate(direction: str, n: int, branch: int, strain: float, ampli
     return fit_rate(times * RATE, np.array(proj)), complex(sigma / RATE)
 
 
+@pytest.mark.analytic
 @pytest.mark.parametrize(
     "direction, n, branch, strain",
     [   # one grid per direction (one compilation each); explicit SSP-RK3: cheaper to compile than IMEX
@@ -91,6 +92,7 @@ def test_shear_growth_rates(direction: str, n: int, branch: int, strain: float) 
     assert abs(measured - theory) <= 0.02 * abs(theory), (measured, theory)
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_layering_rate_converges_with_resolution() -> None:
     """The layering mode's error falls faster than second order (measured: 22 %, 2.9 %, 0.42 % at
@@ -133,6 +135,7 @@ vtk = false
 """
 
 
+@pytest.mark.analytic
 @pytest.mark.slow
 def test_shear_mode_seed_from_a_config_decays_at_the_eigenvalue_rate() -> None:
     """``perturbation = "shear-mode"`` through the run machinery (``ktgf run``): the peculiar kinetic
@@ -154,6 +157,7 @@ def test_shear_mode_seed_from_a_config_decays_at_the_eigenvalue_rate() -> None:
     assert abs(slope / 2 - sigma) <= 0.02 * abs(sigma), (slope / 2, sigma)
 
 
+@pytest.mark.contract
 @pytest.mark.parametrize("kind, branch, pert, flow, field", [
     ("uniform-shear", 2, "shear-mode", "y", "initial.mode"),  # k along the flow: a Kelvin mode, not a normal mode
     ("cooling", 2, "shear-mode", "z", "initial.perturbation"),
@@ -179,6 +183,7 @@ def test_bad_shear_mode_config_names_the_field(kind: str, branch: int, pert: str
     assert "\n" not in str(exc.value) and field in str(exc.value), str(exc.value)
 
 
+@pytest.mark.contract
 def test_shear_mode_temperature_is_the_closed_form_or_refused() -> None:
     """``initial.temperature`` is optional for a shear-mode seed (θ0 is the closed-form steady θ);
     a value that differs is refused in one line naming the field, a missing one elsewhere too."""

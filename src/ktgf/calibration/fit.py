@@ -12,13 +12,18 @@ With model errors far above the DEM's statistical errors, as here, "scaled" is t
 
 A fit that stops early (solver failure, non-finite residuals, evaluation limit) does not raise:
 its result has ``success = False``, the reason in ``message`` and the best point evaluated.
+
+Identifiability (:func:`identifiability`, in every result): observations per fitted parameter,
+the correlation matrix, and warnings naming a pair correlated beyond :data:`CORRELATION_WARNING`
+or the parameters of a direction the Jacobian does not see (rank deficiency). Fewer observations
+than parameters is refused before any evaluation.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Sequence
 
 import numpy as np
@@ -35,6 +40,10 @@ DEFAULT_BOUNDS: dict[str, tuple[float, float]] = {
     **WALL_PARAMETERS,
 }
 ERRORS = ("scaled", "stated")
+#: |correlation| above which a pair of fitted parameters is reported as not separately determined.
+CORRELATION_WARNING = 0.95
+#: Singular values of the column-normalised Jacobian below this fraction of the largest count as zero.
+RANK_TOLERANCE = 1e-10
 
 
 def fittable_parameters(model: Model, *, couette: bool = False) -> dict[str, float]:
@@ -53,6 +62,58 @@ class Parameter:
     start: float
     lower: float
     upper: float
+
+
+@dataclass(frozen=True)
+class Identifiability:
+    """What the data determine: observations per parameter, numerical rank and warnings (one sentence each)."""
+
+    observations: int
+    parameters: int
+    rank: int
+    warnings: tuple[str, ...]
+
+    @property
+    def points_per_parameter(self) -> float:
+        return self.observations / self.parameters if self.parameters else math.nan
+
+
+def identifiability(J: np.ndarray, names: Sequence[str], correlation: np.ndarray | None = None) -> Identifiability:
+    """Rank of the Jacobian ``J`` (columns scaled to unit length, so units do not matter) and the warnings.
+
+    A parameter whose column is zero does not act on the data; the others of a null direction of the
+    scaled Jacobian (components above 0.1 of the unit null vector) are named together; a pair with
+    |correlation| > :data:`CORRELATION_WARNING` is named with its correlation.
+    """
+    J = np.asarray(J, dtype=float)
+    m, n = J.shape
+    warnings: list[str] = []
+    if not np.all(np.isfinite(J)):
+        return Identifiability(m, n, 0, ("the Jacobian at the optimum is not finite: identifiability unknown",))
+    norms = np.linalg.norm(J, axis=0)
+    dead = [names[j] for j in range(n) if norms[j] == 0.0]
+    if dead:
+        warnings.append(f"the data do not depend on {', '.join(dead)} at the optimum (zero column of the Jacobian)")
+    live = [j for j in range(n) if norms[j] > 0.0]
+    rank = 0
+    if live:
+        Js = J[:, live] / norms[live]
+        _, s, Vt = np.linalg.svd(Js, full_matrices=True)
+        s = np.concatenate([s, np.zeros(len(live) - s.size)])
+        rank = int(np.sum(s > s[0] * RANK_TOLERANCE)) if s[0] > 0 else 0
+        for v in Vt[rank:]:
+            involved = [names[live[k]] for k in np.flatnonzero(np.abs(v) > 0.1)]
+            warnings.append(f"the Jacobian is rank-deficient: the data determine only a combination of {', '.join(involved)} "
+                            f"(rank {rank + len(dead)} short of {n}; fix all but one of them)" if len(involved) > 1 else
+                            f"the Jacobian is rank-deficient in {involved[0]}")
+    if correlation is not None and rank == len(live):
+        for i in range(n):
+            for j in range(i + 1, n):
+                c = float(correlation[i, j])
+                if math.isfinite(c) and abs(c) > CORRELATION_WARNING:
+                    warnings.append(f"parameters {names[i]} and {names[j]} are {c:+.4f} correlated (|corr| > {CORRELATION_WARNING:g}): "
+                                    "the data determine mainly one combination of them")
+    return Identifiability(m, n, rank, tuple(warnings))
 
 
 @dataclass
@@ -79,6 +140,9 @@ class FitResult:
     files: list[str]
     walls: dict[str, float] = field(default_factory=dict)
     at_bound: list[str] = field(default_factory=list)
+    #: Covariance of the fitted values (scaled as ``errors`` says): the prediction bands use it.
+    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    identifiability: Identifiability | None = None
 
     @property
     def names(self) -> list[str]:
@@ -134,7 +198,8 @@ class _Stop(Exception):
 
 def calibrate(model: Model, datasets: Sequence[Any], names: Sequence[str], *, start: dict[str, float] | None = None,
               bounds: dict[str, tuple[float, float]] | None = None, weights: str = "sigma", errors: str | None = None,
-              walls: dict[str, float] | None = None, n_cells: int = 200, max_evaluations: int = 100) -> FitResult:
+              walls: dict[str, float] | None = None, n_cells: int = 200, max_evaluations: int = 100,
+              keep: np.ndarray | None = None) -> FitResult:
     """Fit parameters ``names`` of ``model`` to ``datasets`` (from :func:`ktgf.data.read_data`).
 
     Parameters
@@ -155,6 +220,10 @@ def calibrate(model: Model, datasets: Sequence[Any], names: Sequence[str], *, st
         How the standard errors are scaled (module notes); default "scaled" if m > n.
     walls : dict, optional
         Fixed wall parameters (``specularity``, ``wall_restitution``) of the Couette cells.
+    keep : bool array, optional
+        Which observations (in the order of all files' labels) enter the cost; the others are left
+        out and a file with none kept is not evaluated (leave-one-out refits,
+        :mod:`ktgf.calibration.crossval`: the files stay the same, so compiled Jacobians are reused).
     """
     t0 = time.perf_counter()
     start, bounds, walls = dict(start or {}), dict(bounds or {}), dict(walls or {})
@@ -170,8 +239,17 @@ def calibrate(model: Model, datasets: Sequence[Any], names: Sequence[str], *, st
     names = [p.name for p in params]
     fixed = {k: v for k, v in walls.items() if k not in names}
     terms = make_terms(model, datasets, names, weights, n_cells=n_cells, fixed=fixed)
+    if keep is not None:
+        keep = np.asarray(keep, dtype=bool)
+        sizes = [len(t.labels) for t in terms]
+        if keep.shape != (sum(sizes),):
+            raise InputError(f"keep has {keep.size} entries for {sum(sizes)} observations")
+        parts = np.split(keep, np.cumsum(sizes)[:-1])
+        terms = [_Kept(t, k) if not k.all() else t for t, k in zip(terms, parts) if k.any()]
     labels = [lab for t in terms for lab in t.labels]
     m, n = len(labels), len(params)
+    if m < n:
+        raise InputError(f"a fit of {n} parameters ({', '.join(names)}) to {m} data point(s): needs at least {n} data points")
     if errors is None:
         errors = "scaled" if m > n else "stated"
     if errors not in ERRORS:
@@ -234,6 +312,12 @@ def calibrate(model: Model, datasets: Sequence[Any], names: Sequence[str], *, st
     if errors == "scaled":
         cov = cov * float(r @ r) / (m - n)
     se = np.sqrt(np.diag(cov))
+    ident = identifiability(J, names, corr)
+    wide = [f"{p.name} (standard error {s_:.3g}, range {p.lower:g} to {p.upper:g})" for p, s_ in zip(params, se)
+            if math.isfinite(p.upper - p.lower) and math.isfinite(s_) and s_ > p.upper - p.lower]
+    if wide:  # a direction shared by three or more parameters escapes the pairwise test; its errors show it
+        ident = replace(ident, warnings=ident.warnings + ("the data do not determine " + "; ".join(wide)
+                                                          + ": the standard error exceeds the whole range",))
     if not np.all(np.isfinite(se)):
         message += "; the data do not determine every fitted parameter (J^T J is singular: infinite standard errors)"
     notes = sorted({t.method_note for t in terms if getattr(t, "method_note", "")})
@@ -255,8 +339,31 @@ def calibrate(model: Model, datasets: Sequence[Any], names: Sequence[str], *, st
         correlation=corr, errors=errors, cost=0.5 * float(r @ r), residuals=np.asarray(r), labels=labels, observed=obs,
         predicted=pred, weights=weights, success=success, message=message, evaluations=count[0],
         seconds=time.perf_counter() - t0, files=[str(d.path) for d in datasets], walls=used_walls,
-        at_bound=[p.name for p, a in zip(params, active) if a != 0],
+        at_bound=[p.name for p, a in zip(params, active) if a != 0], covariance=cov, identifiability=ident,
     )
+
+
+class _Kept:
+    """A residual term restricted to some of its observations (same interface)."""
+
+    def __init__(self, term: Any, keep: np.ndarray) -> None:
+        self.term, self.keep = term, keep
+        self.data = term.data
+        self.obs = term.obs[keep]
+        self.labels = [lab for lab, k in zip(term.labels, keep) if k]
+        self.method_note = getattr(term, "method_note", "")
+        self.fixed = getattr(term, "fixed", {})
+
+    def predict(self, values: dict[str, float]) -> np.ndarray:
+        return self.term.predict(values)[self.keep]
+
+    def residuals(self, values: dict[str, float]) -> np.ndarray:
+        return self.term.residuals(values)[self.keep]
+
+    def jacobian(self, values: dict[str, float]) -> np.ndarray:
+        J = self.term.jacobian(values)[self.keep]
+        self.method_note = getattr(self.term, "method_note", "")
+        return J
 
 
 def _covariance(J: np.ndarray) -> np.ndarray:

@@ -53,6 +53,38 @@ class ModelFile:
     provenance: dict[str, Any] = field(default_factory=dict)
     rdf: str | None = None
 
+    def covariance(self) -> tuple[list[str], Any] | None:
+        """(fitted parameter names, their covariance) from ``[fit]``, or None if the file holds no fit.
+
+        ``covariance`` if written (ktgf calibrate since the prediction bands), else rebuilt from
+        ``standard_errors`` and ``correlation``.  A malformed table is a one-line error naming the field.
+        """
+        import numpy as np
+
+        names = self.fit.get("parameters")
+        if not names:
+            return None
+        if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+            raise _err(self.path, "fit.parameters", "must be a list of parameter names")
+        n = len(names)
+        where = "fit.covariance" if "covariance" in self.fit else "fit.standard_errors"
+        try:
+            if "covariance" in self.fit:
+                cov = np.array(self.fit["covariance"], dtype=float)
+            else:
+                se = np.array(self.fit["standard_errors"], dtype=float)
+                corr = np.array(self.fit.get("correlation", np.eye(n)), dtype=float)
+                with np.errstate(invalid="ignore"):
+                    cov = corr * np.outer(se, se)
+        except (KeyError, TypeError, ValueError):
+            raise _err(self.path, where, f"missing or not a {n} x {n} table of numbers") from None
+        if cov.shape != (n, n):
+            raise _err(self.path, where, f"shape {cov.shape} does not match the {n} parameters {', '.join(names)}")
+        unknown = [k for k in names if k not in self.model.options() and k not in _WALL_KEYS]
+        if unknown:
+            raise _err(self.path, "fit.parameters", f"{', '.join(unknown)} not an option of model {self.base!r}")
+        return list(names), cov
+
 
 def _err(path: Path, where: str, msg: str) -> InputError:
     return InputError(f"model file {path.name}: field '{where}': {msg}")
@@ -92,7 +124,7 @@ def load_model_file(path: str | Path) -> ModelFile:
     valid = {**model.options(), **_part_choices(options)}
     for k, v in options.items():
         if k not in valid:
-            raise _err(path, f"model.options.{k}", f"model {base!r} has no such option; valid: {', '.join(valid)}")
+            raise _err(path, f"model.options.{k}", f"model {base!r} has no such option{_version_note(data)}; valid: {', '.join(valid)}")
         if isinstance(valid[k], float) and (isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v)):
             raise _err(path, f"model.options.{k}", f"{v!r} is not a finite number")
     try:
@@ -117,6 +149,15 @@ def load_model_file(path: str | Path) -> ModelFile:
             raise _err(path, f"walls.{k}", f"{v!r} is out of range: valid {lo:g} < {k} <= {hi:g}")
     return ModelFile(path, model, base, dict(options), {k: float(v) for k, v in walls.items()},
                      dict(data.get("fit", {})), dict(data.get("provenance", {})), sec.get("rdf"))
+
+
+def _version_note(data: dict[str, Any]) -> str:
+    """' (file written by ktgf X, this is ktgf Y)' when the file comes from another version, else ''."""
+    from .. import __version__
+
+    prov = data.get("provenance")
+    written = prov.get("ktgf_version") if isinstance(prov, dict) else None
+    return f" (file written by ktgf {written}, this is ktgf {__version__})" if written and written != __version__ else ""
 
 
 def _part_choices(options: dict[str, Any]) -> dict[str, Any]:
@@ -218,6 +259,7 @@ def fit_text(result: Any, *, command: str = "", start_file: ModelFile | None = N
     fit = {
         "parameters": result.names, "values": [float(v) for v in result.values],
         "standard_errors": [float(v) for v in result.stderr], "correlation": [[float(c) for c in row] for row in result.correlation],
+        "covariance": [[float(c) for c in row] for row in result.covariance],
         "errors": result.errors, "weights": result.weights, "cost": result.cost, "success": result.success,
         "message": result.message, "evaluations": result.evaluations, "at_bound": result.at_bound,
         "residual_labels": result.labels, "residuals": [float(r) for r in result.residuals],

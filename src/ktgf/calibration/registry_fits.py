@@ -13,7 +13,8 @@ collision rule (β0 = 1) for μ > 0.  The parameters are chosen in two steps, on
 Residuals are the log-ratios model/DEM of T, p/(nT) and τ/p at every state.  :func:`leave_one_out`
 refits without each state in turn and predicts it (the error a user should quote).  The μ = 0, e = 0.7
 row of the frictional file and the Couette file are predictions, never fitted.  Tests refit from the
-shipped data and compare with the registered constants.
+shipped data and compare with the registered constants.  :data:`REGISTERED_FITS` says which data files
+and states each fit used (``ktgf validate`` marks those rows *fitted*): change it with the fits.
 """
 
 from __future__ import annotations
@@ -42,6 +43,28 @@ from ..data import (
 )
 from ..errors import InputError
 from ..shear.steady import steady_shear
+
+
+@dataclass(frozen=True)
+class FitSource:
+    """States of one data file a model was fitted to: ``states`` are (μ, φ, e) tuples, or None for every state."""
+
+    file: str
+    states: tuple[tuple[float, float, float], ...] | None = None
+    sha256: str = ""
+
+
+#: The μ = 0.5 rows of the base frictional file (its μ = 0, e = 0.7 row is a prediction).
+_MU_HALF_BASE = ((0.5, 0.4, 0.7), (0.5, 0.5, 0.7))
+#: What the registered fitted models were fitted to (docs/dense.md §3, docs/friction.md §6.0): ``dense`` — a, b, c
+#: on every state of the frictionless uniform shear (base + extra); ``frictional`` — those, and μ_Z, k on every
+#: μ = 0.5 state of the frictional uniform shear (base + extra).  The other registered models have published
+#: parameters only: every row is a prediction.  Update this with the fits.
+REGISTERED_FITS: dict[str, tuple[FitSource, ...]] = {
+    "dense": (FitSource(UNIFORM_SHEAR), FitSource(UNIFORM_SHEAR_EXTRA)),
+    "frictional": (FitSource(UNIFORM_SHEAR), FitSource(UNIFORM_SHEAR_EXTRA),
+                   FitSource(FRICTION_SHEAR, _MU_HALF_BASE), FitSource(FRICTION_SHEAR_EXTRA)),
+}
 
 #: Observables compared at every state (log-ratio residuals).
 OBSERVABLES: tuple[str, ...] = ("T", "p_over_nT", "tau_over_p")

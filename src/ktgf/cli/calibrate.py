@@ -55,7 +55,11 @@ def calibrate_cmd(
     data: list[Path] = typer.Option(..., "--data", help="Data file (uniform-shear or Couette CSV of the shared format); repeat for several."),
     fit: str = typer.Option(..., "--fit", help="Parameters to fit, comma-separated: float options of the model (phi_c, beta, ...) "
                                                 "and, with Couette data, specularity, wall_restitution."),
-    out: Path = typer.Option(..., "--out", "-o", help="Model file (TOML) to write; every command reads it with --model-file."),
+    out: Path = typer.Option(None, "--out", "-o", help="Model file (TOML) to write; every command reads it with --model-file "
+                             "(needed unless --cross-validate)."),
+    cross_validate: bool = typer.Option(False, "--cross-validate", help="Also refit leaving out one state at a time (a row of a "
+                                        "uniform-shear file, a Couette file) and print each left-out state's error and their "
+                                        "mean: the error to quote (docs/calibration.md)."),
     start: str = typer.Option("", "--start", help="Start values NAME=VALUE,... (default: the model's values)."),
     bounds: str = typer.Option("", "--bounds", help="Bounds NAME=LOW:HIGH,... (default: see docs/calibration.md)."),
     wall: str = typer.Option("", "--wall", help="Fixed wall parameters of Couette cells: specularity=...,wall_restitution=..."),
@@ -65,7 +69,11 @@ def calibrate_cmd(
     max_evaluations: int = typer.Option(100, "--max-evaluations", help="Limit on residual evaluations."),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
-    """Fit chosen parameters of a model to DEM data (least squares, exact gradients) and write a model file."""
+    """Fit chosen parameters of a model to DEM data (least squares, exact gradients) and write a model file.
+
+    Prints the fitted values, their correlations, the data points per parameter and a warning for any
+    pair correlated beyond 0.95 or a rank-deficient Jacobian; --cross-validate adds the leave-one-state-out errors.
+    """
     from ..data import read_data
     from ..calibration.fit import calibrate
     from ..calibration.model_file import fit_text, load_model_file, write_model_file
@@ -74,6 +82,8 @@ def calibrate_cmd(
 
     if (model is None) == (model_file is None):
         raise InputError("give exactly one of --model NAME or --model-file FILE (the model to start from)")
+    if out is None and not cross_validate:
+        raise InputError("--out FILE is needed: the model file to write (only --cross-validate may go without it)")
     start_file = load_model_file(model_file) if model_file is not None else None
     m = start_file.model if start_file is not None else get_model(model)
     datasets = [read_data(p) for p in data]
@@ -84,7 +94,15 @@ def calibrate_cmd(
     if start_file is not None:
         result.base = start_file.base
     command = " ".join(["ktgf", *map(shlex.quote, sys.argv[1:])]) if sys.argv else "ktgf calibrate"
-    path = write_model_file(out, fit_text(result, command=command, start_file=start_file))
+    path = write_model_file(out, fit_text(result, command=command, start_file=start_file)) if out is not None else None
+    cv = None
+    if cross_validate:
+        from ..calibration.crossval import cross_validate as run_cv
+        from ._progress import DelayedProgress
+
+        with DelayedProgress("leave-one-out refits") as bar:
+            cv = run_cv(m, datasets, result.names, full=result, progress=bar, bounds=_bounds(bounds), weights=weights,
+                        walls=walls, n_cells=n_cells, max_evaluations=max_evaluations)
     notes = [n for d in datasets for n in getattr(d, "notes", ())]
     se_kind = ("scaled by the residual variance s^2 = sum(r^2)/(m - n)" if result.errors == "scaled"
                else "from the data's stated uncertainties (not rescaled)")
@@ -97,11 +115,19 @@ def calibrate_cmd(
               for lab, o, p, r in zip(result.labels, result.observed, result.predicted, result.residuals)]
     summary = {"model": result.base, "success": result.success, "message": result.message, "cost": result.cost,
                "weights": result.weights, "standard_errors": se_kind, "evaluations": result.evaluations,
-               "seconds": result.seconds, "walls": result.walls, "out": str(path), "notes": notes}
+               "seconds": result.seconds, "walls": result.walls, "out": str(path) if path else None, "notes": notes}
+    ident = result.identifiability
+    identity = {"observations": ident.observations, "parameters": ident.parameters,
+                "points_per_parameter": ident.points_per_parameter, "rank": ident.rank, "warnings": list(ident.warnings)}
     if fmt == OutputFormat.json:
         import json
 
-        typer.echo(json.dumps({**summary, "parameters": params, "correlation": corr, "points": points}, indent=2, default=float))
+        from ._common import _strict_json
+
+        doc = {**summary, "parameters": params, "correlation": corr, "identifiability": identity, "points": points}
+        if cv is not None:
+            doc["cross_validation"] = {**cv.summary(), "per_quantity": cv.per_quantity(), "rows": cv.rows, "refits": cv.refits}
+        typer.echo(json.dumps(_strict_json(doc), indent=2, default=float))
     else:
         emit(params, fmt, title=f"{result.base}: fitted parameters (standard errors {se_kind})")
         emit(corr, fmt, title="correlations")
@@ -113,10 +139,41 @@ def calibrate_cmd(
                 typer.echo("walls: " + ", ".join(f"{k} = {v:.6g}" for k, v in result.walls.items()))
             typer.echo(f"cost = {result.cost:.6g} (1/2 sum r^2 over {len(result.labels)} points), {result.evaluations} evaluations, "
                        f"{result.seconds:.2f} s; {result.message}")
-            typer.echo(f"wrote {path}")
+            typer.echo(f"identifiability: {ident.observations} data points for {ident.parameters} parameter(s) "
+                       f"({ident.points_per_parameter:.3g} per parameter), Jacobian rank {ident.rank}")
+            if path is not None:
+                typer.echo(f"wrote {path}")
+        if cv is not None:
+            _emit_cross_validation(cv, fmt)
+    for w in ident.warnings:
+        typer.echo(f"Warning: {w}", err=True)
+    if cv is not None:
+        for n in cv.notes:
+            typer.echo(f"Warning: cross-validation: {n}", err=True)
+        for r in cv.refits:
+            if not r["success"]:
+                typer.echo(f"Warning: refit without {r['state']} did not converge: {r['message']}", err=True)
     if not result.success:
-        typer.echo(f"Warning: {result.message} (best point written to {path})", err=True)
+        where = f" (best point written to {path})" if path is not None else ""
+        typer.echo(f"Warning: {result.message}{where}", err=True)
         raise typer.Exit(1)
+
+
+def _emit_cross_validation(cv, fmt: OutputFormat) -> None:
+    """The left-out errors per state and quantity, per quantity, and the mean (table, csv, markdown)."""
+    cols = ("state", "quantity", "data", "sigma", "model", "error", "in_sample_error", "refit_converged")
+    names = [f"refit_{n}" for n in cv.full.names]
+    rows = [{k: r[k] for k in (*cols, *names)} for r in cv.rows]
+    emit(rows, fmt, title=f"leave-one-state-out cross-validation of {', '.join(cv.full.names)}: error = model/data - 1 "
+                          "of the state left out (in_sample_error: the fit on all states)")
+    emit(cv.per_quantity(), fmt, title="cross-validated |error| per quantity")
+    emit([{"states": len(cv.refits), "values": len(cv.rows), "mean_abs_error": cv.mean_abs_error,
+           "mean_abs_in_sample_error": cv.mean_abs_in_sample_error, "seconds": cv.seconds}], fmt,
+         title="cross-validated mean |model/data - 1| (the number to quote)")
+    if fmt == OutputFormat.table:
+        typer.echo(f"cross-validated mean |model/data - 1| over {len(cv.refits)} states and {len(cv.rows)} values: "
+                   f"{100 * cv.mean_abs_error:.2f} % (in sample: {100 * cv.mean_abs_in_sample_error:.2f} %); "
+                   f"{cv.seconds:.1f} s")
 
 
 def register(app: typer.Typer, plot_app: typer.Typer) -> None:

@@ -119,9 +119,12 @@ def compare_cmd(
         dem = resolve(dem)  # a missing file: one line naming it and the shipped files
         rows, extra = compare_with_dem(dem, chosen, n_cells=n_cells, walls=walls)
         c = extra["case"]
+        band_note = _couette_bands(rows, chosen, model_file, extra["dem"], walls, n_cells)
         datasets = {m.label or m.name: extra["datasets"][m.name] for m in chosen if m.name in extra["datasets"]}
         emit(rows, fmt, title=(f"Models vs DEM ({dem.name}: e = {c.e:g}, mean phi = {c.mean_phi:g}, gap = {c.gap:g} d, U = {c.wall_speed:g}); "
                                f"JJ walls, e_w = e, specularity fitted per model to the DEM slip at |y| = {extra['dem'].slip_y:g} d"))
+        if band_note:
+            typer.echo(band_note, err=fmt == OutputFormat.json)
         path = plot_profiles(datasets, out, dem=extra["dem"],
                              title=f"DEM Couette e = {c.e:g}, mean phi = {c.mean_phi:g}; specularity calibrated per model")
     else:
@@ -142,6 +145,35 @@ def compare_cmd(
         dem_data = read_couette(dem) if dem.exists() and _is_dem_case(cfg, dem) else None
         path = plot_profiles(datasets, out, dem=dem_data)
     typer.echo(f"wrote {path}", err=fmt == OutputFormat.json)
+
+
+def _couette_bands(rows: list[dict[str, Any]], chosen: list[Any], model_file: Path | None, dem: Any,
+                   walls: dict[str, dict[str, float]], n_cells: int) -> str:
+    """Adds tau_wall_sd and p_sd (±1σ from the model file's fitted covariance) to the rows; returns the note."""
+    import math
+
+    if model_file is None:
+        return ""
+    from ..calibration.model_file import load_model_file
+
+    fit = load_model_file(model_file).covariance()
+    if fit is None:
+        return ""
+    from ..calibration.bands import couette_bands
+
+    m = chosen[-1]
+    for r in rows:
+        r["tau_wall_sd"], r["p_sd"] = math.nan, math.nan
+    row = rows[-1]
+    if not math.isfinite(row.get("tau_wall", math.nan)):
+        return ""
+    w = walls.get(m.name, {})
+    sd = couette_bands(m, fit[0], fit[1], dem, specularity=row["specularity"], wall_restitution=w.get("wall_restitution"),
+                       slip_fitted=m.name not in walls, n_cells=n_cells)
+    row["tau_wall_sd"], row["p_sd"] = sd["tau_wall"], sd["p"]
+    along = "; the specularity follows the parameters (refitted to the slip)" if m.name not in walls else ""
+    return (f"tau_wall_sd, p_sd: ±1 standard deviation from the covariance of {', '.join(fit[0])} in {model_file.name} "
+            f"(delta method, implicit-function Jacobian of the Couette solution{along})")
 
 
 def _is_dem_case(cfg: Any, dem: Path) -> bool:

@@ -9,6 +9,7 @@ import typer
 
 from pathlib import Path
 
+from ..closures.friction.model_slot import with_friction  # ``--mu`` (cli/couette.py imports it from here)
 from ..errors import InputError
 from ._common import MODEL_HELP, VALUES_HELP, OutputFormat, emit, handle_errors, model_file_option, parse_values, resolve_models
 
@@ -30,22 +31,6 @@ def parse_options(items: list[str] | None) -> dict[str, Any]:
                 value = text.strip()
         out[key.strip()] = value
     return out
-
-
-def with_friction(model: Any, mu: float | None) -> Any:
-    """The model at friction coefficient μ (``--mu``): routed to its friction part, added if it has none.
-
-    A frictionless model given μ > 0 gets the ``coulomb`` friction part with its defaults (Walton's rule,
-    β0 = 1), its RDF unchanged; μ = 0 leaves a frictionless model as it is.
-    """
-    if mu is None:
-        return model
-    from ..closures.friction._part import check_friction_coefficient
-
-    check_friction_coefficient(mu)
-    if model.friction.key == "none":
-        return model if mu == 0.0 else model.with_options(friction="coulomb", mu=float(mu))
-    return model.with_options(mu=float(mu))
 
 
 def shear_rows(model: Any, phi: np.ndarray, e: np.ndarray, stress_scale: float | None = None) -> list[dict[str, float]]:
@@ -78,6 +63,10 @@ def shear(
     option: list[str] = typer.Option(
         None, "--option", "-O", help="Model option KEY=VALUE (repeatable, applied to every model), e.g. phi_f=0.46."
     ),
+    band_jacobian: str = typer.Option("differences", "--band-jacobian", help="How the +-1 sigma bands of a --model-file "
+                                      "fit differentiate the prediction: differences (vectorised central differences, "
+                                      "relative error ~1e-8; default: a band costs about one prediction) or jax (exact "
+                                      "JAX Jacobian; importing and compiling JAX costs seconds per command)."),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
 ) -> None:
     """Steady uniform (Lees–Edwards) shear from the closed forms of docs/model.md §9 (frictional: docs/friction.md).
@@ -86,13 +75,39 @@ def shear(
     rate 1, rho_s = 6/pi): T = θ/(γ̇d)², Trot_over_T (NaN/null where the model has no rotation), p_star =
     p/(rho_s d² γ̇²), tau_over_p = |P_xy|/p, p_over_nT = p/(nT), eta_star = η d²/√(mT), eta_over_eta0 = η/η0,
     astar = γ̇/ν0 and L_over_d (extended-kinetic-theory correlation length, 1 without that option).
+    With a --model-file holding a fit, *_sd columns give +-1 standard deviation of the --model-file model's values
+    from the fitted covariance (delta method; docs/calibration.md).
     """
     options = parse_options(option)
     ms = [m.with_options(**options) if options else m for m in resolve_models(model, model_file)]
     ms = [with_friction(m, mu) for m in ms]
     phis, es = parse_values(phi, "phi"), parse_values(e, "e")
     rows = [{"model": m.name, **row} for m in ms for row in shear_rows(m, phis, es, stress_scale)]
+    note = ""
+    fit = _fit_covariance(model_file)
+    if fit is not None:  # ±1σ from the model file's fitted covariance, on its model's rows (delta method)
+        from ..calibration.bands import SHEAR_BAND_COLUMNS, shear_bands
+
+        bands, method = shear_bands(ms[-1], fit[0], fit[1], phis, es, stress_scale=stress_scale, method=band_jacobian)
+        own = [r for r in rows if r["model"] == ms[-1].name][-phis.size * es.size:]
+        for r in rows:
+            r.update({f"{k}_sd": float("nan") for k in SHEAR_BAND_COLUMNS})
+        for i, r in enumerate(own):
+            r.update({f"{k}_sd": float(bands[k][i]) for k in SHEAR_BAND_COLUMNS})
+        note = (f"*_sd: ±1 standard deviation from the covariance of {', '.join(fit[0])} in {model_file.name} "
+                f"(delta method, Jacobian by {method}); NaN for models without a fit")
     emit(rows, fmt, title=f"{', '.join(m.label or m.name for m in ms)}: Navier–Stokes uniform shear (d = m = 1, shear rate 1)")
+    if note:
+        typer.echo(note, err=fmt == OutputFormat.json)
+
+
+def _fit_covariance(model_file: Path | None) -> tuple[list[str], Any] | None:
+    """(names, covariance) of a model file's fit (None without a file or a fit)."""
+    if model_file is None:
+        return None
+    from ..calibration.model_file import load_model_file
+
+    return load_model_file(model_file).covariance()
 
 
 def register(app: typer.Typer, plot_app: typer.Typer) -> None:

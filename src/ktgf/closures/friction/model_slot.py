@@ -332,4 +332,20 @@ def _is_concrete(x: Any) -> bool:
 #: Friction parts by key (``Model.with_options(friction=KEY)``).
 FRICTIONS: dict[str, type] = {"none": NoFriction, "coulomb": Friction}
 
-__all__ = ["BLEND_CHOICES", "FRICTIONS", "Friction", "NoFriction", "RESTITUTIONS", "STRESSES"]
+def with_friction(model: Any, mu: float | None) -> Any:
+    """The model at friction coefficient μ: routed to its friction part, added if it has none.
+
+    A frictionless model given μ > 0 gets the ``coulomb`` friction part with its defaults (Walton's rule,
+    β0 = 1), its RDF unchanged; μ = 0 leaves a frictionless model as it is; ``None`` changes nothing.
+    """
+    if mu is None:
+        return model
+    from ._part import check_friction_coefficient
+
+    check_friction_coefficient(mu)
+    if model.friction.key == "none":
+        return model if mu == 0.0 else model.with_options(friction="coulomb", mu=float(mu))
+    return model.with_options(mu=float(mu))
+
+
+__all__ = ["BLEND_CHOICES", "FRICTIONS", "Friction", "NoFriction", "RESTITUTIONS", "STRESSES", "with_friction"]
