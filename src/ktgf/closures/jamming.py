@@ -55,7 +55,7 @@ from .._array import namespace
 from ..errors import InputError
 from .friction._part import FrictionPart, check_friction_coefficient, check_range
 from .friction.jamming import JammingFraction, with_jamming_fraction
-from .rdf import JammingPowerLaw, RadialDistribution
+from .rdf import RadialDistribution, jamming_power_chi, jamming_power_dchi
 
 #: 2√3, the constant of the mean-field volume function φ = Z/(Z + 2√3) (Song, Wang & Makse 2008).
 TWO_SQRT3 = 2.0 * math.sqrt(3.0)
@@ -318,29 +318,28 @@ class FrictionalPowerLaw(RadialDistribution):
         return CoordinationJamming(mu_scale=self.mu_scale)
 
     @property
-    def friction_share(self) -> float:
+    def friction_share(self) -> Any:
         """s(μ) = μ/(μ + μ_Z) of Eq. (2): 0 frictionless, 1 as μ → ∞."""
         return self.mu / (self.mu + self.mu_scale)
 
     @property
-    def amplitude(self) -> float:
+    def amplitude(self) -> Any:
         """a(μ) of Eq. (2) (a itself at μ = 0)."""
         return self.a * (1.0 + self.amplitude_growth * self.friction_share)
 
     @property
-    def phi_c(self) -> float:
-        """φ_J(μ), where χ diverges."""
-        return float(self.jamming_law.phi_c(self.mu))
+    def phi_c(self) -> Any:
+        """φ_J(μ) of :attr:`jamming_law`, where χ diverges (written out so that fitted options may be JAX values)."""
+        law = CoordinationJamming
+        z = law.z_infinite + (law.z_frictionless - law.z_infinite) / (1.0 + self.mu / self.mu_scale)
+        return packing_fraction_of_coordination(z)
 
     @property
     def phi_max(self) -> float:
-        return self.phi_c
-
-    def _form(self) -> JammingPowerLaw:
-        return JammingPowerLaw(a=self.amplitude, phi_c=self.phi_c, exponent=self.exponent)
+        return float(self.phi_c)
 
     def chi(self, phi: Any) -> Any:
-        return self._form().chi(phi)
+        return jamming_power_chi(phi, self.amplitude, self.phi_c, self.exponent)
 
     def dchi(self, phi: Any) -> Any:
-        return self._form().dchi(phi)
+        return jamming_power_dchi(phi, self.amplitude, self.phi_c, self.exponent)
