@@ -54,8 +54,10 @@ class FitSource:
     sha256: str = ""
 
 
-#: The μ = 0.5 rows of the base frictional file (its μ = 0, e = 0.7 row is a prediction).
+#: The μ = 0.5 rows (μ, φ, e) of the base and extra frictional files (the base file's μ = 0, e = 0.7 row is a
+#: prediction); ``tests/calibration/test_calibration_validate.py`` checks them against the files.
 _MU_HALF_BASE = ((0.5, 0.4, 0.7), (0.5, 0.5, 0.7))
+_MU_HALF_EXTRA = ((0.5, 0.3, 0.7), (0.5, 0.45, 0.7), (0.5, 0.52, 0.7), (0.5, 0.55, 0.7), (0.5, 0.57, 0.7))
 #: What the registered fitted models were fitted to (docs/dense.md §3, docs/friction.md §6.0): ``dense`` — a, b, c
 #: on every state of the frictionless uniform shear (base + extra); ``frictional`` — those, and μ_Z, k on every
 #: μ = 0.5 state of the frictional uniform shear (base + extra).  The other registered models have published
@@ -63,7 +65,7 @@ _MU_HALF_BASE = ((0.5, 0.4, 0.7), (0.5, 0.5, 0.7))
 REGISTERED_FITS: dict[str, tuple[FitSource, ...]] = {
     "dense": (FitSource(UNIFORM_SHEAR), FitSource(UNIFORM_SHEAR_EXTRA)),
     "frictional": (FitSource(UNIFORM_SHEAR), FitSource(UNIFORM_SHEAR_EXTRA),
-                   FitSource(FRICTION_SHEAR, _MU_HALF_BASE), FitSource(FRICTION_SHEAR_EXTRA)),
+                   FitSource(FRICTION_SHEAR, _MU_HALF_BASE), FitSource(FRICTION_SHEAR_EXTRA, _MU_HALF_EXTRA)),
 }
 
 #: Observables compared at every state (log-ratio residuals).
