@@ -10,15 +10,15 @@ from typer.testing import CliRunner
 
 from ktgf import get_model, list_models
 from ktgf.calibration.model_file import dumps, load_model_file, part_choice_options
-from ktgf.cli import app
-from ktgf.closures.friction import WaltonRestitution
-from ktgf.closures.friction.model_slot import Friction
-from ktgf.shear.steady import steady_shear
 from ktgf.calibration.registry_fits import fit_frictional, fit_frictionless, frictional_states
+from ktgf.cli import app
 from ktgf.closures.dense import DENSE_PARAMETERS
+from ktgf.closures.friction import WaltonRestitution
 from ktgf.closures.friction.calibrated import FRICTIONAL_PARAMETERS
+from ktgf.closures.friction.model_slot import Friction
 from ktgf.closures.rdf import JammingPowerLaw
 from ktgf.errors import InputError
+from ktgf.shear.steady import steady_shear
 
 runner = CliRunner()
 PHI = np.array([0.05, 0.2, 0.35, 0.45, 0.5, 0.55])
