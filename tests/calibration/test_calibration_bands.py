@@ -44,7 +44,7 @@ def test_delta_sigma_is_the_diagonal_of_j_c_jt():
 
 
 @pytest.mark.parametrize("method", ["jax", "differences"])
-@pytest.mark.parametrize("model, names", [("dense", ["phi_c", "beta"]), ("proposed", ["phi_f", "phi_c", "beta"]),
+@pytest.mark.parametrize("model, names", [("dense", ["exponent", "c"]), ("proposed", ["phi_f", "phi_c", "beta"]),
                                           ("frictional", ["c"])])
 @pytest.mark.analytic
 def test_shear_band_matches_central_differences(model, names, method):
@@ -70,7 +70,7 @@ def fitted(tmp_path_factory, data_dir):
     d = tmp_path_factory.mktemp("bands")
     out = d / "fit.toml"
     r = runner.invoke(app, ["calibrate", "--model", "dense", "--data", str(data_dir / "dem_uniform_shear.csv"), "--data",
-                            str(data_dir / "dem_uniform_shear_extra.csv"), "--fit", "phi_c,beta", "--out", str(out)])
+                            str(data_dir / "dem_uniform_shear_extra.csv"), "--fit", "exponent,c", "--out", str(out)])
     assert r.exit_code == 0, r.output
     return out
 
@@ -81,7 +81,7 @@ def test_model_file_holds_the_covariance(fitted):
     se, corr, cov = np.array(fit["standard_errors"]), np.array(fit["correlation"]), np.array(fit["covariance"])
     np.testing.assert_allclose(cov, corr * np.outer(se, se), rtol=1e-10)
     names, c = load_model_file(fitted).covariance()
-    assert names == ["phi_c", "beta"]
+    assert names == ["exponent", "c"]
     np.testing.assert_allclose(c, cov)
 
 
@@ -126,14 +126,14 @@ def test_couette_band_matches_resolved_cells(data_dir):
     from ktgf.couette.compare import calibrate_specularity, wall_stresses
 
     dem = read_data(data_dir / "dem_couette_e0.9_phi0.50.csv")
-    m = get_model("dense", beta=2.0)
+    m = get_model("proposed", beta=2.0)  # the viscosity-divergence RDF of the issue-9 dense, β as option
     n = 80
     spec, _ = calibrate_specularity(m, dem, n_cells=n)
     sd = couette_bands(m, ["beta"], np.array([[1.0]]), dem, specularity=spec, slip_fitted=True, n_cells=n)
     h = 0.02
     out = []
     for b in (2.0 + h, 2.0 - h):
-        mb = get_model("dense", beta=b)
+        mb = get_model("proposed", beta=b)
         _, ds = calibrate_specularity(mb, dem, n_cells=n)
         out.append(wall_stresses(ds))
     d_tau, d_p = (np.array(out[0]) - np.array(out[1])) / (2 * h)

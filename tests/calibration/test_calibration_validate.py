@@ -72,25 +72,27 @@ def test_dem_columns_and_errors(dense_table, data_dir):
 
 
 def test_rows_marked_from_what_dense_was_fitted_to(dense_table):
-    """docs/dense.md: β of dense fitted on dem_uniform_shear.csv only (φ 0.3, 0.5): the rest is predicted."""
+    """docs/dense.md §3: a, b, c of dense fitted on the frictionless uniform shear (base + extra file): the rest is predicted."""
     for r in dense_table["rows"]:
-        assert r["role"] == ("fitted" if r["file"] == "dem_uniform_shear.csv" else "predicted"), r
+        assert r["role"] == ("fitted" if r["file"] in SHEAR_FILES else "predicted"), r
     roles = {(s["case"], s["role"]) for s in dense_table["summary"]}
-    assert ("uniform-shear", "fitted") in roles and ("uniform-shear", "predicted") in roles
+    assert ("uniform-shear", "fitted") in roles and ("frictional-shear", "predicted") in roles
 
 
-def test_frictional_fitted_on_one_row(data_dir):
-    res = validate(get_model("frictional"), [data_dir / "dem_uniform_shear_friction.csv"], sources=fit_sources(model_name="frictional"))
+def test_frictional_fitted_on_its_mu_half_rows(data_dir):
+    """docs/friction.md §6.0: μ_Z and k fitted on every μ = 0.5 row; the μ = 0, e = 0.7 row is a prediction."""
+    files = [data_dir / "dem_uniform_shear_friction.csv", data_dir / "dem_uniform_shear_friction_extra.csv"]
+    res = validate(get_model("frictional"), files, sources=fit_sources(model_name="frictional"))
     fitted = {r["state"] for r in res.rows if r["role"] == "fitted"}
-    assert fitted == {"mu=0.5 phi=0.5 e=0.7"}
-    t = next(r for r in res.rows if r["state"] == "mu=0.5 phi=0.5 e=0.7" and r["quantity"] == "T")
-    assert abs(t["error"]) < 1e-3  # c was solved from this T (closures/friction/calibrated.py)
+    want = {f"mu=0.5 phi={x['phi']} e=0.7" for f in files for x in _rows(f) if float(x["mu"]) == 0.5}
+    assert len(want) == 7 and fitted == want
+    assert {r["state"] for r in res.rows if r["role"] == "predicted"} == {"mu=0 phi=0.5 e=0.7"}
 
 
 def test_model_file_provenance_marks_its_fit_data(data_dir, tmp_path):
     out = tmp_path / "m.toml"
     r = runner.invoke(app, ["calibrate", "--model", "dense", "--data", str(data_dir / "dem_uniform_shear_extra.csv"),
-                            "--fit", "beta", "--out", str(out)])
+                            "--fit", "exponent", "--out", str(out)])
     assert r.exit_code == 0, r.output
     r = runner.invoke(app, ["validate", "--model-file", str(out), "--data", str(data_dir / SHEAR_FILES[0]),
                             "--data", str(data_dir / SHEAR_FILES[1]), "--format", "csv"])
@@ -164,7 +166,7 @@ def test_model_file_from_another_version_with_unknown_options(tmp_path, data_dir
 
 
 def test_a_state_the_model_refuses_keeps_its_rows(data_dir, tmp_path):
-    """dense diverges at φ_c = 0.64: a state at 0.65 is in the table with NaN and the refusal, the others are answered."""
+    """dense diverges at φ_J(0) = 0.634: a state at 0.65 is in the table with NaN and the refusal, the others are answered."""
     lines = (data_dir / "dem_uniform_shear.csv").read_text().splitlines()
     f = tmp_path / "dense_beyond.csv"
     f.write_text("\n".join([*lines, "0.65" + lines[-1][lines[-1].index(","):]]) + "\n")

@@ -47,7 +47,8 @@ pytestmark = pytest.mark.contract
         ("ret", {"zeta11": "new"}, "option zeta11 = 'new'"),
         ("ret", {"dissipation": "magic"}, "option dissipation = 'magic'"),
         ("ret", {"dissipation": "jenkins-berzi-2010", "c": -1.0}, "option c = -1 is out of range"),
-        ("dense", {"phi_c": 0.3}, "option phi_c = 0.3"),
+        ("dense", {"exponent": -1.0}, "option exponent = -1"),
+        ("dense", {"phi_c": 0.3}, "has no option(s) ['phi_c']"),  # φ_J(μ) comes from the jamming law
     ],
 )
 def test_bad_option_is_a_one_line_input_error(name, options, fragment):

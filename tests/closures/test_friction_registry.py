@@ -10,16 +10,15 @@ from typer.testing import CliRunner
 
 from ktgf import get_model, list_models
 from ktgf.calibration.model_file import dumps, load_model_file, part_choice_options
+from ktgf.calibration.registry_fits import fit_frictional, fit_frictionless, frictional_states
 from ktgf.cli import app
+from ktgf.closures.dense import DENSE_PARAMETERS
 from ktgf.closures.friction import WaltonRestitution
+from ktgf.closures.friction.calibrated import FRICTIONAL_PARAMETERS
 from ktgf.closures.friction.model_slot import Friction
-from ktgf.data import FRICTION_SHEAR as DEM_FILE, read_friction_shear
-from ktgf.shear.steady import steady_shear
-from ktgf.closures.dissipation import CorrelationLength
-from ktgf.calibration.registry_fits import fit_correlation_constant
-from ktgf.closures.friction.calibrated import FRICTIONAL_C
-from ktgf.closures.rdf import ChialvoSundaresan
+from ktgf.closures.rdf import JammingPowerLaw
 from ktgf.errors import InputError
+from ktgf.shear.steady import steady_shear
 
 runner = CliRunner()
 PHI = np.array([0.05, 0.2, 0.35, 0.45, 0.5, 0.55])
@@ -29,12 +28,14 @@ def _same_bits(a, b) -> bool:
     return all(np.array_equal(np.asarray(x), np.asarray(y)) for x, y in zip(a, b))
 
 
-FRICTIONLESS = get_model("ret").replace(rdf=ChialvoSundaresan(), dissipation=CorrelationLength(c=FRICTIONAL_C))
+FRICTIONLESS = get_model("dense")
+#: φ_J(0) = 6/(6 + 2√3), the frictionless jamming fraction of the contact-number law (Makse group, "Jamming II", abstract).
+PHI_J0 = 6.0 / (6.0 + 2.0 * 3.0**0.5)
 
 
 @pytest.mark.analytic
-def test_frictional_model_at_mu_zero_is_the_frictionless_model_bit_for_bit():
-    """μ = 0: the RDF's φ_c(0) is φ_rcp = 0.64 exactly and ζ0 is untouched: RET + Chialvo–Sundaresan χ (+ its EKT part)."""
+def test_frictional_model_at_mu_zero_is_dense_bit_for_bit():
+    """One family (issue 33, item 2): μ = 0 gives φ_J(0) and the μ = 0 amplitude exactly and ζ0 untouched: ``dense``."""
     fr = get_model("frictional", mu=0.0)
     for e in (0.5, 0.7, 0.95, 1.0):  # e = 1 is allowed without friction
         assert _same_bits(fr.reduced(PHI, e), FRICTIONLESS.reduced(PHI, e))
@@ -44,9 +45,10 @@ def test_frictional_model_at_mu_zero_is_the_frictionless_model_bit_for_bit():
     a, b = steady_shear(fr, PHI, 0.7), steady_shear(FRICTIONLESS, PHI, 0.7)
     assert _same_bits(a._replace(Trot_over_T=0), b._replace(Trot_over_T=0))
     assert np.all(a.Trot_over_T == 0.0) and np.all(np.isnan(b.Trot_over_T))  # no rotation excited / not modelled
-    # and without the EKT part (its c is the one fitted number) the frictionless core is RET + CS13 χ
+    # and without the EKT part the frictionless core is RET + CS + a φ²/(φ_J(0) − φ)^b at the published φ_J(0)
+    core = JammingPowerLaw(a=DENSE_PARAMETERS["a"], phi_c=PHI_J0, exponent=DENSE_PARAMETERS["exponent"])
     assert _same_bits(get_model("frictional", mu=0.0, dissipation="none").reduced(PHI, 0.7),
-                      get_model("ret").replace(rdf=ChialvoSundaresan()).reduced(PHI, 0.7))
+                      get_model("ret").replace(rdf=core).reduced(PHI, 0.7))
 
 
 @pytest.mark.analytic
@@ -76,7 +78,8 @@ def test_friction_changes_only_the_dissipation_by_the_walton_factor():
 def test_mu_is_routed_to_the_friction_part_and_the_jamming_fraction():
     m = get_model("frictional", mu=0.1)
     assert m.friction.mu == 0.1 and m.rdf.mu == 0.1
-    assert m.phi_max == pytest.approx(0.595, abs=1e-12)  # φ_c(0.1), docs/friction.md §2
+    z = 4.0 + 2.0 / (1.0 + 0.1 / FRICTIONAL_PARAMETERS["mu_scale"])  # Z_J from 6 to 4 (Maxwell counting)
+    assert m.phi_max == pytest.approx(z / (z + 2.0 * 3.0**0.5), rel=1e-14)  # φ(Z) of Song, Wang & Makse (2008)
     assert get_model("frictional").friction.mu == 0.5  # registered default
     assert m.metadata()["friction"] == "coulomb" and '"friction"' in m.metadata()["model_options"]
 
@@ -90,7 +93,8 @@ def test_registered_model_is_its_documented_parts_checked_by_a_dilute_limit():
     φ²T → 25π η*/(13824 ζ0* F) and τ/p → √(3η*ζ0*F/2), p* → 1, where η*, ζ0* are the published φ = 0
     RET values of oracles.md (e = 0.7) and F comes from Walton's rule, which
     test_friction_collisions.py checks against a Monte Carlo of the collision rule.  Its RDF is the
-    published Chialvo–Sundaresan (2013) form, written out here, diverging at φ_c(0.5) = 0.565.
+    Chialvo–Sundaresan (2013) form, written out here with the fitted a, b, k and μ_Z, diverging at φ_J(0.5) of the
+    contact-number law, Z_J = 4 + 2/(1 + μ/μ_Z), φ_J = Z_J/(Z_J + 2√3).
     """
     m = get_model("frictional", mu=0.5)
     eta_star, zeta0_star = 1.147863, 0.212552  # oracles.md, RET at φ = 0, e = 0.7
@@ -103,7 +107,11 @@ def test_registered_model_is_its_documented_parts_checked_by_a_dilute_limit():
     assert s.tau_over_p[0] == pytest.approx(np.sqrt(1.5 * eta_star * zeta0_star * factor), rel=2e-5)
     assert s.p_over_nT[0] == pytest.approx(1.0, abs=1e-5)
     x = np.array([0.1, 0.3, 0.45, 0.55])
-    np.testing.assert_allclose(m.rdf.chi(x), (1 - x / 2) / (1 - x) ** 3 + 0.58 * x**2 / (0.565 - x) ** 1.5, rtol=1e-12)
+    mu_z, k = FRICTIONAL_PARAMETERS["mu_scale"], FRICTIONAL_PARAMETERS["amplitude_growth"]
+    z = 4.0 + 2.0 / (1.0 + 0.5 / mu_z)
+    phi_j, amp = z / (z + 2.0 * 3.0**0.5), DENSE_PARAMETERS["a"] * (1.0 + k * 0.5 / (0.5 + mu_z))
+    want = (1 - x / 2) / (1 - x) ** 3 + amp * x**2 / (phi_j - x) ** DENSE_PARAMETERS["exponent"]
+    np.testing.assert_allclose(m.rdf.chi(x), want, rtol=1e-12)
 
 
 @pytest.mark.contract
@@ -111,8 +119,8 @@ def test_registered_model_is_its_documented_parts_checked_by_a_dilute_limit():
     "options, field",
     [
         ({"mu": -0.1}, "mu"),
-        ({"stress": "schaeffer", "jj_phi_max": 0.6}, "jj_phi_max"),  # above φ_c(0.5) = 0.565
-        ({"stress": "schaeffer", "jj_phi_min": 0.58}, "jj_phi_min"),
+        ({"stress": "schaeffer", "jj_phi_max": 0.6}, "jj_phi_max"),  # above φ_J(0.5) = 0.5959
+        ({"stress": "schaeffer", "jj_phi_min": 0.6}, "jj_phi_min"),
         ({"blend": "tanh", "blend_phi_star": 0.6}, "blend_phi_star"),
         ({"blend": "tanh", "blend_phi_star": 0.5, "blend_width": 0.0}, "blend_width"),
         ({"blend": "sigmoid"}, "blend_phi_star"),
@@ -235,24 +243,36 @@ def test_friction_part_is_hashable_and_a_value():
 
 
 @pytest.mark.dem
-def test_the_fitted_constant_is_the_registered_one(data_dir):
-    """c of ``frictional`` is solved from T at μ = 0.5, φ = 0.5 of the shared file (the one fitted number)."""
-    c = fit_correlation_constant(read_friction_shear(data_dir / DEM_FILE))
-    assert c == pytest.approx(FRICTIONAL_C, abs=1e-4)
-    assert get_model("frictional").dissipation.c == FRICTIONAL_C
+def test_the_fitted_constants_are_the_registered_ones():
+    """μ_Z and k of ``frictional`` refit from the shipped μ = 0.5 uniform shear (a, b, c from the frictionless set)."""
+    step1 = fit_frictionless()
+    fit = fit_frictional(step1.values)
+    assert fit.success and fit.n_points == 21
+    for name, value in FRICTIONAL_PARAMETERS.items():
+        assert fit.values[name] == pytest.approx(value, rel=2e-4), name
+    rdf = get_model("frictional").rdf
+    assert (rdf.mu_scale, rdf.amplitude_growth) == (FRICTIONAL_PARAMETERS["mu_scale"], FRICTIONAL_PARAMETERS["amplitude_growth"])
 
 
 @pytest.mark.dem
-def test_dem_rows_within_15_percent_and_the_no_fit_variant_is_not(data_dir):
-    """The issue's goal on the shared file: T, p*, τ/p within 15 % at μ = 0.5 (T at φ = 0.5 is the fit, the other
-    five are predictions); without the fitted EKT part the φ = 0.5 row misses it (T −17 %, p* −23 %)."""
-    rows = [r for r in read_friction_shear(data_dir / DEM_FILE) if r["mu"] == 0.5]
+def test_frictional_pressure_within_ten_percent_at_mu_half_and_phi_j_alone_is_not_enough():
+    """Issue 33 goal for p/(nT) at μ = 0.5, φ 0.3–0.57 (the fit set of μ_Z, k); moving φ_J(μ) alone (k = 0, μ_Z
+    refit) misses it by more than 20 %, so the second parameter is needed and the test can fail."""
+    states = frictional_states()
+    s = steady_shear(get_model("frictional", mu=0.5), states["phi"], 0.7)
+    err = s.p_over_nT / states["p_over_nT"] - 1.0
+    assert np.all(np.abs(err) < 0.10), err
+    alone = fit_frictional(DENSE_PARAMETERS, states, hold={"amplitude_growth": 0.0})
+    assert np.max(np.abs(np.expm1(alone.residuals[1]))) > 0.20
 
-    def errs(m):
-        s = steady_shear(m, [r["phi"] for r in rows], 0.7)
-        return np.array([[getattr(s, q)[i] / r[q] - 1 for q in ("T", "p_star", "tau_over_p")] for i, r in enumerate(rows)])
 
-    fitted, plain = errs(get_model("frictional", mu=0.5)), errs(get_model("frictional", mu=0.5, dissipation="none"))
-    assert np.all(np.abs(fitted) < 0.15), fitted
-    assert abs(fitted[1, 0]) < 1e-3  # the fitted number
-    assert np.abs(plain[1]).max() > 0.2
+@pytest.mark.dem
+def test_nothing_refused_where_the_particles_flow():
+    """Issue 33 item 6: μ = 0.5, φ = 0.57 flows in the DEM (p* = 79): the model answers; above φ_J(μ) one line names it."""
+    m = get_model("frictional", mu=0.5)
+    assert m.phi_max > 0.57
+    assert np.isfinite(steady_shear(m, 0.57, 0.7).p_star)
+    with pytest.raises(InputError) as info:
+        steady_shear(m, 0.6, 0.7)
+    msg = str(info.value)
+    assert "\n" not in msg and "phi_J(mu=0.5)" in msg and f"{m.phi_max:.4g}" in msg

@@ -24,8 +24,8 @@ def _problem(model, mean_phi=0.5, e=0.9, spec=0.13, n=40):
 @pytest.mark.analytic
 def test_ekt_with_negligible_length_is_the_standard_residual():
     """c → 0 makes L = d everywhere: the residual is the standard theory's, bit for bit."""
-    base = _problem(get_model("dense"))
-    tiny = _problem(get_model("dense", dissipation="jenkins-berzi-2010", c=1e-12))
+    base = _problem(get_model("dense", dissipation="none"))
+    tiny = _problem(get_model("dense", c=1e-12))
     X = naive_start(base) + 0.01 * np.random.default_rng(0).standard_normal(3 * base.n)
     np.testing.assert_array_equal(base.residual(X), tiny.residual(X))
 
@@ -33,8 +33,8 @@ def test_ekt_with_negligible_length_is_the_standard_residual():
 @pytest.mark.analytic
 def test_ekt_reduces_the_dissipation_source_by_d_over_l():
     """γ = (3/2)φθζ0 at the nodes is divided by L/d = max(1, Λ s), s = |du/dy|/√θ (planar cell)."""
-    base = _problem(get_model("dense"), n=60)
-    ekt = _problem(get_model("dense", dissipation="jenkins-berzi-2010", c=3.0), n=60)
+    base = _problem(get_model("dense", dissipation="none"), n=60)
+    ekt = _problem(get_model("dense", c=3.0), n=60)
     X = naive_start(base)
     u, theta, phi = base.unpack(X)
     t0, t1 = base.terms(X), ekt.terms(X)
@@ -49,7 +49,7 @@ def test_ekt_reduces_the_dissipation_source_by_d_over_l():
 
 @pytest.mark.analytic
 def test_ekt_jacobian_matches_directional_derivatives():
-    pr = _problem(get_model("dense", dissipation="jenkins-berzi-2010", c=2.0))
+    pr = _problem(get_model("dense", c=2.0))
     rng = np.random.default_rng(2)
     X = naive_start(pr) + 0.05 * rng.standard_normal(3 * pr.n)
     J = pr.jacobian(X, pr.residual(X))

@@ -13,6 +13,7 @@ import time
 import numpy as np
 import pytest
 
+from ktgf import get_model
 from ktgf.couette.run import Material, to_dataset
 from ktgf.couette.solver import solve
 from ktgf.errors import InputError
@@ -88,7 +89,8 @@ def test_halving_the_regularisation_with_a_sliding_frictional_wall():
 
 @pytest.mark.contract
 def test_an_inventory_above_the_jamming_fraction_is_refused_in_one_line():
-    with pytest.raises(InputError, match=r"mean_phi = 0.6 is out of range: valid 0 < mean_phi < 0.565 .*no steady state") as e:
+    phi_j = get_model("frictional", mu=0.5).phi_max  # φ_J(0.5) of the model's jamming law
+    with pytest.raises(InputError, match=rf"mean_phi = 0.6 is out of range: valid 0 < mean_phi < {phi_j:.6g} .*no steady state") as e:
         frictional_wall_problem(0.5, 0.6, 25.0)
     assert "\n" not in str(e.value)
 

@@ -189,16 +189,12 @@ def test_docs_jamming_sensitivity_is_current(dem_rows):
 
 
 @pytest.mark.analytic
-def test_recommended_parts_reduce_to_the_frictionless_chialvo_sundaresan_model():
+def test_recommended_parts_reduce_to_the_dense_model():
     from ktgf.shear.compositions import recommended_parts
 
     phi = np.array([0.3, 0.5])
-    from ktgf.closures.dissipation import CorrelationLength
-    from ktgf.closures.friction.calibrated import FRICTIONAL_C
-
     rec = frictional_uniform_shear(recommended_parts(), phi, 0.7, 0.0)
-    frictionless = get_model("ret").replace(rdf=ChialvoSundaresan(), dissipation=CorrelationLength(c=FRICTIONAL_C))
-    ref = frictional_uniform_shear(FrictionalShearParts(frictionless), phi, 0.7, 0.0)
+    ref = frictional_uniform_shear(FrictionalShearParts(get_model("dense")), phi, 0.7, 0.0)
     for q in ("T", "p_star", "tau_over_p", "p_over_nT"):
         np.testing.assert_array_equal(getattr(rec, q), getattr(ref, q))
     np.testing.assert_array_equal(rec.Trot_over_T, 0.0)

@@ -117,8 +117,10 @@ def test_a_frictional_stress_that_vanishes_changes_nothing_but_round_off(scheme:
 
 # --- 3. uniform shear: the closed form of ktgf shear --mu ----------------------------------------------
 
-CASES = [({}, 0.4), ({}, 0.5), ({"stress": "schaeffer", "jj_phi_min": 0.45}, 0.5),
-         ({"stress": "srivastava-sundaresan", "jj_phi_min": 0.45}, 0.5)]
+# φ 0.52 with a stress: there the frictional part is most of the pressure (77 % with the refitted model, whose
+# φ_J(0.5) = 0.596; at φ 0.5 it is 47 %), so the test sees it
+CASES = [({}, 0.4), ({}, 0.5), ({"stress": "schaeffer", "jj_phi_min": 0.45}, 0.52),
+         ({"stress": "srivastava-sundaresan", "jj_phi_min": 0.45}, 0.52)]
 
 
 def _closed_form(m: Model, phi: float) -> tuple[float, float, float]:

@@ -1,25 +1,47 @@
-"""The fits behind the registered models' fitted constants (the constants themselves live in ``closures/``).
+"""The fits behind the registered ``dense`` and ``frictional`` models (the constants live in ``closures/``).
 
-* ``dense``: β of the viscosity-divergence RDF (:data:`ktgf.closures.dense.DENSE_BETA`) by
-  :func:`fit_rdf_option` on the frictionless DEM uniform shear (``docs/dense.md``);
-* ``frictional``: the EKT correlation-length constant c (:data:`ktgf.closures.friction.calibrated.FRICTIONAL_C`)
-  by :func:`fit_correlation_constant` on one row of the frictional DEM uniform shear (``docs/friction.md`` §6).
+One family for all μ (``docs/dense.md``, ``docs/friction.md``): RET × :class:`~ktgf.closures.jamming.
+FrictionalPowerLaw` χ (diverging at the contact-number φ_J(μ)) × the EKT correlation length × Walton's
+collision rule (β0 = 1) for μ > 0.  The parameters are chosen in two steps, on homogeneous flows only:
 
-Tests refit both from the shipped data and compare with the constants.  :data:`REGISTERED_FITS` says which
-data files and states each fit used (``ktgf validate`` marks those rows *fitted*): change it with the fits.
+1. :func:`fit_frictionless` — a, b of χ and c of the EKT length on the frictionless uniform shear
+   (``dem_uniform_shear.csv`` + ``dem_uniform_shear_extra.csv``, e = 0.9, φ 0.3–0.6);
+2. :func:`fit_frictional` — the friction scale μ_Z of φ_J(μ) and the amplitude growth k on the
+   frictional uniform shear at μ > 0 (``dem_uniform_shear_friction.csv`` + ``_extra``), the
+   frictionless parameters held.
+
+Residuals are the log-ratios model/DEM of T, p/(nT) and τ/p at every state.  :func:`leave_one_out`
+refits without each state in turn and predicts it (the error a user should quote).  The μ = 0, e = 0.7
+row of the frictional file and the Couette file are predictions, never fitted.  Tests refit from the
+shipped data and compare with the registered constants.  :data:`REGISTERED_FITS` says which data files
+and states each fit used (``ktgf validate`` marks those rows *fitted*): change it with the fits.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..closures.friction.calibrated import FIT_ROW
-from ..closures.models import get_model
-from ..closures.rdf import ViscosityDivergence
+from ..closures.dissipation import CorrelationLength
+from ..closures.friction.model_slot import Friction
+from ..closures.garzo_dufty1999 import GarzoDufty1999
+from ..closures.jamming import CoordinationJamming, FrictionalPowerLaw
+from ..closures.models import Model
+from ..data import (
+    FRICTION_SHEAR,
+    FRICTION_SHEAR_EXTRA,
+    UNIFORM_SHEAR,
+    UNIFORM_SHEAR_EXTRA,
+    read_friction_shear,
+    shipped,
+    uniform_shear_records,
+)
+from ..errors import InputError
 from ..shear.steady import steady_shear
 
 
@@ -32,46 +54,195 @@ class FitSource:
     sha256: str = ""
 
 
-#: What the registered fitted models were fitted to (their docstrings and docs/dense.md, docs/friction.md):
-#: ``dense`` — β on both rows of dem_uniform_shear.csv (φ 0.3, 0.5; e 0.9); ``frictional`` — the EKT
-#: constant c on T of the row μ = 0.5, φ = 0.5 of dem_uniform_shear_friction.csv.  The other registered
-#: models have published parameters only: every row is a prediction.  Update this with the models.
+#: The μ = 0.5 rows (μ, φ, e) of the base and extra frictional files (the base file's μ = 0, e = 0.7 row is a
+#: prediction); ``tests/calibration/test_calibration_validate.py`` checks them against the files.
+_MU_HALF_BASE = ((0.5, 0.4, 0.7), (0.5, 0.5, 0.7))
+_MU_HALF_EXTRA = ((0.5, 0.3, 0.7), (0.5, 0.45, 0.7), (0.5, 0.52, 0.7), (0.5, 0.55, 0.7), (0.5, 0.57, 0.7))
+#: What the registered fitted models were fitted to (docs/dense.md §3, docs/friction.md §6.0): ``dense`` — a, b, c
+#: on every state of the frictionless uniform shear (base + extra); ``frictional`` — those, and μ_Z, k on every
+#: μ = 0.5 state of the frictional uniform shear (base + extra).  The other registered models have published
+#: parameters only: every row is a prediction.  Update this with the fits.
 REGISTERED_FITS: dict[str, tuple[FitSource, ...]] = {
-    "dense": (FitSource("dem_uniform_shear.csv"),),
-    "frictional": (FitSource("dem_uniform_shear_friction.csv", ((0.5, 0.5, 0.7),)),),
+    "dense": (FitSource(UNIFORM_SHEAR), FitSource(UNIFORM_SHEAR_EXTRA)),
+    "frictional": (FitSource(UNIFORM_SHEAR), FitSource(UNIFORM_SHEAR_EXTRA),
+                   FitSource(FRICTION_SHEAR, _MU_HALF_BASE), FitSource(FRICTION_SHEAR_EXTRA, _MU_HALF_EXTRA)),
 }
 
+#: Observables compared at every state (log-ratio residuals).
+OBSERVABLES: tuple[str, ...] = ("T", "p_over_nT", "tau_over_p")
+#: Frictionless parameters (step 1) with their starts and bounds.
+FRICTIONLESS_PARAMETERS = {"a": (0.3, 0.0, 5.0), "exponent": (1.5, 0.5, 4.0), "c": (1.0, 0.05, 5.0)}
+#: Frictional parameters (step 2): μ_Z's lower bound is raised to keep every fitted state below φ_J(μ).
+FRICTIONAL_PARAMETERS = {"mu_scale": (0.6, 0.01, 50.0), "amplitude_growth": (3.0, 0.0, 100.0)}
 
-def relative_errors(model: Any, rows: np.ndarray) -> np.ndarray:
-    """[η*/η*_DEM − 1, p*/p*_DEM − 1] for every DEM row (Navier–Stokes uniform shear)."""
-    r = model.reduced(rows["phi"], rows["e"])
-    eta = np.broadcast_to(np.asarray(r.eta, dtype=float), rows.shape)
-    p = np.broadcast_to(np.asarray(r.p, dtype=float), rows.shape)
-    return np.concatenate([eta / rows["eta_over_eta0"] - 1.0, p / rows["p_over_nT"] - 1.0])
 
+def frictionless_states(paths: tuple[Any, ...] | None = None) -> dict[str, np.ndarray]:
+    """The frictionless uniform-shear states (base + extra file), with τ/p from the DEM's own columns.
 
-def fit_rdf_option(base: Any, rows: np.ndarray, option: str = "beta", *, start: float = 1.75,
-                   bounds: tuple[float, float] = (1.0, 8.0)) -> tuple[float, Any]:
-    """Least-squares value of one option of the viscosity-divergence RDF with ``base``'s theory on DEM ``rows``.
-
-    Returns (value, scipy result); the RDF's other options keep their published values.
+    τ/p = η* (5/16)√(T/π) / (p* (6φ/π) T) in the files' units (d = m = 1).
     """
-    def residual(x: np.ndarray) -> np.ndarray:
-        return relative_errors(base.replace(rdf=ViscosityDivergence(**{option: float(x[0])})), rows)
+    paths = paths or (shipped(UNIFORM_SHEAR), shipped(UNIFORM_SHEAR_EXTRA))
+    rows = np.concatenate([uniform_shear_records(p) for p in paths])
+    rows = rows[np.argsort(rows["phi"], kind="stable")]
+    tau = rows["eta_over_eta0"] * (5.0 / 16.0) * np.sqrt(rows["T"] / math.pi)
+    p = rows["p_over_nT"] * (6.0 * rows["phi"] / math.pi) * rows["T"]
+    return {"mu": np.zeros(rows.size), "phi": rows["phi"].astype(float), "e": rows["e"].astype(float),
+            "T": rows["T"].astype(float), "p_over_nT": rows["p_over_nT"].astype(float), "tau_over_p": tau / p}
 
-    sol = least_squares(residual, [start], bounds=([bounds[0]], [bounds[1]]), xtol=1e-12)
-    return float(sol.x[0]), sol
+
+def frictional_states(paths: tuple[Any, ...] | None = None, *, frictional_only: bool = True) -> dict[str, np.ndarray]:
+    """The frictional uniform-shear states (base + extra file); μ > 0 only unless ``frictional_only=False``."""
+    paths = paths or (shipped(FRICTION_SHEAR), shipped(FRICTION_SHEAR_EXTRA))
+    recs = [r for p in paths for r in read_friction_shear(p) if r["mu"] > 0.0 or not frictional_only]
+    recs.sort(key=lambda r: (r["mu"], r["e"], r["phi"]))
+    out = {k: np.array([r[k] for r in recs], dtype=float) for k in ("mu", "phi", "e", "T", "tau_over_p", "Trot_over_T")}
+    out["p_over_nT"] = np.array([r["p_star"] / (r["phi"] * r["T"]) for r in recs])
+    return out
 
 
-def fit_correlation_constant(rows: list[dict[str, float]], base: Any = None) -> float:
-    """c such that the model's uniform-shear T equals the DEM's at :data:`FIT_ROW` (Brent's method on [0.3, 2])."""
-    from scipy.optimize import brentq
+def subset(states: dict[str, np.ndarray], keep: Any) -> dict[str, np.ndarray]:
+    """The states selected by a boolean mask or index array."""
+    return {k: v[keep] for k, v in states.items()}
 
-    row = next(r for r in rows if (r["mu"], r["phi"]) == FIT_ROW)
-    base = base or get_model("frictional")
 
-    def miss(c: float) -> float:
-        m = base.with_options(mu=row["mu"], dissipation="jenkins-berzi-2010", c=c)
-        return float(steady_shear(m, row["phi"], row["e"]).T) / row["T"] - 1.0
+def family_model(name: str = "family", *, mu: float = 0.0, a: float, exponent: float, c: float, mu_scale: float = 0.1,
+                 amplitude_growth: float = 0.0) -> Model:
+    """The one family at friction μ: RET × FrictionalPowerLaw χ × EKT length (c) × Walton (β0 = 1) if μ > 0."""
+    rdf = FrictionalPowerLaw(mu=mu, a=a, exponent=exponent, mu_scale=mu_scale, amplitude_growth=amplitude_growth)
+    model = Model(name, GarzoDufty1999(), rdf, dissipation=CorrelationLength(c=c))
+    return model.replace(friction=Friction(mu=mu, restitution="walton", beta0=1.0)) if mu > 0.0 else model
 
-    return float(brentq(miss, 0.3, 2.0, xtol=1e-12))
+
+def predict(params: dict[str, float], states: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """T, p/(nT), τ/p of the family with ``params`` at every state (grouped by (μ, e))."""
+    out = {k: np.empty(states["phi"].size) for k in OBSERVABLES}
+    for mu, e in sorted(set(zip(states["mu"].tolist(), states["e"].tolist()))):
+        idx = np.flatnonzero((states["mu"] == mu) & (states["e"] == e))
+        s = steady_shear(family_model(mu=mu, **params), states["phi"][idx], e)
+        for k in OBSERVABLES:
+            out[k][idx] = np.broadcast_to(getattr(s, k), idx.shape)
+    return out
+
+
+def log_errors(params: dict[str, float], states: dict[str, np.ndarray]) -> np.ndarray:
+    """ln(model/DEM) of T, p/(nT), τ/p, shape (3, n_states)."""
+    pred = predict(params, states)
+    return np.array([np.log(pred[k] / states[k]) for k in OBSERVABLES])
+
+
+@dataclass(frozen=True)
+class Fit:
+    """A least-squares fit: values, standard errors, correlation, residuals (log-ratios, shape (3, n))."""
+
+    names: tuple[str, ...]
+    values: dict[str, float]
+    stderr: dict[str, float]
+    correlation: np.ndarray
+    residuals: np.ndarray
+    n_points: int
+    success: bool
+
+    @property
+    def points_per_parameter(self) -> float:
+        return self.n_points / len(self.names)
+
+
+def _least_squares(residual: Callable[[np.ndarray], np.ndarray], names: tuple[str, ...], start: list[float],
+                   lower: list[float], upper: list[float]) -> tuple[Any, np.ndarray, np.ndarray]:
+    sol = least_squares(residual, start, bounds=(lower, upper), x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    J = sol.jac
+    dof = max(sol.fun.size - len(names), 1)
+    cov = np.linalg.pinv(J.T @ J) * (2.0 * sol.cost / dof)
+    sd = np.sqrt(np.diag(cov))
+    return sol, cov, sd
+
+
+def _free(table: dict[str, tuple[float, float, float]], hold: dict[str, float]) -> tuple[tuple[str, ...], list, list, list]:
+    names = tuple(k for k in table if k not in hold)
+    start, lower, upper = (list(v) for v in zip(*(table[k] for k in names)))
+    return names, start, lower, upper
+
+
+def fit_frictionless(states: dict[str, np.ndarray] | None = None, *, hold: dict[str, float] | None = None) -> Fit:
+    """Step 1: a, b (χ) and c (EKT) on frictionless uniform shear (default: the shipped e = 0.9 set).
+
+    ``hold`` keeps some of them at given values (e.g. ``{"exponent": 1.5}``, Chialvo & Sundaresan's).
+    """
+    states = frictionless_states() if states is None else states
+    hold = dict(hold or {})
+    names, start, lower, upper = _free(FRICTIONLESS_PARAMETERS, hold)
+
+    def params(x: np.ndarray) -> dict[str, float]:
+        return {**hold, **dict(zip(names, x))}
+
+    sol, cov, sd = _least_squares(lambda x: log_errors(params(x), states).ravel(), names, start, lower, upper)
+    return _result(names, sol, cov, sd, states, params)
+
+
+def _lowest_mu_scale(states: dict[str, np.ndarray]) -> float:
+    """The μ_Z below which φ_J(μ) would fall under a fitted state's φ (the data say those states flow)."""
+    law = CoordinationJamming()
+    worst = 0.0
+    for mu in np.unique(states["mu"]):
+        phi = float(states["phi"][states["mu"] == mu].max())
+        z = 2.0 * math.sqrt(3.0) * phi / (1.0 - phi)  # Z at φ, law's inverse
+        share = (law.z_frictionless - z) / (law.z_frictionless - law.z_infinite)  # s(μ) that puts φ_J at φ
+        if share <= 0.0:
+            return math.inf
+        worst = max(worst, float(mu) * (1.0 - share) / share)
+    return worst
+
+
+def fit_frictional(frictionless: dict[str, float], states: dict[str, np.ndarray] | None = None, *,
+                   hold: dict[str, float] | None = None) -> Fit:
+    """Step 2: μ_Z and k (Eq. 2 of :class:`~ktgf.closures.jamming.FrictionalPowerLaw`) at μ > 0, step 1 held.
+
+    ``hold`` keeps one of them at a given value (e.g. ``{"amplitude_growth": 0.0}``: φ_J(μ) alone).
+    """
+    states = frictional_states() if states is None else states
+    hold = dict(hold or {})
+    names, start, lower, upper = _free(FRICTIONAL_PARAMETERS, hold)
+    if "mu_scale" in names:
+        lower[0] = max(lower[0], _lowest_mu_scale(states) * (1.0 + 1e-6) + 1e-9)
+        start[0] = min(max(start[0], lower[0] * 1.5), upper[0])
+    base = {**{k: frictionless[k] for k in FRICTIONLESS_PARAMETERS}, **hold}
+
+    def params(x: np.ndarray) -> dict[str, float]:
+        return {**base, **dict(zip(names, x))}
+
+    sol, cov, sd = _least_squares(lambda x: log_errors(params(x), states).ravel(), names, start, lower, upper)
+    return _result(names, sol, cov, sd, states, params)
+
+
+def _result(names: tuple[str, ...], sol: Any, cov: np.ndarray, sd: np.ndarray, states: dict[str, np.ndarray],
+            params: Callable[[np.ndarray], dict[str, float]]) -> Fit:
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(sd, sd)
+    return Fit(names, {n: float(v) for n, v in zip(names, sol.x)}, {n: float(s) for n, s in zip(names, sd)}, corr,
+               log_errors(params(sol.x), states), int(sol.fun.size), bool(sol.success))
+
+
+def leave_one_out(fit: Callable[[dict[str, np.ndarray]], dict[str, float]],
+                  states: dict[str, np.ndarray]) -> np.ndarray:
+    """Relative errors (model/DEM − 1) of T, p/(nT), τ/p at each state, predicted by a fit without it.
+
+    ``fit(states)`` returns the full parameter dict of the family.  Shape (3, n_states); a state the
+    refit cannot predict (above its φ_J(μ)) is NaN.
+    """
+    n = states["phi"].size
+    out = np.full((len(OBSERVABLES), n), np.nan)
+    for i in range(n):
+        params = fit(subset(states, np.arange(n) != i))
+        try:
+            out[:, i] = np.expm1(log_errors(params, subset(states, [i]))[:, 0])
+        except InputError:  # refused: the left-out φ lies above the refit's φ_J(μ); stays NaN
+            continue
+    return out
+
+
+def registered_parameters() -> dict[str, float]:
+    """The registered family's parameters (from :mod:`ktgf.closures.dense` and ``closures/friction/calibrated``)."""
+    from ..closures.dense import DENSE_PARAMETERS
+    from ..closures.friction.calibrated import FRICTIONAL_PARAMETERS as FRICTIONAL
+
+    return {**DENSE_PARAMETERS, **FRICTIONAL}

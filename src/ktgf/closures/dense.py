@@ -1,19 +1,22 @@
-"""The recommended dense model ``dense``: RET with the viscosity-divergence RDF, divergence exponent fitted.
+"""The fitted numbers of the recommended dense model ``dense`` (the frictionless member of one family for all μ).
 
-Composition (``docs/dense.md``): Garzó & Dufty (1999) RET (model.md §3) × the viscosity-divergence
-RDF of model.md §2 (φ_f = 0.49, φ_c = 0.64 as published, smooth junction) with its exponent β
-fitted to the frictionless DEM uniform shear at e = 0.9 (``shared/data/dem_uniform_shear.csv``,
-φ = 0.3 and 0.5): least squares on the relative errors of η/η0 and p/(nT) of the Navier–Stokes
-closed forms (:mod:`ktgf.shear.steady`).  The e = 0.7 frictionless row of
-``dem_uniform_shear_friction.csv`` and the Couette file are predictions, not fitted.
+Composition (``docs/dense.md``): Garzó & Dufty (1999) RET (model.md §3) × the χ of
+:class:`~ktgf.closures.jamming.FrictionalPowerLaw` — Carnahan–Starling plus the Chialvo–Sundaresan
+(2013) jamming term a φ²/(φ_J − φ)^b, diverging at the published frictionless jamming fraction
+φ_J(0) = 6/(6 + 2√3) = 0.634 of the contact-number law (not fitted) — × the extended-kinetic-theory
+correlation length ``jenkins-berzi-2010`` (:mod:`ktgf.closures.dissipation`) with constant c.
 
-Only one parameter is fitted: the two φ of the file fix χ(0.5) and nothing else, so fitting φ_f
-instead of β gives the same uniform-shear residuals (both are in ``docs/dense.md``); the two
-differ where the Couette core goes beyond φ = 0.5, and there the β fit predicts the DEM wall
-stresses (the one use of the Couette file: choosing which single parameter to fit).
+a, b and c are fitted together (:func:`ktgf.calibration.registry_fits.fit_frictionless`: log-ratios of
+T, p/(nT) and τ/p) on the frictionless DEM uniform shear at e = 0.9, φ 0.3–0.6
+(``dem_uniform_shear.csv`` + ``dem_uniform_shear_extra.csv``: 7 states, 21 points, 7 per parameter).
+The μ = 0, e = 0.7 row of the frictional file and the Couette file are predictions, not fitted.
+Why b is fitted and not kept at Chialvo & Sundaresan's 1.5: at the published φ_J(0) = 0.634 the DEM's
+own excess of χ over Carnahan–Starling rises with a local exponent of 1.9–2.2 between neighbouring
+states; b = 1.5 fits only with φ_J(0) moved to 0.623, below the published frictionless value
+(``docs/dense.md`` §2 has both fits and their cross-validated errors).
 """
 
 from __future__ import annotations
 
-#: β of ``dense``, from :func:`ktgf.calibration.registry_fits.fit_rdf_option` on ``dem_uniform_shear.csv`` (docs/dense.md).
-DENSE_BETA = 4.052
+#: a, b of χ and c of the EKT length, from :func:`ktgf.calibration.registry_fits.fit_frictionless` (docs/dense.md).
+DENSE_PARAMETERS: dict[str, float] = {"a": 0.1238, "exponent": 1.9102, "c": 0.8861}

@@ -37,6 +37,9 @@ but Carnahan–Starling, the Bocquet viscosity law) to φ_J(μ) of a law; :func:
 refuses a state at or above φ_J(μ) with one line naming it; :func:`mu_scale_for` gives the μ scale
 of the two one-parameter laws that puts φ_J(μ) at a given value (to take a printed or calibrated
 point).
+
+:class:`FrictionalPowerLaw` is the RDF of the registered ``dense`` and ``frictional`` models: the
+Chialvo–Sundaresan form diverging at the contact-number φ_J(μ).
 """
 
 from __future__ import annotations
@@ -52,6 +55,7 @@ from .._array import namespace
 from ..errors import InputError
 from .friction._part import FrictionPart, check_friction_coefficient, check_range
 from .friction.jamming import JammingFraction, with_jamming_fraction
+from .rdf import RadialDistribution, jamming_power_chi, jamming_power_dchi
 
 #: 2√3, the constant of the mean-field volume function φ = Z/(Z + 2√3) (Song, Wang & Makse 2008).
 TWO_SQRT3 = 2.0 * math.sqrt(3.0)
@@ -257,3 +261,85 @@ def mu_scale_for(law: Any, mu: float, phi_j: float) -> float:
     check_range("target jamming fraction phi_j", phi_j, low=float(lo), high=float(hi), low_open=True, high_open=True,
                 why=f"between the limits of {_describe(law)}")
     return float(mu / (b / (x - a) - 1.0))
+
+
+@dataclass(frozen=True)
+class FrictionalPowerLaw(RadialDistribution):
+    """χ = χ_CS + a(μ) φ²/(φ_J(μ) − φ)^b: the Chialvo–Sundaresan form diverging at the contact-number φ_J(μ).
+
+    The form of Chialvo & Sundaresan, Phys. Fluids 25, 070603 (2013) (their a = 0.58, b = 1.5 for
+    frictionless spheres; :class:`~ktgf.closures.rdf.JammingPowerLaw`), with the divergence at φ_J(μ) of
+    :class:`CoordinationJamming` (φ_J(0) = 6/(6 + 2√3) = 0.634, φ_J(∞) = 4/(4 + 2√3) = 0.536) and an
+    amplitude that grows with friction on the same scale μ_Z as the contact number:
+
+        a(μ) = a (1 + k s(μ)),     s(μ) = μ/(μ + μ_Z) = (Z_0 − Z_J(μ))/(Z_0 − Z_∞)                   (2)
+
+    s goes from 0 (frictionless) to 1 (μ → ∞), so at μ = 0 the amplitude is a and φ_J is φ_J(0) exactly
+    (one family for all μ: the registered ``dense`` is this RDF at μ = 0).  a, b, μ_Z and k are
+    calibration parameters of the registered models (``docs/dense.md``, ``docs/friction.md``); the form of
+    a(μ) between μ = 0 and the one frictional μ of the shared data (0.5) is our choice, not a fit.
+
+    Parameters
+    ----------
+    mu : float
+        Particle friction coefficient (≥ 0).
+    a, exponent : float
+        Amplitude at μ = 0 and divergence exponent b (defaults: Chialvo & Sundaresan's 0.58 and 1.5).
+    mu_scale : float
+        μ_Z of the contact-number law (default 0.1).
+    amplitude_growth : float
+        k of Eq. (2) (≥ 0; default 0: the amplitude does not depend on μ).
+    """
+
+    mu: float = 0.0
+    a: float = 0.58
+    exponent: float = 1.5
+    mu_scale: float = 0.1
+    amplitude_growth: float = 0.0
+    key: ClassVar[str] = "frictional-power-law"
+    label: ClassVar[str] = "CS + power law at φ_J(μ)"
+    reference: ClassVar[str] = ("Chialvo & Sundaresan, Phys. Fluids 25, 070603 (2013) (form); φ_J(μ): "
+                                "ktgf.closures.jamming.CoordinationJamming")
+
+    def __post_init__(self) -> None:
+        from .options import real_option
+
+        check_friction_coefficient(self.mu)
+        owner = f"RDF {self.key}"
+        real_option("a", self.a, owner=owner, low=0.0, low_open=False, why="amplitude")
+        real_option("exponent", self.exponent, owner=owner, low=0.0, high=10.0, low_open=True,
+                    why="divergence exponent, at most 10")
+        real_option("amplitude_growth", self.amplitude_growth, owner=owner, low=0.0, low_open=False, why="k of a(mu) = a (1 + k s(mu))")
+        _ = self.jamming_law  # validates mu_scale
+
+    @property
+    def jamming_law(self) -> CoordinationJamming:
+        """The model's one φ_J(μ) (every divergence of the model uses it)."""
+        return CoordinationJamming(mu_scale=self.mu_scale)
+
+    @property
+    def friction_share(self) -> Any:
+        """s(μ) = μ/(μ + μ_Z) of Eq. (2): 0 frictionless, 1 as μ → ∞."""
+        return self.mu / (self.mu + self.mu_scale)
+
+    @property
+    def amplitude(self) -> Any:
+        """a(μ) of Eq. (2) (a itself at μ = 0)."""
+        return self.a * (1.0 + self.amplitude_growth * self.friction_share)
+
+    @property
+    def phi_c(self) -> Any:
+        """φ_J(μ) of :attr:`jamming_law`, where χ diverges (written out so that fitted options may be JAX values)."""
+        law = CoordinationJamming
+        z = law.z_infinite + (law.z_frictionless - law.z_infinite) / (1.0 + self.mu / self.mu_scale)
+        return packing_fraction_of_coordination(z)
+
+    @property
+    def phi_max(self) -> float:
+        return float(self.phi_c)
+
+    def chi(self, phi: Any) -> Any:
+        return jamming_power_chi(phi, self.amplitude, self.phi_c, self.exponent)
+
+    def dchi(self, phi: Any) -> Any:
+        return jamming_power_dchi(phi, self.amplitude, self.phi_c, self.exponent)

@@ -17,12 +17,12 @@ visc-div    Lun et al. (1984)     Torquato                   Bocquet et al. dive
 proposed    Garzó & Dufty (1999)  viscosity-divergence RDF   theory's own
 =========== ===================== ========================== ==========================
 
-and the recommended dense model ``dense`` (``docs/dense.md``): RET with the viscosity-divergence
-RDF whose divergence exponent β is fitted to the DEM uniform shear (:mod:`ktgf.closures.dense`), and
-the recommended model for frictional particles ``frictional`` (``docs/friction.md``): RET with the
-Chialvo–Sundaresan RDF diverging at the frictional jamming fraction φ_c(μ), Walton's collision rule
-(:mod:`ktgf.closures.friction.model_slot`) and the EKT correlation length whose constant c is the one
-number fitted (to T of one row of the frictional DEM file, :mod:`ktgf.closures.friction.calibrated`).
+and one recommended family for all friction coefficients μ (``docs/dense.md``, ``docs/friction.md``):
+RET × Carnahan–Starling plus a Chialvo–Sundaresan jamming term diverging at the contact-number
+φ_J(μ) (:class:`~ktgf.closures.jamming.FrictionalPowerLaw`) × the EKT correlation length, with
+Walton's collision rule for μ > 0 — ``dense`` is its member at μ = 0 (a, b, c fitted to frictionless
+DEM uniform shear, :mod:`ktgf.closures.dense`), ``frictional`` the member at μ (default 0.5; μ_Z and k
+fitted to frictional DEM uniform shear, :mod:`ktgf.closures.friction.calibrated`).
 """
 
 from __future__ import annotations
@@ -38,10 +38,10 @@ from .coefficients import Dimensional, Reduced, to_dimensional
 from .garzo_dufty1999 import GarzoDufty1999
 from .lun1984 import Lun1984
 from .rdf import CarnahanStarling, RadialDistribution, Torquato, ViscosityDivergence
-from .dense import DENSE_BETA
+from .dense import DENSE_PARAMETERS
 from .dissipation import DISSIPATIONS, CorrelationLength, NoDissipationCorrection
-from .friction.calibrated import FRICTIONAL_C
-from .friction.jamming import FrictionalChialvoSundaresan
+from .friction.calibrated import FRICTIONAL_PARAMETERS
+from .jamming import FrictionalPowerLaw, check_below_jamming
 from .friction.model_slot import FRICTIONS, Friction, NoFriction
 from .viscosity_divergence import NoViscosityCorrection, ViscosityDivergenceLaw
 
@@ -124,6 +124,9 @@ class Model:
         for name, value in (("solid fraction phi", phi), ("restitution coefficient e", e)):
             if value is None:
                 raise InputError(f"{name} is missing (None); give a number or an array")
+        law = getattr(self.rdf, "jamming_law", None)
+        if law is not None:  # name the model's jamming fraction phi_J(mu) (issue 33, item 6)
+            check_below_jamming(phi, self.rdf.mu, law)
         check_state(phi, e, theta, phi_max=self.phi_max, rdf_name=self.rdf.describe())
         self.friction.check_state(e)
 
@@ -334,15 +337,23 @@ register_model(
         description="RET with the radial distribution function derived from the viscosity divergence",
     ),
 )
+def _family_rdf(mu: float) -> FrictionalPowerLaw:
+    """The χ of the registered family at friction μ (``dense`` is μ = 0)."""
+    return FrictionalPowerLaw(mu=mu, a=DENSE_PARAMETERS["a"], exponent=DENSE_PARAMETERS["exponent"],
+                              **FRICTIONAL_PARAMETERS)
+
+
 register_model(
     Model(
         "dense",
         GarzoDufty1999(),
-        ViscosityDivergence(beta=DENSE_BETA),
+        _family_rdf(0.0),
+        dissipation=CorrelationLength(c=DENSE_PARAMETERS["c"]),
         label="Dense",
         description=(
-            "Recommended for dense flows: RET with the viscosity-divergence RDF, exponent beta fitted to "
-            "DEM uniform shear (docs/dense.md)"
+            "Recommended for dense flows: RET, Carnahan-Starling + Chialvo-Sundaresan jamming term diverging at "
+            "phi_J(0) = 0.634, EKT correlation length; a, b, c fitted to DEM uniform shear (docs/dense.md); "
+            "'frictional' at mu = 0"
         ),
     ),
 )
@@ -350,14 +361,14 @@ register_model(
     Model(
         "frictional",
         GarzoDufty1999(),
-        FrictionalChialvoSundaresan(mu=0.5),
-        dissipation=CorrelationLength(c=FRICTIONAL_C),
+        _family_rdf(0.5),
+        dissipation=CorrelationLength(c=DENSE_PARAMETERS["c"]),
         friction=Friction(mu=0.5, restitution="walton", beta0=1.0),
         label="Frictional",
         description=(
-            "Recommended for frictional particles (default mu = 0.5; option mu): RET, Chialvo-Sundaresan RDF "
-            "diverging at phi_c(mu), Walton's collision rule with beta0 = 1, EKT correlation length with c fitted "
-            "to T of one row of the frictional DEM file (docs/friction.md)"
+            "Recommended for frictional particles (default mu = 0.5; option mu): 'dense' with Walton's collision "
+            "rule (beta0 = 1), the divergence at the contact-number phi_J(mu) and a friction-grown jamming "
+            "amplitude; mu_Z and k fitted to frictional DEM uniform shear (docs/friction.md); mu = 0 is 'dense'"
         ),
     ),
 )

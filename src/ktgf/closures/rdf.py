@@ -255,6 +255,18 @@ class MaAhmadi(_DivergesAtPhiC):
         return dnum / den**a - a * num * dden / den ** (a + 1.0)
 
 
+def jamming_power_chi(phi: Any, a: Any, phi_c: Any, b: Any) -> Any:
+    """χ_CS + a φ²/(φ_c − φ)^b (pure: any of the arguments may be a JAX value)."""
+    # (2 − φ)/(2(1 − φ)³) in Chialvo & Sundaresan is the Carnahan–Starling χ written differently.
+    return _cs_chi(phi) + a * phi**2 / power(phi_c - phi, b)
+
+
+def jamming_power_dchi(phi: Any, a: Any, phi_c: Any, b: Any) -> Any:
+    """dχ/dφ of :func:`jamming_power_chi`."""
+    gap = phi_c - phi
+    return _cs_dchi(phi) + a * (2.0 * phi / power(gap, b) + b * phi**2 / power(gap, b + 1.0))
+
+
 @dataclass(frozen=True)
 class JammingPowerLaw(_DivergesAtPhiC):
     """Carnahan–Starling plus a jamming divergence of free exponent: χ = χ_CS + a φ²/(φ_c − φ)^b.
@@ -283,13 +295,10 @@ class JammingPowerLaw(_DivergesAtPhiC):
         _check_exponent("exponent", self.exponent, self.key)
 
     def chi(self, phi: Any) -> Any:
-        # (2 − φ)/(2(1 − φ)³) in Chialvo & Sundaresan is the Carnahan–Starling χ written differently.
-        return _cs_chi(phi) + self.a * phi**2 / power(self.phi_c - phi, self.exponent)
+        return jamming_power_chi(phi, self.a, self.phi_c, self.exponent)
 
     def dchi(self, phi: Any) -> Any:
-        gap = self.phi_c - phi
-        b = self.exponent
-        return _cs_dchi(phi) + self.a * (2.0 * phi / power(gap, b) + b * phi**2 / power(gap, b + 1.0))
+        return jamming_power_dchi(phi, self.a, self.phi_c, self.exponent)
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ..closures.friction.calibrated import FRICTIONAL_C
+from ..closures.friction.calibrated import FRICTIONAL_PARAMETERS
 from ..data import FRICTION_SHEAR as DEM_FILE, read_friction_shear
 from ..plotting.shear import plot_frictional_shear
 from ..shear.steady import steady_shear
@@ -84,12 +84,13 @@ def errors(rows: list[dict[str, float]]) -> dict[str, list[dict[str, float]]]:
 
 def run(ctx: SectionContext) -> None:
     ctx.paragraph(
-        "Granules and powders are frictional (μ ≈ 0.3–0.5). The recommended model for them, 'frictional' (RET with the "
-        "Chialvo–Sundaresan radial distribution function diverging at the frictional jamming fraction φ_c(μ), Walton's "
-        "collision rule for the dissipation and the extended-kinetic-theory correlation length, whose constant c = "
-        f"{FRICTIONAL_C:g} is the one number fitted — to T of the row μ = 0.5, φ = 0.5; docs/friction.md) is compared here with "
-        "uniform shear of frictional spheres, with frictionless RET as the baseline. At μ = 0 the frictional model is its "
-        "frictionless composition (RET, Chialvo–Sundaresan χ, the same correlation length), bit for bit."
+        "Granules and powders are frictional (μ ≈ 0.3–0.5). The recommended model for them, 'frictional', is the "
+        "recommended 'dense' model (RET, Carnahan–Starling plus a Chialvo–Sundaresan jamming term, the extended-kinetic-"
+        "theory correlation length) with Walton's collision rule for the dissipation, its divergence moved to the "
+        "contact-number jamming fraction φ_J(μ) and its jamming amplitude grown with friction; the two friction numbers "
+        f"(μ_Z = {FRICTIONAL_PARAMETERS['mu_scale']:g}, k = {FRICTIONAL_PARAMETERS['amplitude_growth']:g}) are fitted to the "
+        "μ = 0.5 uniform shear (docs/friction.md). It is compared here with uniform shear of frictional spheres, with "
+        "frictionless RET as the baseline. At μ = 0 the frictional model is 'dense', bit for bit."
     )
     ds = curves(ctx.settings.dense_points)
     path = ctx.data_file(DEM_FILE)

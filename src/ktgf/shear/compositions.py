@@ -86,8 +86,8 @@ class FrictionalShearParts:
         """The closure model at friction coefficient μ: its RDF's divergence moved to φ_c(μ)."""
         check_friction_coefficient(mu)
         rdf = self.model.rdf
-        if isinstance(rdf, FrictionalChialvoSundaresan):
-            return self.model.replace(rdf=dataclasses.replace(rdf, mu=float(mu)))
+        if isinstance(rdf, FrictionalChialvoSundaresan) or "mu" in {f.name for f in dataclasses.fields(rdf)}:
+            return self.model.replace(rdf=dataclasses.replace(rdf, mu=float(mu)))  # the RDF carries its own φ_J(μ)
         if "phi_c" in {f.name for f in dataclasses.fields(rdf)}:
             jam = dataclasses.replace(self.jamming, phi_rcp=float(rdf.phi_c))
             return self.model.replace(rdf=with_jamming_fraction(rdf, float(mu), jam))
@@ -148,9 +148,9 @@ def mu_i_uniform_shear(rheology: Any, dilatancy: Any, phi: Any) -> ShearState:
 def recommended_parts(theory: str = "ret") -> FrictionalShearParts:
     """The registered ``frictional`` composition as parts (``docs/friction.md`` §6), with another theory if asked.
 
-    ``theory`` (RET by default) with the Chialvo–Sundaresan χ diverging at φ_c(μ), the EKT correlation
-    length of ``frictional`` (c fitted, :mod:`ktgf.closures.friction.calibrated`) and Walton's collision rule
-    with β0 = 1 — for RET the registered model ``frictional`` itself (the same numbers: tested).
+    ``theory`` (RET by default) with the χ of ``frictional`` diverging at φ_J(μ), its EKT correlation
+    length and Walton's collision rule with β0 = 1 — for RET the registered model ``frictional`` itself
+    (the same numbers: tested).
     """
     model = get_model("frictional")
     if theory != "ret":

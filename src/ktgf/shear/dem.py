@@ -5,8 +5,8 @@ uniform-shear file (``dem_uniform_shear*.csv``).  Frictional (``dem_uniform_shea
 :func:`compositions` lists the compared compositions and what each fits.  At most one number per
 composition is fitted: the tangential restitution β of the rough-sphere dissipation, to the rotational
 temperature T_rot/T of the row μ = 0.5, φ = 0.4 (:func:`fit_tangential_restitution`); and, for the
-registered ``frictional`` model, the EKT correlation-length constant c to T of the row μ = 0.5, φ = 0.5
-(:func:`ktgf.calibration.registry_fits.fit_correlation_constant`).  Everything else is predicted.
+registered ``frictional`` model, μ_Z and k of its χ on the whole μ = 0.5 set, a, b, c on the frictionless set
+(:mod:`ktgf.calibration.registry_fits`).  Everything else is predicted.
 """
 
 from __future__ import annotations
@@ -27,7 +27,6 @@ from ..closures.friction import (
     RoughSphereRestitution,
     WaltonRestitution,
 )
-from ..closures.friction.calibrated import FRICTIONAL_C
 from ..closures.models import get_model
 from ..data import uniform_shear_records
 from .compositions import FrictionalShearParts, frictional_uniform_shear, mu_i_uniform_shear
@@ -93,7 +92,7 @@ def compositions(rows: list[dict[str, float]]) -> list[tuple[str, str, Any]]:
          FrictionalShearParts(ret.replace(rdf=fcs), restitution=RoughSphereRestitution(beta=beta))),
         ("RET, χ_CS13(φ_c(μ)), Walton μ, β0 = 1", "nothing (β0 = 1: the DEM contact law)",
          FrictionalShearParts(ret.replace(rdf=fcs), restitution=WaltonRestitution(beta0=1.0))),
-        (f"**frictional** (registered): the same + EKT c = {FRICTIONAL_C:g}", "c to T at μ = 0.5, φ = 0.5",
+        ("**frictional** (registered): χ at φ_J(μ), EKT, Walton β0 = 1", "a, b, c (frictionless set); μ_Z, k (μ = 0.5 set)",
          FrictionalShearParts(get_model("frictional"), restitution=WaltonRestitution(beta0=1.0))),
         ("Enskog, χ_CS13(φ_c(μ)), e_eff Chialvo–Sundaresan", "nothing",
          FrictionalShearParts(get_model("enskog").replace(rdf=fcs))),

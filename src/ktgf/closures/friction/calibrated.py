@@ -1,20 +1,18 @@
-"""The one fitted number of the ``frictional`` model: the correlation-length constant c of extended kinetic theory.
+"""The fitted numbers of the ``frictional`` model beyond those of ``dense`` (one family for all μ).
 
-``frictional`` = RET × Chialvo–Sundaresan χ diverging at φ_c(μ) × Walton's collision rule (β0 = 1) ×
-the EKT dissipation correction ``jenkins-berzi-2010`` (:mod:`ktgf.closures.dissipation`) whose constant c
-is solved exactly from the granular temperature T = θ/(γ̇d)² of ONE row of the shared frictional DEM file
-``dem_uniform_shear_friction.csv``: μ = 0.5, φ = 0.5 (:data:`FIT_ROW`).  Everything else is predicted:
-p* and τ/p of that row, the row μ = 0.5, φ = 0.4 and the frictionless row (``docs/friction.md`` §6).
+``frictional`` = ``dense`` (RET × :class:`~ktgf.closures.jamming.FrictionalPowerLaw` χ × EKT length, with
+a, b, c of :data:`ktgf.closures.dense.DENSE_PARAMETERS`) × Walton's collision rule with β0 = 1
+(:mod:`ktgf.closures.friction.model_slot`), at friction μ (default 0.5).  Friction enters in three
+places: the collisional dissipation (Walton, no fitted number), the jamming fraction φ_J(μ) of the
+contact-number law (scale μ_Z) and the amplitude a(μ) = a (1 + k μ/(μ + μ_Z)) of the jamming term.
 
-Why this parameter: without it the no-fit composition's T falls from φ = 0.4 to 0.5 while the DEM's rises
-(0.169 → 0.184); the correlation length, which reduces the dissipation where dγ̇/√θ is large in dense flow,
-is the one part of the registry that acts in that direction.  At the fitted c it is inactive at φ = 0.4
-(L = d there) and at the frictionless row, so those are unchanged by the fit.
+μ_Z and k are fitted (:func:`ktgf.calibration.registry_fits.fit_frictional`, log-ratios of T, p/(nT),
+τ/p) on the frictional DEM uniform shear at μ = 0.5, e = 0.7, φ 0.3–0.57
+(``dem_uniform_shear_friction.csv`` + ``_extra``: 7 states, 21 points), a, b, c held at the
+frictionless fit.  At μ = 0 both drop out exactly: ``frictional`` with μ = 0 is ``dense`` (tested).
 """
 
 from __future__ import annotations
 
-#: c of ``frictional``: :func:`ktgf.calibration.registry_fits.fit_correlation_constant` on ``dem_uniform_shear_friction.csv`` (docs/friction.md §6).
-FRICTIONAL_C = 0.7921
-#: (μ, φ) of the DEM row whose T fixes c.
-FIT_ROW = (0.5, 0.5)
+#: μ_Z (mu_scale) and k (amplitude_growth), from :func:`ktgf.calibration.registry_fits.fit_frictional` (docs/friction.md §6).
+FRICTIONAL_PARAMETERS: dict[str, float] = {"mu_scale": 0.6202, "amplitude_growth": 5.772}
