@@ -217,18 +217,7 @@ def at_jamming(part: Any, mu: float, law: Any = None) -> Any:
     :class:`~ktgf.errors.InputError` for μ < 0, a part without ``phi_c`` and a freezing point φ_f at or
     above φ_J(μ).
     """
-    law = JammingFraction() if law is None else law
-    if hasattr(part, "chi"):  # an RDF: the friction module already does this, with the same checks
-        return with_jamming_fraction(part, mu, law)
-    check_friction_coefficient(mu)
-    names = {f.name for f in dataclasses.fields(part)} if dataclasses.is_dataclass(part) else set()
-    if "phi_c" not in names:
-        raise InputError(f"{_describe(part)} has no divergence point phi_c to move to the jamming fraction")
-    phi_c = float(law.phi_c(mu))
-    if "phi_f" in names:
-        check_range("freezing point phi_f", part.phi_f, high=phi_c, high_open=True,
-                    why=f"must lie below the jamming fraction phi_J(mu={mu:g}) = {phi_c:.4g}")
-    return dataclasses.replace(part, phi_c=phi_c)
+    return with_jamming_fraction(part, mu, law)
 
 
 def check_below_jamming(phi: Any, mu: float, law: Any = None) -> None:

@@ -70,26 +70,29 @@ class JammingFraction(FrictionPart):
         return d_jamming_fraction_dmu(mu, self.phi_rcp, self.phi_rlp, self.mu_scale)
 
 
-def with_jamming_fraction(rdf: RadialDistribution, mu: float, jamming: JammingFraction | None = None) -> RadialDistribution:
-    """A copy of ``rdf`` whose divergence point ``phi_c`` is moved to φ_c(μ).
+def with_jamming_fraction(part: Any, mu: float, jamming: Any = None) -> Any:
+    """A copy of ``part`` whose divergence point ``phi_c`` is moved to φ_c(μ) of ``jamming`` (any law with
+    ``phi_c(mu)``; default :class:`JammingFraction`).
 
-    Works for every RDF family with a ``phi_c`` field (Torquato, Lun–Savage, Ma–Ahmadi,
-    Chialvo–Sundaresan, viscosity divergence).  Raises :class:`~ktgf.errors.InputError` for μ < 0,
-    for a family without ``phi_c`` (Carnahan–Starling diverges only at φ = 1) and when the family's
+    Works for every frozen part with a ``phi_c`` field: the RDF families (Torquato, Lun–Savage, Ma–Ahmadi,
+    Chialvo–Sundaresan, viscosity divergence) and the Bocquet viscosity law, so that the RDF and the
+    viscosity divergence of a model diverge at the same point.  Raises :class:`~ktgf.errors.InputError` for
+    μ < 0, for a part without ``phi_c`` (Carnahan–Starling diverges only at φ = 1) and when the part's
     freezing point φ_f would lie at or above φ_c(μ).
     """
     from ...errors import InputError
 
     check_friction_coefficient(mu)
     jamming = jamming or JammingFraction()
-    names = {f.name for f in dataclasses.fields(rdf)}
+    names = {f.name for f in dataclasses.fields(part)} if dataclasses.is_dataclass(part) else set()
     if "phi_c" not in names:
-        raise InputError(f"RDF {rdf.describe()} has no divergence point phi_c to move to the frictional jamming fraction")
+        what = part.describe() if hasattr(part, "describe") else type(part).__name__
+        raise InputError(f"{what} has no divergence point phi_c to move to the jamming fraction")
     phi_c = float(jamming.phi_c(mu))
     if "phi_f" in names:
-        check_range("freezing point phi_f", rdf.phi_f, high=phi_c, high_open=True,
-                    why=f"must lie below the jamming fraction phi_c(mu={mu:g}) = {phi_c:.4g}")
-    return dataclasses.replace(rdf, phi_c=phi_c)
+        check_range("freezing point phi_f", part.phi_f, high=phi_c, high_open=True,
+                    why=f"must lie below the jamming fraction phi_J(mu={mu:g}) = {phi_c:.4g}")
+    return dataclasses.replace(part, phi_c=phi_c)
 
 
 @dataclass(frozen=True)
