@@ -32,7 +32,7 @@ RHO_S = 6.0 / math.pi
 INERTIA = 0.1
 #: Samples per strain unit in the time series, rows (averages of samples) per strain unit.
 SAMPLES_PER_STRAIN = 100
-ROWS_PER_STRAIN = 20
+ROWS_PER_STRAIN = 50
 #: Snapshots for the Q6 check, bins of the velocity profile.
 SNAPSHOTS = 4
 PROFILE_BINS = 10
@@ -221,13 +221,16 @@ def _analyse(run: ShearRun, where: Path, geom: dict) -> dict:
     series = analysis.read_ave_time(where / "series.txt")
     strain = series[:, 0] * geom["dt"]
     values = series[:, 1:]
-    blocks = analysis.block_means(strain, values, run.skip, run.strain, max(2, round(run.strain - run.skip)))
+    rows = int(np.count_nonzero(strain > run.skip + 1e-9))
+    # blocks of one strain unit (at least 2, at most one row each)
+    blocks = analysis.block_means(strain, values, run.skip, run.strain, min(rows, max(2, round(run.strain - run.skip))))
     half = analysis.block_means(strain, values, run.skip, run.strain, 2)
-    quarter = analysis.block_means(strain, values, run.skip, run.strain, 8)
+    k = max(1, min(4, rows // 2))
+    eighths = analysis.block_means(strain, values, run.skip, run.strain, 2 * k)
     drifts = {}
     for name, col in (("T", 0), ("p", None)):
-        q = quarter[:, col] if col is not None else quarter[:, 2:5].mean(axis=1)
-        drifts[name] = analysis.drift(q[:4], q[4:])
+        q = eighths[:, col] if col is not None else eighths[:, 2:5].mean(axis=1)
+        drifts[name] = analysis.drift(q[:k], q[k:])
     prof = analysis.read_ave_chunk(where / "profile.txt")
     slope, dev = analysis.profile_linearity(prof[:, 1] * geom["L"], prof[:, 3], prof[:, 2], 1.0, geom["L"])
     q6 = [analysis.q6_global(lo, H, x) for lo, H, x in analysis.read_dump_frames(where / "snaps.dump")]

@@ -38,10 +38,10 @@ def shear_sweep(phis: Sequence[float], e: float, *, mu: float = 0.0, particles: 
     for phi in phis:
         check_state(float(phi), e, mu, particles, strain, skip, contact_fraction)
     lammps = find_lammps()
-    calibrate_restitution(e, steps_per_contact, lammps=lammps)  # once here; the workers read the cache
     runs = [ShearRun(float(phi), e, mu, particles, seed, strain, skip, contact_fraction, steps_per_contact)
             for phi in phis for seed in range(1, seeds + 1)]
     try:
+        calibrate_restitution(e, steps_per_contact, lammps=lammps)  # once here; the workers read the cache
         results = map_tasks(_run_task, [(r, str(run_dir)) for r in runs], executor=executor, progress=progress)
     except LammpsError as exc:
         raise LammpsError(f"{exc} (finished runs are kept in {run_dir}: run the same command again to resume)") from None
