@@ -95,5 +95,51 @@ def shear_cmd(
             typer.echo(f"wrote {out}")
 
 
+@dem_app.command("cooling")
+@handle_errors
+def cooling_cmd(
+    phi: str = typer.Option(..., "--phi", help=f"Solid fraction(s), below 0.494: {VALUES_HELP}."),
+    e: str = typer.Option(..., "--e", help=f"Restitution coefficient(s), 0 < e < 1: {VALUES_HELP}."),
+    particles: int = typer.Option(6912, "--particles", help="Spheres per box (>= 100)."),
+    seeds: int = typer.Option(2, "--seeds", help="Independent runs per state."),
+    contact_fraction: float = typer.Option(0.01, "--contact-fraction", help="Contact time over the Enskog mean free time at T0, f_c."),
+    steps_per_contact: float = typer.Option(50.0, "--steps-per-contact", help="Time steps per contact time t_c/dt."),
+    out: Path = typer.Option(None, "--out", "-o", help="Write the CSV file here (the format of dem_hcs_cooling.csv)."),
+    fmt: DemFormat = typer.Option(DemFormat.table, "--format", help="What to print: table, json or csv."),
+    run_dir: Path = typer.Option(Path("ktgf-dem-runs"), "--run-dir", help="Folder of the runs (inputs, LAMMPS logs); reruns resume."),
+    workers: int = typer.Option(0, "--workers", help="Local processes running LAMMPS at once (0: one at a time, in-process)."),
+    dask: str = typer.Option(None, "--dask", help=DASK_HELP),
+) -> None:
+    """Homogeneous cooling of frictionless spheres in LAMMPS: Haff fits A over T0 -> T0/4 and T0 -> T0/2, p/(nT)."""
+    from ..dem.cooling import COLUMNS, csv_text
+    from ..dem.sweep import cooling_sweep
+    from ..errors import InputError
+    from ..sweep import open_executor
+    from ._common import OutputFormat, emit
+    from ._progress import DelayedProgress
+
+    phis = [float(p) for p in parse_values(phi, "phi")]
+    es = [float(x) for x in parse_values(e, "e")]
+    if workers < 0:
+        raise InputError(f"--workers {workers} is out of range: valid >= 0")
+    try:
+        with open_executor(workers, dask) as executor, DelayedProgress("LAMMPS runs") as bar:
+            rows = cooling_sweep(phis, es, particles=particles, seeds=seeds, contact_fraction=contact_fraction,
+                                 steps_per_contact=steps_per_contact, run_dir=run_dir, executor=executor, progress=bar)
+    except KeyboardInterrupt:
+        typer.echo(f"Interrupted: finished runs are kept in {run_dir}; run the same command again to resume.", err=True)
+        raise typer.Exit(130) from None
+    text = csv_text(rows)
+    if out is not None:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(text)
+    if fmt == DemFormat.csv:
+        typer.echo(text, nl=False)
+    else:
+        emit([{k: r[k] for k in COLUMNS} for r in rows], OutputFormat(fmt.value), title="ktgf dem cooling")
+        if out is not None and fmt == DemFormat.table:
+            typer.echo(f"wrote {out}")
+
+
 def register(app: typer.Typer, plot_app: typer.Typer) -> None:
     app.add_typer(dem_app, name="dem")

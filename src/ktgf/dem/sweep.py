@@ -60,3 +60,38 @@ def stiffness_change(base: ShearState, stiffer: ShearState) -> dict[str, tuple[f
         da, db = base.errors[k], stiffer.errors[k]
         out[k] = (b / a - 1.0, (b - a) / (da**2 + db**2) ** 0.5)
     return out
+
+
+def _cooling_task(task: tuple[Any, str]) -> dict:
+    from .cooling import run_cooling
+
+    run, root = task
+    return run_cooling(run, Path(root))
+
+
+def cooling_sweep(phis: Sequence[float], es: Sequence[float], *, particles: int = 6912, seeds: int = 2,
+                  contact_fraction: float = 0.01, steps_per_contact: float = 50.0, run_dir: Path = Path("ktgf-dem-runs"),
+                  executor: Any = None, progress: Callable[[int, int], None] | None = None) -> list[dict]:
+    """Homogeneous-cooling rows for every (φ, e), resumable like :func:`shear_sweep`."""
+    from ..errors import InputError
+    from .cooling import CoolingRun, check_cooling, combine_cooling
+
+    if seeds < 1:
+        raise InputError(f"seeds = {seeds} is out of range: valid seeds >= 1")
+    for phi in phis:
+        for e in es:
+            check_cooling(float(phi), float(e), particles, contact_fraction)
+    lammps = find_lammps()
+    runs = [CoolingRun(float(phi), float(e), particles, seed, contact_fraction, steps_per_contact)
+            for phi in phis for e in es for seed in range(1, seeds + 1)]
+    try:
+        for e in es:
+            calibrate_restitution(float(e), steps_per_contact, lammps=lammps)
+        results = map_tasks(_cooling_task, [(r, str(run_dir)) for r in runs], executor=executor, progress=progress)
+    except LammpsError as exc:
+        raise LammpsError(f"{exc} (finished runs are kept in {run_dir}: run the same command again to resume)") from None
+    rows = []
+    for _, group in groupby(zip(runs, results), key=lambda rr: rr[0].key):
+        pairs = list(group)
+        rows.append(combine_cooling([p[0] for p in pairs], [p[1] for p in pairs]))
+    return rows
