@@ -141,5 +141,54 @@ def cooling_cmd(
             typer.echo(f"wrote {out}")
 
 
+@dem_app.command("couette")
+@handle_errors
+def couette_cmd(
+    e: float = typer.Option(0.9, "--e", help="Normal restitution (particle-particle = particle-wall), 0 < e <= 1."),
+    phi: float = typer.Option(0.5, "--phi", help="Mean solid fraction between the planes tangent to the wall-sphere tops."),
+    mu: float = typer.Option(0.0, "--mu", help="Coulomb friction coefficient (0: smooth spheres)."),
+    height: float = typer.Option(20.0, "--height", help="H, wall-sphere centre to centre [d]."),
+    speed: float = typer.Option(10.0, "--speed", help="U, relative wall speed (walls at -U/2 and +U/2)."),
+    cells_x: int = typer.Option(12, "--wall-spheres-x", help="Wall spheres per row along x (L_x in d)."),
+    rows_z: int = typer.Option(14, "--wall-rows-z", help="Rows of wall spheres along z, even (L_z = rows * sqrt(3)/2)."),
+    strain: float = typer.Option(200.0, "--strain", help="Total strain U t/H."),
+    skip: float = typer.Option(110.0, "--skip", help="Strain discarded before averaging (blocks of 2)."),
+    contact_time: float = typer.Option(0.003125, "--contact-time", help="Contact time t_c (the shared case's value)."),
+    steps_per_contact: float = typer.Option(50.0, "--steps-per-contact", help="Time steps per contact time t_c/dt."),
+    seed: int = typer.Option(1, "--seed", help="Seed of the start lattice's vacancies and velocities."),
+    out: Path = typer.Option(None, "--out", "-o", help="Write the profile CSV here (the format of dem_couette_e0.9_phi0.50.csv)."),
+    fmt: DemFormat = typer.Option(DemFormat.table, "--format", help="What to print: table, json or csv."),
+    run_dir: Path = typer.Option(Path("ktgf-dem-runs"), "--run-dir", help="Folder of the run (input, LAMMPS log); a rerun reads it back."),
+) -> None:
+    """Planar Couette flow between bumpy walls in LAMMPS: phi, u, theta and stress profiles and the wall stresses."""
+    from ..dem.couette import COLUMNS, CouetteRun, csv_text, run_couette
+    from ._common import OutputFormat, emit
+
+    run = CouetteRun(phi=phi, e=e, mu=mu, height=height, speed=speed, cells_x=cells_x, rows_z=rows_z, strain=strain,
+                     skip=skip, contact_time=contact_time, steps_per_contact=steps_per_contact, seed=seed)
+    try:
+        res = run_couette(run, run_dir)
+    except KeyboardInterrupt:
+        typer.echo("Interrupted: the Couette run is lost (it is one LAMMPS process).", err=True)
+        raise typer.Exit(130) from None
+    text = csv_text(run, res)
+    if out is not None:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(text)
+    if fmt == DemFormat.csv:
+        typer.echo(text, nl=False)
+        return
+    if fmt == DemFormat.json:
+        import json
+
+        typer.echo(json.dumps({k: v for k, v in res.items() if k != "rows"} | {"profile": res["rows"]}, indent=2, default=float))
+        return
+    emit([{k: r[k] for k in COLUMNS[:7]} for r in res["rows"]], OutputFormat.table, title="ktgf dem couette")
+    typer.echo(f"wall shear stress tau = {res['tau']:.5g} +- {res['dtau']:.2g}, wall normal stress p_yy = {res['p_yy']:.5g} "
+               f"+- {res['dp_yy']:.2g}, N = {res['N']}")
+    if out is not None:
+        typer.echo(f"wrote {out}")
+
+
 def register(app: typer.Typer, plot_app: typer.Typer) -> None:
     app.add_typer(dem_app, name="dem")
