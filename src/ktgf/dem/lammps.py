@@ -13,6 +13,7 @@ import functools
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -43,16 +44,31 @@ class Lammps:
         cwd = Path(cwd)
         env = {**os.environ, "OMP_NUM_THREADS": "1"}
         cmd = [*self.command, "-in", Path(script).name, "-log", log, "-screen", "none", "-nocite"]
+        # its own process group: the PyPI `lmp` is a Python wrapper that starts the real binary, and both must go
+        proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                start_new_session=True)
         try:
-            proc = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+            stdout, stderr = proc.communicate(timeout=timeout)
         except subprocess.TimeoutExpired:
+            _kill_group(proc)
             raise LammpsError(f"LAMMPS run in {cwd} exceeded {timeout:g} s") from None
+        except BaseException:  # Ctrl-C (or a cancelled task): never leave LAMMPS running on its own
+            _kill_group(proc)
+            raise
         logfile = cwd / log
         if proc.returncode != 0:
             text = logfile.read_text(errors="replace") if logfile.is_file() else ""
-            tail = [ln for ln in (text + "\n" + proc.stdout + "\n" + proc.stderr).splitlines() if ln.strip()][-4:]
+            tail = [ln for ln in (text + "\n" + stdout + "\n" + stderr).splitlines() if ln.strip()][-4:]
             raise LammpsError(f"LAMMPS run in {cwd} failed (exit {proc.returncode}): " + " | ".join(tail))
         return logfile
+
+
+def _kill_group(proc: subprocess.Popen) -> None:
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    proc.communicate()
 
 
 def _candidates() -> list[list[str]]:
