@@ -3,7 +3,6 @@ bad input (one line, exit 2) and resumed sweeps."""
 
 from __future__ import annotations
 
-import os
 import stat
 import textwrap
 

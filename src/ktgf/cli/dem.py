@@ -56,8 +56,8 @@ def shear_cmd(
     phis = [float(p) for p in parse_values(phi, "phi")]
     if workers < 0:
         raise InputError(f"--workers {workers} is out of range: valid >= 0")
-    kw = dict(mu=mu, particles=particles, seeds=seeds, strain=strain, skip=skip, steps_per_contact=steps_per_contact,
-              run_dir=run_dir)
+    kw = {"mu": mu, "particles": particles, "seeds": seeds, "strain": strain, "skip": skip, "steps_per_contact": steps_per_contact,
+              "run_dir": run_dir}
     try:
         with open_executor(workers, dask) as executor, DelayedProgress("LAMMPS runs") as bar:
             states = shear_sweep(phis, e, contact_fraction=contact_fraction, executor=executor, progress=bar, **kw)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 
@@ -95,7 +96,7 @@ def block_means(t: np.ndarray, values: np.ndarray, start: float, stop: float, n_
     """Means of ``values`` (rows at times ``t``) over ``n_blocks`` equal blocks of [start, stop]."""
     edges = np.linspace(start, stop, n_blocks + 1)
     out = []
-    for a, b in zip(edges[:-1], edges[1:]):
+    for a, b in itertools.pairwise(edges):
         sel = (t > a + 1e-9) & (t <= b + 1e-9)
         out.append(values[sel].mean(axis=0))
     return np.array(out)

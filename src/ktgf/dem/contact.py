@@ -74,7 +74,7 @@ def _two_body_script(e_model: float, steps_per_contact: float, speed: float = 1.
         z = 4.0 * k
         lines += [f"create_atoms 1 single {-0.5 - gap / 2:.17g} 0 {z} units box",
                   f"create_atoms 1 single {0.5 + gap / 2:.17g} 0 {z} units box"]
-    steps = lead + 2 + int(math.ceil(1.3 * steps_per_contact)) + 5
+    steps = lead + 2 + math.ceil(1.3 * steps_per_contact) + 5
     lines += [
         f"set type 1 diameter 1.0 density {6.0 / math.pi:.17g}",
         f"pair_style gran/hooke/history {kn:.17g} {2.0 / 7.0 * kn:.17g} {gn:.17g} 0.0 0.0 0",

@@ -19,6 +19,7 @@ forces on the wall spheres: τ = (F_x,bottom − F_x,top)/(2A), p_yy = (F_y,top 
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import math
 import time
@@ -165,8 +166,8 @@ def _script(run: CouetteRun, e_model: float) -> tuple[str, dict]:
         f"compute fine flow chunk/atom bin/1d y {-h / 2 - 0.5:.17g} {FINE:.17g} units box bound y {-h / 2 - 0.5:.17g} {h / 2 + 0.5:.17g}",
         "compute vir flow stress/atom NULL virial",
         "variable vxx atom vx*vx", "variable vyy atom vy*vy", "variable vzz atom vz*vz", "variable vxy atom vx*vy",
-        f"fix prof flow ave/chunk {every} 100 {block} layers vx vy vz v_vxx v_vyy v_vzz v_vxy c_vir[1] c_vir[2] c_vir[3] c_vir[4] "
-        "norm all file profile.txt",
+        (f"fix prof flow ave/chunk {every} 100 {block} layers vx vy vz v_vxx v_vyy v_vzz v_vxy c_vir[1] c_vir[2] c_vir[3] c_vir[4] "
+        "norm all file profile.txt"),
         f"fix hist flow ave/chunk {every} 100 {block} fine vx norm all file fine.txt",
         f"fix walls all ave/time {every} 100 {block} c_fb[1] c_ft[1] c_fb[2] c_ft[2] file walls.txt",
         f"run {total - skip}",
@@ -212,7 +213,7 @@ def _analyse(run: CouetteRun, where: Path, info: dict) -> dict:
     centres_fine = -h / 2 - 0.5 + FINE * (np.arange(info["fine_bins"]) + 0.5)
     bin_volume = area * BIN
     # φ per block: each fine histogram bin's spheres (centre at the bin's centre) cut by each coarse bin
-    overlap = np.array([[slab_volume(c, lo, hi) for c in centres_fine] for lo, hi in zip(edges[:-1], edges[1:])])
+    overlap = np.array([[slab_volume(c, lo, hi) for c in centres_fine] for lo, hi in itertools.pairwise(edges)])
     phi_blocks = fine[:, :, 2] @ overlap.T / bin_volume
     count = prof[:, :, 2]
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -239,8 +240,8 @@ def _analyse(run: CouetteRun, where: Path, info: dict) -> dict:
     occupied = n_bin > 0
     y = 0.5 * (edges[:-1] + edges[1:])
     wall_phi = np.array([slab_volume(np.array([-h / 2, h / 2]), lo, hi).sum() * run.cells_x * run.rows_z / bin_volume
-                         for lo, hi in zip(edges[:-1], edges[1:])])
-    centre_count = np.array([((centres_fine >= lo) & (centres_fine < hi)) for lo, hi in zip(edges[:-1], edges[1:])], float)
+                         for lo, hi in itertools.pairwise(edges)])
+    centre_count = np.array([((centres_fine >= lo) & (centres_fine < hi)) for lo, hi in itertools.pairwise(edges)], float)
     phi_centre = (fine[:, :, 2].mean(axis=0) @ centre_count.T) * (math.pi / 6.0) / bin_volume
     rows = []
     for i in range(len(y)):
@@ -303,30 +304,30 @@ def csv_text(run: CouetteRun, res: dict) -> str:
     lo, hi = occ[0], occ[-1]
     u = run.speed / 2.0
     head = [
-        f"# DEM (LAMMPS {res['lammps_version']}, run by `ktgf dem couette`) planar Couette flow of "
-        f"{'frictionless' if run.mu == 0 else 'frictional'} inelastic spheres between bumpy walls",
+        (f"# DEM (LAMMPS {res['lammps_version']}, run by `ktgf dem couette`) planar Couette flow of "
+        f"{'frictionless' if run.mu == 0 else 'frictional'} inelastic spheres between bumpy walls"),
         f"# case: ktgf_e{run.e:g}_phi{run.phi:.2f}_mu{run.mu:g}",
         "# units: d = 1 (sphere diameter), m = 1 (sphere mass), rho_s = 6/pi; velocities in the same units as U",
         f"# e (particle-particle = particle-wall normal restitution): {run.e:g} ; tangential friction: {run.mu:g}"
         + (" (smooth)" if run.mu == 0 else ""),
-        f"# geometry: periodic x (flow, Lx = {run.cells_x:g}) and z (vorticity, Lz = {run.lz:.6f}); walls = one hexagonal close-packed "
+        (f"# geometry: periodic x (flow, Lx = {run.cells_x:g}) and z (vorticity, Lz = {run.lz:.6f}); walls = one hexagonal close-packed "
         f"layer of {res['wall_spheres']} touching spheres each (d = 1, rows along x), centres at y = -+{run.height / 2:g}; "
-        f"H = {run.height:g} (wall-centre to wall-centre)",
-        f"# N flowing spheres: {res['N']} ; mean solid fraction {run.phi:.4f} defined as N*pi/6/(Lx*Lz*(H-d)) "
-        "(slab between planes tangent to wall-sphere tops)",
+        f"H = {run.height:g} (wall-centre to wall-centre)"),
+        (f"# N flowing spheres: {res['N']} ; mean solid fraction {run.phi:.4f} defined as N*pi/6/(Lx*Lz*(H-d)) "
+        "(slab between planes tangent to wall-sphere tops)"),
         f"# walls move rigidly at u_x = -U/2 (bottom) and +U/2 (top), U = {run.speed:g} ; nominal shear rate U/H = {run.speed / run.height:g}",
-        f"# contact: linear spring-dashpot, kn = {res['kn']:.6g}, gamma_n = {res['gamma_n']:.6g} (e_model = {res['e_model']:.6g}), "
+        (f"# contact: linear spring-dashpot, kn = {res['kn']:.6g}, gamma_n = {res['gamma_n']:.6g} (e_model = {res['e_model']:.6g}), "
         f"kt = 2/7 kn, mu = {run.mu:g} (pp); 2kn, 2 m_eff gamma_n (particle-wall, wall = infinite mass); t_c = {run.contact_time:g} ; "
-        f"dt = t_c/{run.steps_per_contact:g} = {res['dt']:.4g}",
+        f"dt = t_c/{run.steps_per_contact:g} = {res['dt']:.4g}"),
         f"# protocol: {run.skip:g} strain units (U t/H) discarded, then {run.strain - run.skip:g} averaged in {res['blocks']} blocks of {BLOCK_STRAIN:g}",
-        f"# wall shear stress tau = {res['tau']:.5g} +- {res['dtau']:.2g} ; wall normal stress p_yy = {res['p_yy']:.5g} +- {res['dp_yy']:.2g} ; "
-        f"tau/p = {res['tau'] / res['p_yy']:.4f} ; I = (U/H) d / sqrt(p/rho_s) = {run.speed / run.height / math.sqrt(res['p_yy'] / RHO_S):.4f}",
+        (f"# wall shear stress tau = {res['tau']:.5g} +- {res['dtau']:.2g} ; wall normal stress p_yy = {res['p_yy']:.5g} +- {res['dp_yy']:.2g} ; "
+        f"tau/p = {res['tau'] / res['p_yy']:.4f} ; I = (U/H) d / sqrt(p/rho_s) = {run.speed / run.height / math.sqrt(res['p_yy'] / RHO_S):.4f}"),
         f"# slip: first occupied bin bottom y={lo['y']:g} ux={lo['ux']:.5g} (wall {-u:g}), top y={hi['y']:g} ux={hi['ux']:.5g} (wall {u:g})",
-        "# columns: y = bin centre (bins of 0.5); phi = volume-based solid fraction of flowing spheres (exact sphere/slab intersection "
-        "from 0.05-wide centre histograms); ux = mean velocity (centre-in-bin); theta = (1/3)<|v-u|^2> with u the time-averaged bin mean (per unit mass)",
-        "# extra columns: *_sem = standard error from block means; phi_centre = centre-count based; phi_wall = solid fraction of the wall "
+        ("# columns: y = bin centre (bins of 0.5); phi = volume-based solid fraction of flowing spheres (exact sphere/slab intersection "
+        "from 0.05-wide centre histograms); ux = mean velocity (centre-in-bin); theta = (1/3)<|v-u|^2> with u the time-averaged bin mean (per unit mass)"),
+        ("# extra columns: *_sem = standard error from block means; phi_centre = centre-count based; phi_wall = solid fraction of the wall "
         "spheres themselves; Txx,Tyy,Tzz,Txy = <c_i c_j>; ncount = mean number of sphere centres in the bin; tau_xy,p_xx,p_yy,p_zz = stress "
-        "profile (kinetic from velocity moments + per-atom virial, half of each contact's virial assigned to each partner)",
+        "profile (kinetic from velocity moments + per-atom virial, half of each contact's virial assigned to each partner)"),
     ]
     body = [",".join(COLUMNS)] + [",".join(f"{r[k]:.6g}" for k in COLUMNS) for r in rows]
     return "\n".join(head + body) + "\n"

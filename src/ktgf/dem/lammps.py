@@ -87,11 +87,11 @@ def _candidates() -> list[list[str]]:
     return found
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _probe(command: tuple[str, ...]) -> tuple[str | None, bool]:
     """(version, has GRANULAR pair style) of an executable; version None if it does not run."""
     try:
-        out = subprocess.run([*command, "-h"], capture_output=True, text=True, timeout=60,
+        out = subprocess.run([*command, "-h"], capture_output=True, text=True, timeout=60, check=False,
                              env={**os.environ, "OMP_NUM_THREADS": "1"}).stdout
     except (OSError, subprocess.TimeoutExpired):
         return None, False

@@ -7,9 +7,10 @@ finished runs are read back, not rerun.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from itertools import groupby
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any
 
 from ..sweep import map_tasks
 from .contact import calibrate_restitution
