@@ -128,3 +128,15 @@ def test_failed_lammps_run_shows_its_log(tmp_path, monkeypatch):
     assert r.exit_code == 2
     assert "Fake failure on purpose" in r.output and "kept in" in r.output
     assert r.output.strip().count("\n") == 0
+
+
+def test_stiffness_change_is_relative_to_the_base_run():
+    from ktgf.dem.shear import ShearState
+    from ktgf.dem.sweep import stiffness_change
+
+    keys = ("T", "p_star", "tau_over_p", "p_over_nT", "eta_over_eta0")
+    base = ShearState(0.0, 0.5, 0.9, 864, [1], dict.fromkeys(keys, 2.0), dict.fromkeys(keys, 0.03))
+    stiffer = ShearState(0.0, 0.5, 0.9, 864, [1], dict.fromkeys(keys, 2.1), dict.fromkeys(keys, 0.04))
+    change = stiffness_change(base, stiffer)
+    assert change["T"][0] == pytest.approx(0.05)
+    assert change["T"][1] == pytest.approx(0.1 / 0.05)
