@@ -164,8 +164,11 @@ def calibrate_restitution(e: float, steps_per_contact: float = 50.0, *, lammps: 
             cache = json.loads(path.read_text())
         except (OSError, ValueError):
             cache = {}
-        if key in cache:
-            return Restitution(**cache[key])
+        try:
+            if key in cache:
+                return Restitution(**cache[key])
+        except TypeError:  # an entry of another ktgf version: calibrate again
+            pass
     e_model = e
     for _ in range(max_iterations):
         measured = two_body_restitution(e_model, steps_per_contact, lammps=lammps)
