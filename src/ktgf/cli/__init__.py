@@ -23,7 +23,7 @@ app = typer.Typer(
 plot_app = typer.Typer(help="Figures (PNG/PDF/SVG by file extension).", no_args_is_help=True, rich_markup_mode=None)
 app.add_typer(plot_app, name="plot")
 
-COMMAND_MODULES = ("closures", "shear", "hcs", "couette", "chute", "solver", "report", "calibrate", "validate")
+COMMAND_MODULES = ("closures", "shear", "hcs", "couette", "chute", "solver", "report", "calibrate", "validate", "dem")
 
 
 def _print_version(value: bool) -> None:
