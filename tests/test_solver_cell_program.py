@@ -18,7 +18,7 @@ import pytest
 
 from ktgf.closures import get_model
 from ktgf.closures.models import list_models
-from ktgf.solver import cell_program
+from ktgf.solver import cell_program, cxx
 from ktgf.solver.friction import cell_coefficients, for_case
 from ktgf.solver.grid import Grid
 from ktgf.solver.physics import Physics
@@ -34,6 +34,17 @@ RTOL64 = 1e-13
 #: φ_c − φ).  Both are held to the float64 closures at the same float32 state: measured 18–77 ε₃₂
 #: for the program and 16–48 ε₃₂ for XLA over the registered models (largest: `dense`, β = 4.052).
 TOL32 = 128 * float(np.finfo(np.float32).eps)
+
+
+def _no_compiler() -> str | None:
+    try:
+        cxx.compiler()
+    except RuntimeError as err:
+        return str(err)
+    return None
+
+
+pytestmark = pytest.mark.skipif(_no_compiler() is not None, reason=f"cell programs need a C++ compiler: {_no_compiler()}")
 
 
 def _states(phys: Physics, n: int, dtype) -> tuple:
