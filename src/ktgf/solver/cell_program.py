@@ -3,7 +3,7 @@
 Why: a stage of the fused kernel (:func:`.flux_kernel.ssprk_stage`) needed an XLA pass first, to
 evaluate the closures at every cell and write 13 fields (primitive fields, (p*, g), (η, λ_b, κ, ω),
 the energy source (s0, s1)), which the kernel then read back and padded: ≈ 15 ns a cell of XLA and
-≈ 4 ns of padding per stage, a third of the stage (docs/solver.md, Speed).  Here the same function —
+≈ 4 ns of padding per stage, a third of the stage (docs/solver.md at cef4049, Speed).  Here the same function —
 :func:`.stepping.kernel_stage_inputs` of the model's :meth:`.Physics.reduced`, nothing rewritten — is
 traced once with scalar inputs, and its jaxpr (elementwise arithmetic only) is printed as a C++ loop
 over a row of cells.  The kernel calls it row by row as its sweep goes (each thread keeps the few planes
@@ -47,7 +47,7 @@ log = logging.getLogger(__name__)
 #: kernel reduces to maxima.
 OUTPUTS = ("rho", "u_x", "u_y", "u_z", "theta", "p_star", "g", "eta", "lambda_b", "kappa", "omega", "s0", "s1")
 #: What the XLA closure pass costs where a program would run, for the one-line warning when it cannot be built:
-#: the A/B of ``benchmarks/bench_solver.py --ab`` (docs/solver.md, Speed).
+#: the A/B of ``benchmarks/bench_solver.py --ab`` (docs/solver.md, "Fallbacks").
 FALLBACK_COST = "1.1-1.5x the time per SSP-RK3 step"
 SYMBOL = "ktgf_cells"
 _CTYPES = {np.dtype(np.float64): "double", np.dtype(np.float32): "float", np.dtype(np.bool_): "bool",
@@ -286,7 +286,7 @@ def _program(treedef: Any, avals: tuple, dtype: Any, limits: str | None) -> Cell
         return _compiled(source, dtype, 0 if limits is None else len(START_TERMS), what)
     except (RuntimeError, OSError) as err:
         warn_once(log, f"{what} could not be built ({err}); the fused stage evaluates the closures in an XLA pass "
-                       f"instead, {FALLBACK_COST} (docs/solver.md, Speed)", key="cell program build")
+                       f"instead, {FALLBACK_COST} (docs/solver.md, Fallbacks)", key="cell program build")
         return None
 
 

@@ -59,7 +59,7 @@ LIMITS_TARGET = "ktgf_cell_limits"
 #: Spins (``pause`` instructions, 3000 take 80 us on this machine) an idle OpenMP thread waits before it sleeps.
 SPIN_COUNT = 3000
 #: What the JAX path costs where the kernel would run, for the one-line warning when it cannot be built: the
-#: time per step of the JAX path over the kernel's (docs/solver.md, Speed: 64³ RET float64 SSP-RK3).
+#: time per step of the JAX path over the kernel's (docs/solver.md, "Fallbacks": 64³ RET float64 SSP-RK3).
 FALLBACK_COST = "about 6x the time per SSP-RK3 step on a periodic 3D grid"
 #: What a library computes, in the order of the KTGF_KIND values of flux_kernel.cc: the viscous flux
 #: divergence (:func:`flux_divergence` with ``viscous``), the inviscid one (the explicit part of the IMEX
@@ -130,7 +130,7 @@ def row_length(grid: Any) -> int:
     :data:`ROW_MIN` to :data:`ROW_MAX` in multiples of :data:`ROW_STEP`, else 0 (a library for any length).
 
     A library built for one row length has every stencil offset as a constant, so its loops need no set-up per
-    row (docs/solver.md, "Rows of a known length": in cache, one thread, float32 1.63x faster at 16-cell rows and
+    row (docs/solver.md at cef4049, "Rows of a known length": in cache, one thread, float32 1.63x faster at 16-cell rows and
     1.18x at 64, float64 1.25x and 1.07x).  Each new length costs one build (10-15 s, then cached); shorter rows
     would gain too, but grids of 8 cells and fewer a side are small tests, where a build costs more than it saves."""
     n = int(grid.cells[-1])
@@ -164,8 +164,8 @@ def _library(v: Variant) -> Any:
     if lib is None:
         # Idle OpenMP threads must sleep, not spin: between calls XLA's own threads need the cores.  But they
         # spin briefly first (GOMP_SPINCOUNT, 80 us here): a step calls the kernel three times with almost
-        # nothing in between, and waking a sleeping thread for each call cost about 0.2 ms per step (docs/solver.md,
-        # "Waking the threads").  Both are read once, when libgomp loads: set before the library is.
+        # nothing in between, and waking a sleeping thread for each call cost about 0.2 ms per step (docs/solver.md at
+        # cef4049, "Waking the threads").  Both are read once, when libgomp loads: set before the library is.
         os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
         os.environ.setdefault("GOMP_SPINCOUNT", str(SPIN_COUNT))
         lib = ctypes.cdll.LoadLibrary(str(build(v)))
@@ -188,7 +188,7 @@ def _usable(v: Variant) -> bool:
     except (RuntimeError, OSError) as err:
         _loaded["failed"] = str(err)
         warn_once(log, f"the C++ flux kernel is not available ({err}); the solver runs the JAX path instead, "
-                       f"{FALLBACK_COST} (docs/solver.md, Speed)")
+                       f"{FALLBACK_COST} (docs/solver.md, Fallbacks)")
         return False
     return True
 
