@@ -227,9 +227,10 @@ def test_without_a_compiler_the_jax_path_runs_and_says_why_once(no_compiler, mon
     assert len(builds) == 1
     (message,) = _warnings(caplog)
     assert "\n" not in message
-    assert "the C++ flux kernel is not available (no C++ compiler (CXX = 'no-such-compiler-ktgf' is not found))" in message
+    why = "no C++ compiler (CXX = 'no-such-compiler-ktgf' is not found)"
+    assert f"the C++ flux kernel is not available ({why})" in message
     assert f"the solver runs the JAX path instead, {flux_kernel.FALLBACK_COST}" in message
-    assert flux_kernel.unavailable() == "no C++ compiler (CXX = 'no-such-compiler-ktgf' is not found)"
+    assert flux_kernel.unavailable() == why
     assert not any(base in text for base in (flux_kernel.TARGET, flux_kernel.STAGE_TARGET, flux_kernel.CELLS_TARGET,
                                              flux_kernel.LIMITS_TARGET))
     # The JAX path, bit for bit: the same steps with the kernel switched off.
@@ -291,7 +292,8 @@ def test_a_compiler_without_openmp_builds_a_serial_kernel(tmp_path) -> None:
     script = tmp_path / "serial.py"
     script.write_text(SERIAL_SCRIPT)
     env = {**os.environ, "KTGF_CACHE_DIR": str(tmp_path / "cache")}
-    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env, timeout=600)
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env, timeout=600,
+                         check=False)
     assert run.returncode == 0, run.stderr[-3000:]
     assert float(run.stdout.strip().splitlines()[-1]) < 1e-13
     said = [line for line in run.stderr.splitlines() if "does not build OpenMP programs" in line]

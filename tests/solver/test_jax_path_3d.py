@@ -112,10 +112,11 @@ def test_a_3d_couette_cell_keeps_the_1d_solver_profile(jax_path) -> None:
     ref = couette_reference(phys, grid, 0.3)
     y = grid.centres(0) - 0.5 * grid.lengths[0]
     profile = {k: np.interp(y, ref["y"].values, ref[k].values) for k in ("u", "phi", "theta")}
-    column = lambda f: np.broadcast_to(f[:, None, None], grid.cells)  # noqa: E731
+    column = lambda f: np.broadcast_to(f[:, None, None], grid.cells)
     u = np.zeros((3, *grid.cells))
     u[1] = column(profile["u"])
-    U0 = conservative(jnp.asarray(RHO_S * column(profile["phi"])), jnp.asarray(u), jnp.asarray(column(profile["theta"])))
+    U0 = conservative(jnp.asarray(RHO_S * column(profile["phi"])), jnp.asarray(u),
+                      jnp.asarray(column(profile["theta"])))
     U0 = U0 * (0.3 * RHO_S * U0[0].size / float(U0[0].sum()))  # the exact inventory (interpolation moved it)
     t_end = 2.0 * grid.lengths[0] / 1.0  # 2 strains at U/H
     U, t, steps, status, _ = jax_path(U0, 0.0, t_end, grid, phys, sim.num)

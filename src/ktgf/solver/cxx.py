@@ -34,9 +34,9 @@ import shutil
 import subprocess
 import tempfile
 import time
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator, Sequence
 
 try:
     import fcntl
@@ -55,8 +55,8 @@ COMMON_FLAGS = ("-O3", "-ffp-contract=off", "-fno-math-errno", "-shared", "-fPIC
 #: Instruction-set flags, the first the compiler accepts is used (none: code for the compiler's default target).
 ARCH_FLAGS = (("-march=native",), ("-mcpu=native",))
 _OPENMP_PROBE = ('#include <omp.h>\nextern "C" int ktgf_probe(int n) {\n  int s = 0;\n'
-                 "#pragma omp parallel for reduction(+ : s)\n  for (int i = 0; i < n; ++i) s += omp_get_num_threads();\n"
-                 "  return s;\n}\n")
+                 "#pragma omp parallel for reduction(+ : s)\n"
+                 "  for (int i = 0; i < n; ++i) s += omp_get_num_threads();\n  return s;\n}\n")
 _SIMD_PROBE = ('extern "C" void ktgf_probe(long n, double* x) {\n#pragma omp simd\n'
                "  for (long i = 0; i < n; ++i) x[i] *= 2;\n}\n")
 _PLAIN_PROBE = 'extern "C" int ktgf_probe(int n) { return n + 1; }\n'
@@ -95,8 +95,8 @@ def warn_once(logger: logging.Logger, message: str, key: str | None = None) -> N
 class Toolchain:
     """A compiler and what it accepts (:func:`toolchain`).
 
-    ``identity``: the first line of its version text and its target triple; ``arch``: the instruction-set flags it accepts
-    (:data:`ARCH_FLAGS`, empty if none); ``openmp``: ``("-fopenmp",)`` if it builds and links an OpenMP program,
+    ``identity``: the first line of its version text and its target triple; ``arch``: the instruction-set flags it
+    accepts (:data:`ARCH_FLAGS`, empty if none); ``openmp``: ``("-fopenmp",)`` if it builds and links an OpenMP program,
     else empty, and ``openmp_error`` why not; ``simd``: ``("-fopenmp-simd",)`` if it accepts that, else empty;
     ``target``: what the arch flags mean here — the compiler's own expansion of them (``-###``: the CPU model and
     its features) and the CPU's feature flags (``/proc/cpuinfo``; empty elsewhere)."""
@@ -117,7 +117,7 @@ class Toolchain:
 
 def _run(args: Sequence[str], cwd: str) -> subprocess.CompletedProcess:
     try:
-        return subprocess.run(list(args), capture_output=True, text=True, cwd=cwd, timeout=120)
+        return subprocess.run(list(args), capture_output=True, text=True, cwd=cwd, timeout=120, check=False)
     except (OSError, subprocess.TimeoutExpired) as err:
         return subprocess.CompletedProcess(list(args), 1, "", str(err))
 
@@ -149,7 +149,8 @@ def _expansion(cxx: str, flags: Sequence[str], folder: str) -> str:
 
 
 def cpu_features() -> str:
-    """The CPU's feature flags (the ``flags`` or ``Features`` lines of ``/proc/cpuinfo``; the machine name elsewhere)."""
+    """The CPU's feature flags (the ``flags`` or ``Features`` lines of ``/proc/cpuinfo``; the machine name
+    elsewhere)."""
     found = set()
     with contextlib.suppress(OSError):
         for line in Path("/proc/cpuinfo").read_text().splitlines():
@@ -159,7 +160,7 @@ def cpu_features() -> str:
     return f"{platform.machine()}: {' | '.join(sorted(found))}"
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def toolchain(cxx: str) -> Toolchain:
     """Probes the compiler ``cxx`` (a path): its identity and the flags it accepts (once per process and compiler;
     a few small compilations, about a second)."""
@@ -175,9 +176,9 @@ def toolchain(cxx: str) -> Toolchain:
         omp = _builds(cxx, (*arch, "-fopenmp"), _OPENMP_PROBE, folder)
         simd = _builds(cxx, (*arch, "-fopenmp-simd"), _SIMD_PROBE, folder)
         target = _expansion(cxx, arch, folder) + (f" | {cpu_features()}" if arch else "")
-    result = Toolchain(cxx, identity, arch, ("-fopenmp",) if omp.returncode == 0 else (),
-                       "" if omp.returncode == 0 else _last_line(omp), ("-fopenmp-simd",) if simd.returncode == 0 else (),
-                       target)
+    openmp = omp.returncode == 0
+    result = Toolchain(cxx, identity, arch, ("-fopenmp",) if openmp else (), "" if openmp else _last_line(omp),
+                       ("-fopenmp-simd",) if simd.returncode == 0 else (), target)
     log.debug("compiler %s: %s; flags %s", cxx, identity, result.flags(True))
     return result
 
@@ -271,7 +272,7 @@ def _compile(cxx: str, source: str | Path, flags: Sequence[str], lib: Path, what
         fd, tmp = tempfile.mkstemp(suffix=".so", dir=lib.parent)
         os.close(fd)
         temporary.append(tmp)
-        proc = subprocess.run([cxx, *flags, str(source), "-o", tmp], capture_output=True, text=True)
+        proc = subprocess.run([cxx, *flags, str(source), "-o", tmp], capture_output=True, text=True, check=False)
         if proc.returncode != 0:
             raise RuntimeError(f"compiling {what} failed: {_last_line(proc)}")
         os.replace(tmp, lib)

@@ -130,8 +130,8 @@ def row_length(grid: Any) -> int:
     :data:`ROW_MIN` to :data:`ROW_MAX` in multiples of :data:`ROW_STEP`, else 0 (a library for any length).
 
     A library built for one row length has every stencil offset as a constant, so its loops need no set-up per
-    row (docs/solver.md at cef4049, "Rows of a known length": in cache, one thread, float32 1.63x faster at 16-cell rows and
-    1.18x at 64, float64 1.25x and 1.07x).  Each new length costs one build (10-15 s, then cached); shorter rows
+    row (docs/solver.md at cef4049, "Rows of a known length": in cache, one thread, float32 1.63x faster at 16-cell
+    rows and 1.18x at 64, float64 1.25x and 1.07x).  Each new length costs one build (10-15 s, then cached); shorter rows
     would gain too, but grids of 8 cells and fewer a side are small tests, where a build costs more than it saves."""
     n = int(grid.cells[-1])
     return n if ROW_MIN <= n <= ROW_MAX and n % ROW_STEP == 0 else 0
