@@ -18,7 +18,7 @@ import pytest
 
 from ktgf.closures import get_model
 from ktgf.closures.models import list_models
-from ktgf.solver import cell_program
+from ktgf.solver import cell_program, cxx
 from ktgf.solver.friction import cell_coefficients, for_case
 from ktgf.solver.grid import Grid
 from ktgf.solver.physics import Physics
@@ -36,7 +36,16 @@ RTOL64 = 1e-13
 TOL32 = 128 * float(np.finfo(np.float32).eps)
 
 
-pytestmark = pytest.mark.contract
+def _no_compiler() -> str | None:
+    try:
+        cxx.compiler()
+    except RuntimeError as err:
+        return str(err)
+    return None
+
+
+pytestmark = [pytest.mark.contract,
+              pytest.mark.skipif(_no_compiler() is not None, reason=f"cell programs need a C++ compiler: {_no_compiler()}")]
 
 
 def _states(phys: Physics, n: int, dtype) -> tuple:

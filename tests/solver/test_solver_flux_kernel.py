@@ -6,10 +6,10 @@ side for every limiter and Riemann solver with and without the viscous fluxes, a
 both time schemes and two closure models.  The fused SSP-RK3 stage (:func:`.flux_kernel.ssprk_stage`)
 is checked the same way, in both precisions and with a frictional model, and its energy source
 s0 + s1∇·u against :func:`~ktgf.solver.sources.cooling_source` for every registered model.  Also:
-where the kernel does not apply it is not used, and without a compiler the solver falls back to
-the JAX path with one warning.  The build: one library per variant instantiates the face sweep once,
-refuses calls of another variant, is built once by two processes that need it at the same time, and
-is announced (INFO on the ``ktgf`` logger, which the command line shows).
+where the kernel does not apply it is not used (without a compiler: tests/solver/test_cxx_toolchain.py).
+The build: one library per variant instantiates the face sweep once, refuses calls of another variant, is
+built once by two processes that need it at the same time, and is announced (INFO on the ``ktgf`` logger,
+which the command line shows).
 """
 
 from __future__ import annotations
@@ -47,7 +47,8 @@ D, RHO_S = 1e-3, 2500.0
 #: a few differently.  float32: the same rounding differences, relative to 2^-24.
 RTOL = {jnp.float64: 1e-13, jnp.float32: 3e-6}
 
-pytestmark = pytest.mark.skipif(not flux_kernel.available(), reason="flux kernel could not be built")
+_WHY = None if flux_kernel.available() else flux_kernel.unavailable()
+pytestmark = pytest.mark.skipif(_WHY is not None, reason=f"the C++ flux kernel could not be built: {_WHY}")
 
 
 def _grid() -> Grid:
@@ -132,28 +133,6 @@ def test_kernel_is_in_the_compiled_rhs_only_where_it_applies() -> None:
     assert flux_kernel.TARGET not in _with_kernel(False, lambda: hlo(periodic))
     assert flux_kernel.TARGET not in _with_kernel(True, lambda: hlo(sheared))
     assert flux_kernel.TARGET not in _with_kernel(True, lambda: hlo(flat))
-
-
-@pytest.mark.contract
-def test_without_a_compiler_the_jax_path_runs_with_one_warning(monkeypatch, tmp_path) -> None:
-    monkeypatch.setenv("CXX", "no-such-compiler-ktgf")
-    monkeypatch.setenv("KTGF_CACHE_DIR", str(tmp_path))
-    monkeypatch.setattr(flux_kernel, "_loaded", {})
-    builds = []
-    build = flux_kernel.build
-    monkeypatch.setattr(flux_kernel, "build", lambda v: builds.append(v) or build(v))
-    with pytest.warns(RuntimeWarning, match="flux kernel unavailable.*no-such-compiler-ktgf"):
-        assert not flux_kernel.applies(_grid(), jnp.float64, "rhs", "vanleer", "hll")
-    # Decided once: no second warning (an error here, pyproject's filterwarnings), no retry of any variant.
-    assert not flux_kernel.applies(_grid(), jnp.float64, "rhs", "vanleer", "hll")
-    assert not flux_kernel.applies(_grid(), jnp.float32, "stage", "minmod", "rusanov")
-    assert not flux_kernel.available()
-    assert len(builds) == 1
-    U = _state(_grid(), _physics("ret"), jnp.float64)
-    text = _with_kernel(True, lambda: jax.jit(lambda U: ssprk3_step(U, 1e-6, _grid(), _physics("ret"), Numerics(
-        scheme="ssprk3"))).lower(U).as_text())
-    assert not any(base in text for base in (flux_kernel.TARGET, flux_kernel.STAGE_TARGET,
-                                             flux_kernel.LIMITS_TARGET))
 
 
 def _steps(U, grid, phys, num, steps: int = 3):

@@ -3,7 +3,7 @@
 Why: a stage of the fused kernel (:func:`.flux_kernel.ssprk_stage`) needed an XLA pass first, to
 evaluate the closures at every cell and write 13 fields (primitive fields, (p*, g), (η, λ_b, κ, ω),
 the energy source (s0, s1)), which the kernel then read back and padded: ≈ 15 ns a cell of XLA and
-≈ 4 ns of padding per stage, a third of the stage (docs/solver.md, Speed).  Here the same function —
+≈ 4 ns of padding per stage, a third of the stage (docs/solver.md at cef4049, Speed).  Here the same function —
 :func:`.stepping.kernel_stage_inputs` of the model's :meth:`.Physics.reduced`, nothing rewritten — is
 traced once with scalar inputs, and its jaxpr (elementwise arithmetic only) is printed as a C++ loop
 over a row of cells.  The kernel calls it row by row as its sweep goes (each thread keeps the few planes
@@ -16,7 +16,8 @@ XLA expands it), so it agrees with the XLA evaluation to round-off
 (tests/test_solver_cell_program.py checks every registered model, both precisions).  The parameters
 of :class:`.Physics` (e, d, ρ_s, …) are runtime inputs, not constants, so changing them does not
 recompile; a model is compiled once per precision (≈ 1 s, cached like the kernel in
-``$KTGF_CACHE_DIR`` by :mod:`.cxx`).
+``$KTGF_CACHE_DIR`` by :mod:`.cxx`).  A program that cannot be built (the compiler fails) is said once, at
+WARNING on the ``ktgf`` logger, with what it costs: the stage then evaluates the closures in an XLA pass.
 
 It applies where the closures depend on the cell's own state only (no velocity gradient:
 :func:`.friction.needs_rate` false) and the jaxpr has only the primitives of :data:`_EXPRESSIONS`;
@@ -29,6 +30,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import hashlib
+import logging
 from dataclasses import dataclass
 from typing import Any
 
@@ -37,14 +39,16 @@ import jax.numpy as jnp
 import numpy as np
 from jax.extend.core import Literal
 
-from .cxx import shared_library
+from .cxx import shared_library, warn_once
 
+log = logging.getLogger(__name__)
 #: Outputs of a cell program, in the order the kernel stores them (its Field enum, then s0, s1); a
 #: step-start program (``limits``) adds :data:`.stepping.LIMIT_TERMS` and :data:`.stepping.STATUS_TERMS`, which the
 #: kernel reduces to maxima.
 OUTPUTS = ("rho", "u_x", "u_y", "u_z", "theta", "p_star", "g", "eta", "lambda_b", "kappa", "omega", "s0", "s1")
-FLAGS = ("-O3", "-march=native", "-fopenmp-simd", "-ffp-contract=off", "-fno-math-errno", "-shared", "-fPIC",
-         "-std=c++17")
+#: What the XLA closure pass costs where a program would run, for the one-line warning when it cannot be built:
+#: the A/B of ``benchmarks/bench_solver.py --ab`` (docs/solver.md, "Fallbacks").
+FALLBACK_COST = "1.1-1.5x the time per SSP-RK3 step"
 SYMBOL = "ktgf_cells"
 _CTYPES = {np.dtype(np.float64): "double", np.dtype(np.float32): "float", np.dtype(np.bool_): "bool",
            np.dtype(np.int32): "int32_t", np.dtype(np.int64): "int64_t"}
@@ -263,7 +267,7 @@ def source_for(treedef: Any, avals: tuple, dtype: Any, limits: str | None = None
 
 @functools.lru_cache(maxsize=None)
 def _compiled(source: str, dtype: Any, nlim: int, what: str) -> CellProgram:
-    function = getattr(ctypes.cdll.LoadLibrary(str(shared_library("cells", source, FLAGS, what, "1 s"))), SYMBOL)
+    function = getattr(ctypes.cdll.LoadLibrary(str(shared_library("cells", source, (), what, "1 s"))), SYMBOL)
     key = int(hashlib.sha256(source.encode()).hexdigest()[:15], 16)  # < 2^60: an int64 attribute
     return CellProgram(source, key, np.dtype(dtype), function, nlim)
 
@@ -275,9 +279,14 @@ def _program(treedef: Any, avals: tuple, dtype: Any, limits: str | None) -> Cell
     model = jax.tree_util.tree_unflatten(treedef, avals).model.name
     what = f"the {np.dtype(dtype).name} {'step-start ' if limits else ''}cell program of {model}"
     try:
-        return _compiled(source_for(treedef, avals, dtype, limits), dtype, 0 if limits is None else len(START_TERMS),
-                         what)
-    except (Unsupported, RuntimeError, OSError):
+        source = source_for(treedef, avals, dtype, limits)
+    except Unsupported:  # does not apply (module docstring): nothing lost that this configuration could have had
+        return None
+    try:
+        return _compiled(source, dtype, 0 if limits is None else len(START_TERMS), what)
+    except (RuntimeError, OSError) as err:
+        warn_once(log, f"{what} could not be built ({err}); the fused stage evaluates the closures in an XLA pass "
+                       f"instead, {FALLBACK_COST} (docs/solver.md, Fallbacks)", key="cell program build")
         return None
 
 

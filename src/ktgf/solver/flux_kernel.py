@@ -23,20 +23,21 @@ the path for GPUs, sharding, walls and Lees–Edwards boundaries.
 Build: one shared library per *variant* (:class:`Variant`: precision × limiter × Riemann solver × kind × row
 length, the kind one of :data:`KINDS` — the viscous flux divergence, the inviscid one of the IMEX scheme, or the
 SSP-RK3 stage entries; the row length that of the grid's last axis where :func:`row_length` fixes it, else any),
-compiled when a solver first needs it (:func:`applies`) with the C++ compiler
-``$CXX`` (default ``g++``; OpenMP, ``-O3 -march=native``) into ``$KTGF_CACHE_DIR`` (default
-``~/.cache/ktgf``) by :mod:`.cxx`, and kept there; a variant is chosen by ``-D`` macros, so each build
+compiled when a solver first needs it (:func:`applies`) by :mod:`.cxx` (the C++ compiler ``$CXX`` or the first
+found, ``-O3`` and the flags it accepts: ``-march=native``, OpenMP threads) into ``$KTGF_CACHE_DIR`` (default
+``~/.cache/ktgf``), and kept there; a variant is chosen by ``-D`` macros, so each build
 compiles the face sweep once (7–15 s here; one library of all 64 instantiations took 6 minutes).  Each
 variant registers its FFI targets under the base names (:data:`TARGET`, ...) plus :attr:`Variant.suffix`
 (:func:`target`); its handlers refuse a call that asks for another variant.  Without a compiler (or if a
-build fails) the JAX path runs and one warning says why; no further build is tried in that process.
+build fails, or JAX has no ``jax.ffi``) the JAX path runs and one WARNING on the ``ktgf`` logger says why and
+what it costs (:func:`unavailable`); no further build is tried in that process.
 """
 
 from __future__ import annotations
 
 import ctypes
+import logging
 import os
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -45,8 +46,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .cxx import shared_library
+from .cxx import shared_library, warn_once
 from .stencil import GHOST, LIMITERS, RIEMANN_SOLVERS
+
+log = logging.getLogger(__name__)
 
 SOURCE = Path(__file__).with_name("flux_kernel.cc")
 #: Base names of the FFI targets; a variant's are these plus its :attr:`Variant.suffix`.
@@ -56,7 +59,9 @@ CELLS_TARGET = "ktgf_ssprk_stage_cells"
 LIMITS_TARGET = "ktgf_cell_limits"
 #: Spins (``pause`` instructions, 3000 take 80 us on this machine) an idle OpenMP thread waits before it sleeps.
 SPIN_COUNT = 3000
-FLAGS = ("-O3", "-march=native", "-fopenmp", "-ffp-contract=off", "-fno-math-errno", "-shared", "-fPIC", "-std=c++17")
+#: What the JAX path costs where the kernel would run, for the one-line warning when it cannot be built: the
+#: time per step of the JAX path over the kernel's (docs/solver.md, "Fallbacks": 64³ RET float64 SSP-RK3).
+FALLBACK_COST = "about 6x the time per SSP-RK3 step on a periodic 3D grid"
 #: What a library computes, in the order of the KTGF_KIND values of flux_kernel.cc: the viscous flux
 #: divergence (:func:`flux_divergence` with ``viscous``), the inviscid one (the explicit part of the IMEX
 #: scheme), and the SSP-RK3 stage (:func:`ssprk_stage`, :func:`ssprk_stage_cells`, :func:`cell_limits` and the
@@ -124,8 +129,8 @@ def row_length(grid: Any) -> int:
     :data:`ROW_MIN` to :data:`ROW_MAX` in multiples of :data:`ROW_STEP`, else 0 (a library for any length).
 
     A library built for one row length has every stencil offset as a constant, so its loops need no set-up per
-    row (docs/solver.md, "Rows of a known length": in cache, one thread, float32 1.63x faster at 16-cell rows and
-    1.18x at 64, float64 1.25x and 1.07x).  Each new length costs one build (10-15 s, then cached); shorter rows
+    row (docs/solver.md at cef4049, "Rows of a known length": in cache, one thread, float32 1.63x faster at 16-cell
+    rows and 1.18x at 64, float64 1.25x and 1.07x).  Each new length costs one build (10-15 s, then cached); shorter rows
     would gain too, but grids of 8 cells and fewer a side are small tests, where a build costs more than it saves."""
     n = int(grid.cells[-1])
     return n if ROW_MIN <= n <= ROW_MAX and n % ROW_STEP == 0 else 0
@@ -145,8 +150,10 @@ def target(base: str, v: Variant) -> str:
 def build(v: Variant = DEFAULT) -> Path:
     """The compiled library of the variant ``v`` (built now if not in the cache); raises RuntimeError if it cannot
     be."""
-    return shared_library("flux_kernel", SOURCE, (*FLAGS, *v.macros, f"-I{jax.ffi.include_dir()}"),
-                          f"the CPU flux kernel for {v}", "10-15 s")
+    if not hasattr(jax, "ffi"):
+        raise RuntimeError(f"jax {jax.__version__} has no jax.ffi (jax >= 0.5 has)")
+    return shared_library("flux_kernel", SOURCE, (*v.macros, f"-I{jax.ffi.include_dir()}"),
+                          f"the CPU flux kernel for {v}", "10-15 s", threads=True)
 
 
 def _library(v: Variant) -> Any:
@@ -156,8 +163,8 @@ def _library(v: Variant) -> Any:
     if lib is None:
         # Idle OpenMP threads must sleep, not spin: between calls XLA's own threads need the cores.  But they
         # spin briefly first (GOMP_SPINCOUNT, 80 us here): a step calls the kernel three times with almost
-        # nothing in between, and waking a sleeping thread for each call cost about 0.2 ms per step (docs/solver.md,
-        # "Waking the threads").  Both are read once, when libgomp loads: set before the library is.
+        # nothing in between, and waking a sleeping thread for each call cost about 0.2 ms per step (docs/solver.md at
+        # cef4049, "Waking the threads").  Both are read once, when libgomp loads: set before the library is.
         os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
         os.environ.setdefault("GOMP_SPINCOUNT", str(SPIN_COUNT))
         lib = ctypes.cdll.LoadLibrary(str(build(v)))
@@ -170,17 +177,24 @@ def _library(v: Variant) -> Any:
 
 
 def _usable(v: Variant) -> bool:
-    """Whether the library of ``v`` is loaded, or can be now.  The first failure warns and switches the
-    kernel off for the process: a compiler that fails once would fail (slowly) for every variant."""
+    """Whether the library of ``v`` is loaded, or can be now.  The first failure warns (one line, WARNING on the
+    ``ktgf`` logger: why, and what the JAX path costs) and switches the kernel off for the process: a compiler
+    that fails once would fail (slowly) for every variant."""
     if "failed" in _loaded:
         return False
     try:
         _library(v)
     except (RuntimeError, OSError) as err:
-        warnings.warn(f"ktgf flux kernel unavailable, using the JAX path: {err}", RuntimeWarning, stacklevel=2)
         _loaded["failed"] = str(err)
+        warn_once(log, f"the C++ flux kernel is not available ({err}); the solver runs the JAX path instead, "
+                       f"{FALLBACK_COST} (docs/solver.md, Fallbacks)")
         return False
     return True
+
+
+def unavailable() -> str | None:
+    """Why the kernel is off in this process (the error of its first failed build), or None if it is not (yet)."""
+    return _loaded.get("failed")
 
 
 def available() -> bool:
