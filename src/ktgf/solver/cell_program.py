@@ -13,7 +13,7 @@ to memory, with no XLA closure pass at all.
 Physics stays in one place: the generated code is the jaxpr of the Python closures, operation for
 operation in the same precision (each jaxpr variable keeps its dtype; ``integer_pow`` is expanded as
 XLA expands it), so it agrees with the XLA evaluation to round-off
-(tests/test_solver_cell_program.py checks every registered model, both precisions).  The parameters
+(tests/solver/test_solver_cell_program.py checks every registered model, both precisions).  The parameters
 of :class:`.Physics` (e, d, ρ_s, …) are runtime inputs, not constants, so changing them does not
 recompile; a model is compiled once per precision (≈ 1 s, cached like the kernel in
 ``$KTGF_CACHE_DIR`` by :mod:`.cxx`).  A program that cannot be built (the compiler fails) is said once, at

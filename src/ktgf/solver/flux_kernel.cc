@@ -4,7 +4,7 @@
 // riemann_flux, stress, heat_flux, stress_work, face_divergence, cell_divergence) except that the
 // face divergence multiplies by 1/dx where the JAX path divides by dx (one rounding apart): the
 // JAX path is the reference, this kernel is checked against it to round-off
-// (tests/test_solver_flux_kernel.py).
+// (tests/solver/test_solver_flux_kernel.py).
 // Why a kernel: XLA recomputes every face state and wave speed inside each of the five flux
 // components of an axis (docs/solver.md, Speed); here each face is computed once, from cells
 // that sit in cache, and its flux goes to the two cells it separates.

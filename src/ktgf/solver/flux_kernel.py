@@ -5,7 +5,7 @@ limiter, HLL/Rusanov, central viscous stress and heat flux, face divergence, ∇
 cell fields the JAX path gets; every closure stays in Python (the cell programs of
 :func:`ssprk_stage_cells` are generated from it).  It computes each face once
 instead of once per flux component (docs/solver.md, Speed) and agrees with the JAX path to
-round-off (tests/test_solver_flux_kernel.py).  :func:`ssprk_stage` also applies the energy
+round-off (tests/solver/test_solver_flux_kernel.py).  :func:`ssprk_stage` also applies the energy
 source and the stage update of :func:`.stepping.ssprk3_step` in the same sweep, so a stage of
 the explicit scheme is one closure pass (XLA) and one kernel call; :func:`ssprk_stage_cells` also
 evaluates the closures, by a generated cell program (:mod:`.cell_program`), plane by plane as its sweep

@@ -480,7 +480,7 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
     also hold U's status: a step's state is checked in the next step's first stage (the last one's by
     :func:`.flux_kernel.cell_limits` after the loop), and a rejected step has overwritten the last good state,
     which is computed again from U by repeating the accepted steps: the same compiled steps, so the same
-    bits (the kernels do not depend on the thread count: tests/test_solver_flux_kernel.py).
+    bits (the kernels do not depend on the thread count: tests/solver/test_solver_flux_kernel.py).
     """
     program = start_program(grid, phys, num, U[0].dtype)
 
