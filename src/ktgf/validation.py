@@ -73,6 +73,13 @@ def check_range(
 def check_state(phi: Any, e: Any, theta: Any = None, *, phi_max: float = 1.0, rdf_name: str = "") -> None:
     """Check 0 ≤ φ < φ_max, 0 < e ≤ 1 and θ > 0 (if given); raise :class:`InputError` otherwise."""
     why = f"packing limit of RDF {rdf_name}" if rdf_name else "packing limit"
+    shapes = [np.shape(x) for x in (phi, e, theta) if x is not None]
+    try:
+        np.broadcast_shapes(*shapes)
+    except ValueError:
+        names = ("phi", "e", "theta")[:len(shapes)]
+        raise InputError("arrays of shapes " + ", ".join(f"{n} {s}" for n, s in zip(names, shapes))
+                         + " do not broadcast together: give arrays of one shape, or scalars") from None
     check_range("solid fraction phi", phi, low=0.0, high=phi_max, high_open=True, why=why)
     check_range("restitution coefficient e", e, low=0.0, high=1.0, low_open=True)
     if theta is not None:

@@ -100,3 +100,13 @@ def test_cli_plot_coefficients(tmp_path):
     result = runner.invoke(app, ["plot", "coefficients", "--e", "0.8", "--out", str(out)])
     assert result.exit_code == 0, result.output
     assert out.stat().st_size > 20_000
+
+
+@pytest.mark.contract
+def test_arrays_that_do_not_broadcast_are_one_line_input_errors() -> None:
+    """Found by the property test of tests/hcs: φ of shape (2,) with e of shape (3,) was a NumPy ValueError."""
+    from ktgf import get_model
+
+    for name in ("enskog", "ret", "dense"):
+        with pytest.raises(InputError, match=r"^arrays of shapes phi \(2,\), e \(3,\) do not broadcast together"):
+            get_model(name).reduced([0.1, 0.2], [0.9, 0.9, 0.9])

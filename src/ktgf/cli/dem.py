@@ -17,6 +17,7 @@ class DemFormat(str, Enum):
     csv = "csv"
     table = "table"
     json = "json"
+    markdown = "markdown"
 
 
 class Columns(str, Enum):
@@ -38,7 +39,7 @@ def shear_cmd(
     steps_per_contact: float = typer.Option(50.0, "--steps-per-contact", help="Time steps per contact time t_c/dt."),
     stiffness_check: bool = typer.Option(False, "--stiffness-check", help="Rerun every state at f_c/2 and report the change."),
     out: Path = typer.Option(None, "--out", "-o", help="Write the CSV file here (the format of the shared DEM files)."),
-    fmt: DemFormat = typer.Option(DemFormat.table, "--format", help="What to print: table, json or csv."),
+    fmt: DemFormat = typer.Option(DemFormat.table, "--format", help="What to print: table, json, csv (the file's text) or markdown."),
     columns: Columns = typer.Option(Columns.friction, "--columns",
                                     help="friction: dem_uniform_shear_friction.csv columns; smooth: dem_uniform_shear.csv (mu = 0)."),
     run_dir: Path = typer.Option(Path("ktgf-dem-runs"), "--run-dir", help="Folder of the runs (inputs, LAMMPS logs); reruns resume."),
@@ -88,7 +89,8 @@ def shear_cmd(
     else:
         from ._common import OutputFormat, emit
 
-        emit(output.rows(states, columns.value), OutputFormat.table, title=f"ktgf dem shear (LAMMPS {states[0].contact['lammps_version']})")
+        emit(output.rows(states, columns.value), OutputFormat(fmt.value),
+             title=f"ktgf dem shear (LAMMPS {states[0].contact['lammps_version']})")
         for ln in stiff_lines:
             typer.echo(ln[2:])
         if out is not None:
@@ -105,7 +107,7 @@ def cooling_cmd(
     contact_fraction: float = typer.Option(0.01, "--contact-fraction", help="Contact time over the Enskog mean free time at T0, f_c."),
     steps_per_contact: float = typer.Option(50.0, "--steps-per-contact", help="Time steps per contact time t_c/dt."),
     out: Path = typer.Option(None, "--out", "-o", help="Write the CSV file here (the format of dem_hcs_cooling.csv)."),
-    fmt: DemFormat = typer.Option(DemFormat.table, "--format", help="What to print: table, json or csv."),
+    fmt: DemFormat = typer.Option(DemFormat.table, "--format", help="What to print: table, json, csv (the file's text) or markdown."),
     run_dir: Path = typer.Option(Path("ktgf-dem-runs"), "--run-dir", help="Folder of the runs (inputs, LAMMPS logs); reruns resume."),
     workers: int = typer.Option(0, "--workers", help="Local processes running LAMMPS at once (0: one at a time, in-process)."),
     dask: str = typer.Option(None, "--dask", help=DASK_HELP),
@@ -157,7 +159,7 @@ def couette_cmd(
     steps_per_contact: float = typer.Option(50.0, "--steps-per-contact", help="Time steps per contact time t_c/dt."),
     seed: int = typer.Option(1, "--seed", help="Seed of the start lattice's vacancies and velocities."),
     out: Path = typer.Option(None, "--out", "-o", help="Write the profile CSV here (the format of dem_couette_e0.9_phi0.50.csv)."),
-    fmt: DemFormat = typer.Option(DemFormat.table, "--format", help="What to print: table, json or csv."),
+    fmt: DemFormat = typer.Option(DemFormat.table, "--format", help="What to print: table, json, csv (the file's text) or markdown."),
     run_dir: Path = typer.Option(Path("ktgf-dem-runs"), "--run-dir", help="Folder of the run (input, LAMMPS log); a rerun reads it back."),
 ) -> None:
     """Planar Couette flow between bumpy walls in LAMMPS: phi, u, theta and stress profiles and the wall stresses."""
@@ -183,7 +185,7 @@ def couette_cmd(
 
         typer.echo(json.dumps({k: v for k, v in res.items() if k != "rows"} | {"profile": res["rows"]}, indent=2, default=float))
         return
-    emit([{k: r[k] for k in COLUMNS[:7]} for r in res["rows"]], OutputFormat.table, title="ktgf dem couette")
+    emit([{k: r[k] for k in COLUMNS[:7]} for r in res["rows"]], OutputFormat(fmt.value), title="ktgf dem couette")
     typer.echo(f"wall shear stress tau = {res['tau']:.5g} +- {res['dtau']:.2g}, wall normal stress p_yy = {res['p_yy']:.5g} "
                f"+- {res['dp_yy']:.2g}, N = {res['N']}")
     if out is not None:
