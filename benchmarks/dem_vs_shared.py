@@ -12,14 +12,14 @@ from __future__ import annotations
 import math
 import sys
 
-from ktgf.data import read_friction_shear
+from ktgf.data import read_table
 
 OBSERVABLES = ("T", "Trot_over_T", "p_star", "tau_star", "tau_over_p", "p_over_nT", "eta_over_eta0", "eta_star")
 
 
 def main(mine_path: str, *shared_paths: str) -> None:
-    shared = [r for p in shared_paths for r in read_friction_shear(p)]
-    for m in read_friction_shear(mine_path):
+    shared = [r for p in shared_paths for r in read_table(p).records()]
+    for m in read_table(mine_path).records():
         key = (m.get("mu", 0.0), m["phi"], m["e"])
         ref = next((r for r in shared if (r.get("mu", 0.0), r["phi"], r["e"]) == key), None)
         if ref is None:
