@@ -16,7 +16,6 @@ homogeneous state to last to T0/4 (the shared boxes are).
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import time
@@ -28,7 +27,7 @@ import numpy as np
 from ..errors import InputError
 from . import analysis
 from .contact import calibrate_restitution, collision_frequency, spring_dashpot
-from .lammps import Lammps, find_lammps
+from .lammps import Lammps, RunParameters, find_lammps
 from .shear import RHO_S
 
 COLUMNS = ("phi", "e", "N", "seeds", "A_main", "A_main_sem", "A_early", "ratio_main", "ratio_early", "p_over_nT")
@@ -38,7 +37,7 @@ SAMPLES_PER_COLLISION = 5
 
 
 @dataclass(frozen=True)
-class CoolingRun:
+class CoolingRun(RunParameters):
     phi: float
     e: float
     particles: int = 6912
@@ -49,9 +48,6 @@ class CoolingRun:
     @property
     def key(self) -> str:
         return f"hcs_phi{self.phi:g}_e{self.e:g}_N{self.particles}_fc{self.contact_fraction:g}"
-
-    def digest(self) -> str:
-        return hashlib.sha256(json.dumps(asdict(self), sort_keys=True).encode()).hexdigest()[:16]
 
 
 def check_cooling(phi: float, e: float, particles: int, contact_fraction: float = 0.01) -> None:

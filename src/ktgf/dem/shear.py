@@ -13,7 +13,6 @@ Stress from LAMMPS ``compute pressure`` with the peculiar kinetic part (``temp/d
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import time
@@ -25,7 +24,7 @@ import numpy as np
 from ..errors import InputError
 from . import analysis
 from .contact import calibrate_restitution, collision_frequency
-from .lammps import Lammps, find_lammps
+from .lammps import Lammps, RunParameters, find_lammps
 
 #: DEM units: ρ_s = 6/π (d = m = 1), moment of inertia of a solid sphere I = m d²/10.
 RHO_S = 6.0 / math.pi
@@ -49,7 +48,7 @@ SERIES = ("T", "Trot", "pxx", "pyy", "pzz", "pxy", "contacts")
 
 
 @dataclass(frozen=True)
-class ShearRun:
+class ShearRun(RunParameters):
     """One LAMMPS run: a state (φ, e, μ, N) and seed with its protocol."""
 
     phi: float
@@ -65,9 +64,6 @@ class ShearRun:
     @property
     def key(self) -> str:
         return f"mu{self.mu:g}_phi{self.phi:g}_e{self.e:g}_N{self.particles}_fc{self.contact_fraction:g}"
-
-    def digest(self) -> str:
-        return hashlib.sha256(json.dumps(asdict(self), sort_keys=True).encode()).hexdigest()[:16]
 
 
 def jamming_point(mu: float) -> float:
