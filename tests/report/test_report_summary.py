@@ -61,6 +61,12 @@ def test_summary_is_first_and_every_number_comes_from_its_netcdf(quick_report, d
                     phi = float(row.case.split("=")[1])
                     k = int(np.argmin(np.abs(ds.phi.values - phi)))
                     again = abs(float(m.eta_model[k] / m.eta_dem[k] - 1))
+                elif row.measure.startswith("mean |model/DEM"):  # fitted models against all DEM files
+                    what, role = row.case.removeprefix("Fitted models, ").removesuffix(" rows").split(": ")
+                    pick = (ds.model == name) & (ds.role == role) & np.isfinite(ds.error)
+                    if what != "all DEM files":
+                        pick &= ds.case == what
+                    again = float(np.mean(np.abs(ds.error.values[pick.values])))
                 else:  # Couette profiles: recomputed from the model and DEM profiles in the file
                     dem = {"y": ds.y_dem.values, "ux": ds.u_dem.values, "phi": ds.phi_dem.values, "theta": ds.theta_dem.values}
                     e = couette.profile_errors(ds.y.values, {k: m[k].values for k in ("u", "phi", "theta")}, dem,

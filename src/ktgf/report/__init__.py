@@ -8,6 +8,7 @@ Sections (each cached on disk under a hash of its inputs, see :mod:`.framework`)
 4. :mod:`.cooling_gas` — 3D cooling gas below/above the critical size (needs :mod:`ktgf.solver`);
 5. :mod:`.dense` — dense regime: uniform-shear η*, p* against φ and Couette wall stresses, against DEM;
 6. :mod:`.friction` — frictional particles: the ``frictional`` model's uniform shear against frictional DEM;
+7. :mod:`.validation` — the fitted models against every DEM file, fitted and predicted points apart;
 
 then a discussion generated from the numbers and everything needed to rerun (:mod:`.page`).
 
@@ -17,7 +18,7 @@ then a discussion generated from the numbers and everything needed to rerun (:mo
 []
 """
 
-from . import coefficients, cooling_gas, couette, dense, friction, hcs  # noqa: F401  (registers the sections)
+from . import coefficients, cooling_gas, couette, dense, friction, hcs, validation  # noqa: F401  (registers the sections)
 from .build import Report, ReportInterrupted, build_report
 from .check import check_report
 from .framework import Section, SectionContext, SectionResult, register_section, sections

@@ -1,8 +1,9 @@
 """Section 6: frictional particles — uniform shear of the ``frictional`` model against the frictional DEM file.
 
-Models: the registered ``frictional`` model (RET, Chialvo–Sundaresan χ at φ_c(μ), Walton's collision
-rule, EKT correlation length with c fitted to T of the row μ = 0.5, φ = 0.5; ``docs/friction.md``) at the
-DEM's μ, and frictionless RET (the kinetic theory
+Models: the registered ``frictional`` model (``dense`` — RET, Carnahan–Starling plus a jamming term that
+diverges at φ_J(μ), the EKT correlation length — with Walton's collision rule; its two friction numbers
+fitted to the μ = 0.5 rows of both frictional files, ``docs/friction.md``) at the DEM's μ, and frictionless
+RET (the kinetic theory
 users have without friction).  Curves and table: :func:`ktgf.shear.steady.steady_shear`
 in the columns of ``dem_uniform_shear_friction.csv`` (d = m = 1, γ̇ = 1, e = 0.7): T, T_rot/T, p*, τ/p.
 The issue's goal (within 15 % of the DEM for p*, τ/p and T at μ = 0.5) is checked row by row.
@@ -109,8 +110,8 @@ def run(ctx: SectionContext) -> None:
     ctx.table("Frictional uniform shear: DEM values and model/DEM − 1 (%)",
               ["state", *[f"DEM {q}" for q in ("T", "p*", "τ/p", "T_rot/T")],
                *[f"{get_model(n).label} {q}" for n in MODELS for q in ("T", "p*", "τ/p", "T_rot/T")]], table,
-              note="Closed forms at the DEM's (μ, φ, e); DEM standard errors ≤ 1.3 %. Fitted: the frictional model's c, to T at "
-                   "μ = 0.5, φ = 0.5 (that cell is 0 by construction); every other cell is a prediction. "
+              note="Closed forms at the DEM's (μ, φ, e); DEM standard errors ≤ 1.3 %. Fitted: the frictional model's μ_Z and k, to "
+                   "the μ = 0.5 rows (section 7 and `ktgf validate --model frictional` mark each row fitted or predicted). "
                    "Frictionless RET has no rotation (T_rot/T: –).")
     goal = {f"{r['phi']:g}": max(abs(errs["frictional"][j][k + "_err"]) for k in GOAL) for j, r in enumerate(rows) if r["mu"] == 0.5}
     ctx.number("friction_errors", errs)
@@ -134,7 +135,7 @@ def discuss(nb: dict[str, Any]) -> list[str]:
     return [f"Frictional particles (μ = 0.5, e = 0.7): the 'frictional' model's largest error over T, p* and τ/p is "
             + ", ".join(f"{100 * v:.0f} % at φ = {phi}" for phi, v in worst.items())
             + f" — the issue's goal (within {100 * GOAL_TOLERANCE:.0f} %) is " + ("met" if met else "not met")
-            + " on the shared file (one fitted number: c, to T at φ = 0.5; the other values are predictions)."]
+            + " on the shared file (its μ = 0.5 rows are in the fit of the two friction numbers)."]
 
 
 SECTION = register_section(Section(

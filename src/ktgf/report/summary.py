@@ -93,9 +93,27 @@ def summarise(results: list[SectionResult]) -> Summary:
         if cw:
             for key, what in (("tau_error", "wall shear stress τ_w: |error|"), ("p_error", "wall normal stress p: |error|")):
                 s.rows.append(Row("Couette cell, wall stresses (predicted)", what, "dense", {n: abs(v[key]) for n, v in cw.items()}, data))
+    val = by.get("validation")
+    if val is not None and val.numbers.get("validation"):
+        _validation_rows(s, val)
     _recommend(s, states)
     _caveats(s, by, hcs)
     return s
+
+
+def _validation_rows(s: Summary, val: SectionResult) -> None:
+    """One row per case and role of the fitted models' validation (regime ``validation``: not ranked, the models
+    differ in what they were fitted to), the pooled rows first."""
+    per_model = val.numbers["validation"]
+    cases = list(dict.fromkeys(c for v in per_model.values() for c in v))
+    cases = ["all", *[c for c in cases if c != "all"]]
+    for case in cases:
+        for role in ("fitted", "predicted"):
+            errors = {n: v[case][role] for n, v in per_model.items() if role in v.get(case, {})}
+            if errors:
+                what = "all DEM files" if case == "all" else case
+                s.rows.append(Row(f"Fitted models, {what}: {role} rows", "mean |model/DEM − 1|", "validation", errors,
+                                  _data(val, "validation")))
 
 
 def _recommend(s: Summary, states: list[tuple[float, float]]) -> None:
@@ -158,6 +176,9 @@ def _caveats(s: Summary, by: dict[str, SectionResult], hcs: SectionResult | None
                          "real granules have friction: the frictional section compares the `frictional` model with frictional DEM.")
     else:
         s.caveats.append("All DEM data are for frictionless spheres; real granules have friction, which these closures omit.")
+    if any(r.regime == "validation" for r in s.rows):
+        s.caveats.append("Fitted models: quote the predicted rows (states not in the fit), not the fitted ones; those rows are "
+                         "not ranked against the paper's models, which were fitted to none of these data.")
     if "cooling_gas" in by:
         s.caveats.append("The 3D cooling-gas section has no DEM counterpart: it checks the predicted instability thresholds, not accuracy.")
 
