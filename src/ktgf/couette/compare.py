@@ -12,6 +12,10 @@ velocity at the outermost occupied DEM bins (|y| = 9.25 in the shared file) equa
 there (mean of both walls).  One scalar per model is fitted to one number; the profiles (u, φ, √θ)
 and the wall stresses are predictions.  A model read from a model file that holds walls
 (``ktgf calibrate`` on Couette data) keeps them instead.
+
+Bumpy walls (``wall="bumpy"``): the DEM's own walls, a layer of fixed spheres whose diameter and gap the
+file's header states (:func:`dem_bumpy_wall`), with e_w = e and the conditions of
+:func:`ktgf.couette.walls.bumpy_wall_fluxes`: nothing is fitted, so every number is a prediction.
 """
 
 from __future__ import annotations
@@ -24,7 +28,7 @@ import numpy as np
 
 from ..data import CouetteCase, CouetteData, read_couette
 from ..closures import PAPER_MODELS, get_model
-from ..errors import ConvergenceError
+from ..errors import ConvergenceError, InputError
 from .geometry import PlanarCell
 from .run import Material, run
 from .walls import Wall
@@ -34,10 +38,23 @@ from .walls import Wall
 DemProfile = CouetteData
 
 
+WALL_KINDS = ("johnson-jackson", "bumpy")
+
+
+def dem_bumpy_wall(case: CouetteCase, name: str = "the DEM file") -> Wall:
+    """The DEM cell's wall as a bumpy wall: wall-sphere diameter and gap from the header, e_w = e (nothing fitted)."""
+    if case.wall_sphere_diameter is None or case.wall_sphere_gap is None:
+        raise InputError(f"{name}: the header does not state the wall spheres (a line like '# geometry: ... walls = one "
+                         "hexagonal close-packed layer of 168 touching spheres each (d = 1, ...)'), needed by wall = bumpy")
+    return Wall.of_type("bumpy", restitution=case.e, wall_sphere_diameter=case.wall_sphere_diameter,
+                        wall_sphere_gap=case.wall_sphere_gap)
+
+
 def dem_cell(specularity: float, model: Any, case: CouetteCase, *, wall_restitution: float | None = None,
-             n_cells: int = 200, stretch: float = 1.5, start=None):
-    """The continuum counterpart of a DEM cell with JJ walls of the given specularity (e_w = e by default)."""
-    wall = Wall(specularity=specularity, restitution=case.e if wall_restitution is None else wall_restitution)
+             n_cells: int = 200, stretch: float = 1.5, start=None, wall: Wall | None = None):
+    """The continuum counterpart of a DEM cell with JJ walls of the given specularity (e_w = e by default), or ``wall``."""
+    if wall is None:
+        wall = Wall(specularity=specularity, restitution=case.e if wall_restitution is None else wall_restitution)
     return run(model, PlanarCell(case.gap, case.wall_speed), wall, wall, case.mean_phi,
                Material(case.d, case.rho_s, case.e), n_cells=n_cells, stretch=stretch, start=start)
 
@@ -88,22 +105,33 @@ def wall_stresses(ds) -> tuple[float, float]:
 
 
 def compare_with_dem(dem_path: str | Path, models=PAPER_MODELS, *, n_cells: int = 200,
-                     walls: dict[str, dict[str, float]] | None = None) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+                     walls: dict[str, dict[str, float]] | None = None,
+                     wall: str = "johnson-jackson") -> tuple[list[dict[str, Any]], dict[str, Any]]:
     """Each model in the DEM file's case: specularity calibrated on the DEM slip (or ``walls[name]``), errors, wall stresses.
 
     ``models`` are registry names or :class:`~ktgf.closures.Model` objects.  Returns (rows, extra)
     with one row per model: φ', RMS profile errors, wall shear stress ``tau_wall`` and pressure
     ``p`` with the DEM's ``tau_wall_dem``, ``p_dem`` and relative errors, max φ and ``valid``
     (converged and max φ below φ_rcp).  A model whose solve fails gets a row saying so.
+    ``wall="bumpy"``: every model between the DEM's bumpy walls (:func:`dem_bumpy_wall`; φ' is then NaN and
+    ``walls`` is not used), nothing fitted.
     """
+    if wall not in WALL_KINDS:
+        raise InputError(f"wall = {wall!r} is unknown; valid: {', '.join(WALL_KINDS)}")
     dem = read_couette(dem_path)
+    bumpy = dem_bumpy_wall(dem.case, dem.path.name) if wall == "bumpy" else None
     walls = walls or {}
     rows, datasets = [], {}
     for item in models:
         m = get_model(item)
         row: dict[str, Any] = {"model": m.label or m.name}
         try:
-            if m.name in walls:
+            if bumpy is not None:
+                spec = math.nan
+                ds = dem_cell(spec, m, dem.case, n_cells=n_cells, wall=bumpy)
+                how = (f"bumpy walls of the DEM ({dem.path.name}: spheres d_w = {bumpy.wall_sphere_diameter:g} d, gap "
+                       f"{bumpy.wall_sphere_gap:g} d), e_w = {bumpy.restitution:g}; nothing fitted")
+            elif m.name in walls:
                 w = walls[m.name]
                 spec = float(w.get("specularity", math.nan))
                 ds = dem_cell(spec, m, dem.case, wall_restitution=w.get("wall_restitution"), n_cells=n_cells)
