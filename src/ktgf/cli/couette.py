@@ -100,7 +100,7 @@ def compare_cmd(
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
     wall: str = typer.Option("johnson-jackson", "--wall", help="Walls of the DEM case: johnson-jackson (e_w = e, "
                              "specularity fitted per model to the DEM slip) or bumpy (the DEM's wall spheres from its "
-                             "header, e_w = e, nothing fitted)."),
+                             "header, e_w = e, nothing fitted; the cell is then the layer the sphere centres reach)."),
 ) -> None:
     """Models on one figure (u/U, phi, sqrt(theta)/U vs y/d) with DEM points, profile errors and wall stresses against the DEM."""
     from ..couette.compare import compare_with_dem
@@ -125,8 +125,10 @@ def compare_cmd(
         bumpy = wall == "bumpy"
         if bumpy:
             band_note = "±1σ bands: computed for Johnson-Jackson walls only" if model_file is not None else ""
+            cell = extra["cell"]
             walls_note = (f"bumpy walls (spheres d_w = {c.wall_sphere_diameter:g} d, gap {c.wall_sphere_gap:g} d, "
-                          "from the DEM header), e_w = e, nothing fitted")
+                          f"from the DEM header), e_w = e, nothing fitted; cell = the layer of the centres, gap "
+                          f"{cell.gap:.4g} d, mean phi {cell.mean_phi:.4g}")
         else:
             band_note = _couette_bands(rows, chosen, model_file, extra["dem"], walls, n_cells)
             walls_note = f"JJ walls, e_w = e, specularity fitted per model to the DEM slip at |y| = {extra['dem'].slip_y:g} d"

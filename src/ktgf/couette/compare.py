@@ -15,11 +15,17 @@ and the wall stresses are predictions.  A model read from a model file that hold
 
 Bumpy walls (``wall="bumpy"``): the DEM's own walls, a layer of fixed spheres whose diameter and gap the
 file's header states (:func:`dem_bumpy_wall`), with e_w = e and the conditions of
-:func:`ktgf.couette.walls.bumpy_wall_fluxes`: nothing is fitted, so every number is a prediction.
+:func:`ktgf.couette.walls.bumpy_wall_fluxes`: nothing is fitted, so every number is a prediction.  The
+continuum cell is then the layer the sphere centres can reach, |y| ≤ H/2 − h with h the height of a sphere
+resting in a hollow of the wall, holding the same particles (:func:`bumpy_dem_case`): the kinetic theory's
+fields are those of the centres, and the wall condition is written for the centres in contact with the wall
+spheres.  (The Johnson–Jackson cell keeps the slab between the planes tangent to the wall spheres; the
+wall stresses are sensitive to this choice, ``docs/dense.md`` §5.1.)
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 from typing import Any
@@ -48,6 +54,17 @@ def dem_bumpy_wall(case: CouetteCase, name: str = "the DEM file") -> Wall:
                          "hexagonal close-packed layer of 168 touching spheres each (d = 1, ...)'), needed by wall = bumpy")
     return Wall.of_type("bumpy", restitution=case.e, wall_sphere_diameter=case.wall_sphere_diameter,
                         wall_sphere_gap=case.wall_sphere_gap)
+
+
+def bumpy_dem_case(case: CouetteCase, wall: Wall) -> CouetteCase:
+    """The DEM case on the layer the sphere centres can reach between bumpy walls: gap H − 2h, same particles.
+
+    h = √(σ² − a²/3) (:attr:`ktgf.closures.bumpy_wall.BumpyWall.resting_height`, in d) is the height of the
+    centre of a sphere resting in a hollow of the wall above the wall-sphere centres, the farthest a centre
+    can go; the header's mean φ is over the slab H − d (``case.gap``), so φ̄' = φ̄ (H − d)/(H − 2h).
+    """
+    gap = case.gap + case.d - 2.0 * wall.spheres.resting_height * case.d
+    return dataclasses.replace(case, gap=gap, mean_phi=case.mean_phi * case.gap / gap)
 
 
 def dem_cell(specularity: float, model: Any, case: CouetteCase, *, wall_restitution: float | None = None,
@@ -114,12 +131,13 @@ def compare_with_dem(dem_path: str | Path, models=PAPER_MODELS, *, n_cells: int 
     ``p`` with the DEM's ``tau_wall_dem``, ``p_dem`` and relative errors, max φ and ``valid``
     (converged and max φ below φ_rcp).  A model whose solve fails gets a row saying so.
     ``wall="bumpy"``: every model between the DEM's bumpy walls (:func:`dem_bumpy_wall`; φ' is then NaN and
-    ``walls`` is not used), nothing fitted.
+    ``walls`` is not used) on the layer of the centres (:func:`bumpy_dem_case`; ``extra["cell"]``), nothing fitted.
     """
     if wall not in WALL_KINDS:
         raise InputError(f"wall = {wall!r} is unknown; valid: {', '.join(WALL_KINDS)}")
     dem = read_couette(dem_path)
     bumpy = dem_bumpy_wall(dem.case, dem.path.name) if wall == "bumpy" else None
+    cell = dem.case if bumpy is None else bumpy_dem_case(dem.case, bumpy)
     walls = walls or {}
     rows, datasets = [], {}
     for item in models:
@@ -128,9 +146,10 @@ def compare_with_dem(dem_path: str | Path, models=PAPER_MODELS, *, n_cells: int 
         try:
             if bumpy is not None:
                 spec = math.nan
-                ds = dem_cell(spec, m, dem.case, n_cells=n_cells, wall=bumpy)
+                ds = dem_cell(spec, m, cell, n_cells=n_cells, wall=bumpy)
                 how = (f"bumpy walls of the DEM ({dem.path.name}: spheres d_w = {bumpy.wall_sphere_diameter:g} d, gap "
-                       f"{bumpy.wall_sphere_gap:g} d), e_w = {bumpy.restitution:g}; nothing fitted")
+                       f"{bumpy.wall_sphere_gap:g} d), e_w = {bumpy.restitution:g}, on the layer of the centres (gap "
+                       f"{cell.gap:.4g} d, mean phi {cell.mean_phi:.4g}); nothing fitted")
             elif m.name in walls:
                 w = walls[m.name]
                 spec = float(w.get("specularity", math.nan))
@@ -157,7 +176,7 @@ def compare_with_dem(dem_path: str | Path, models=PAPER_MODELS, *, n_cells: int 
             "max_phi": float(ds.attrs["max_phi"]), "valid": bool(ds.attrs["physically_valid"]), "message": "",
         })
         datasets[m.name] = ds
-    return rows, {"datasets": datasets, "dem": dem, "target_u": dem.slip_speed(), "case": dem.case}
+    return rows, {"datasets": datasets, "dem": dem, "target_u": dem.slip_speed(), "case": dem.case, "cell": cell}
 
 
 def dem_slip_target(dem: CouetteData) -> float:
