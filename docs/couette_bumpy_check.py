@@ -62,11 +62,11 @@ def main() -> None:
     t0, c0 = time.time(), time.process_time()
     half_h = dem.case.gap / 2 + 0.5
     planes = (("tangent planes (wall-sphere tops)", half_h - 0.5 * wall.wall_sphere_diameter),
-              ("resting centre over a hollow, H/2 − h (Table 1)", half_h - wall.spheres.resting_height),
+              ("resting centre over a hollow, H/2 − h (as table 1)", half_h - wall.spheres.resting_height),
               ("contact over a saddle, H/2 − σ cos θ_w", half_h - wall.spheres.sigma * math.cos(wall.spheres.bumpiness)),
               ("contact on top of a wall sphere, H/2 − σ", half_h - wall.spheres.sigma))
     print("\nTable 2: bumpy walls, the continuum cell ending at other planes (same particles)\n")
-    print(HEAD.format("cell ends at |y| = … / model", u_dem))
+    print(HEAD.format("cell ends at y = ± … d / model", u_dem))
     for label, half in planes:
         case = dataclasses.replace(dem.case, gap=2 * half, mean_phi=dem.case.mean_phi * dem.case.gap / (2 * half))
         for name in ("dense", "proposed", "ret"):
