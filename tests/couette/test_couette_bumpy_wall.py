@@ -13,9 +13,9 @@ import math
 
 import numpy as np
 import pytest
+from helpers.calibration_synthetic import couette_header, with_header
 from typer.testing import CliRunner
 
-from helpers.calibration_synthetic import couette_header, with_header
 from ktgf.cli import app
 from ktgf.closures.bumpy_wall import BumpyWall, wall_fluxes
 from ktgf.couette import PlanarCell, Wall

@@ -18,8 +18,8 @@ and three equations:
 
 At the walls the outer half-cell fluxes are the wall conditions of :mod:`ktgf.couette.walls`
 (or the row is replaced by a Dirichlet condition); a bumpy wall's normal stress N is the model's
-pressure at the wall node, so its shear stress and heat flux also depend on φ there.  The scheme is conservative: at a solution
-the shear stress is the same in every interval and on both walls, and the shear work summed
+pressure at the wall node, so its shear stress and heat flux also depend on φ there.  The scheme
+is conservative: at a solution the shear stress is the same in every interval and on both walls, and the shear work summed
 over the intervals plus the slip work equals the wall power exactly, so the energy budget
 closes to the solver tolerance.  The truncation error is O(Δx²) inside and O(Δx) in the wall
 half-cells, which gives second-order global accuracy (tested by mesh refinement).
@@ -176,7 +176,7 @@ class Problem:
             wall = self.walls[k]
             slip[k] = u[i] - self.u_wall[k]
             cf = jj_friction(wall, phi[i], chi_w[k], theta[i])
-            bumpy = (bumpy_wall_fluxes(wall, p[i], theta[i], slip[k]) if wall.is_bumpy else None)
+            bumpy = bumpy_wall_fluxes(wall, p[i], theta[i], slip[k]) if wall.is_bumpy else None
             if bumpy is not None:  # N = the flow's normal stress at the wall node (p_yy = p in these models)
                 wall_dissipation[k] = bumpy[2]
             if wall.momentum == "bumpy":

@@ -211,7 +211,7 @@ def bumpy_wall_fluxes(wall: Wall, normal_stress, theta, slip):
     S = N F(v/√θ), Q = N √θ G(v/√θ, e_w) = S v − D with F, G of :func:`ktgf.closures.bumpy_wall.wall_fluxes` (the
     kinetics of Maxwellian spheres hitting the wall's spheres; derivation and tests there, ``docs/dense_physics.md``
     §6).  ``normal_stress`` N is the flow's normal stress at the wall, ``theta`` θ and ``slip`` v = u − u_wall
-    in any consistent units (S, D in those of N; Q in N × velocity).  NumPy arrays; a non-finite state (a
+    in any consistent units (S in those of N; D − Q and D in N × velocity).  NumPy arrays; a non-finite state (a
     Newton trial point) gives NaN instead of an input error, so the solver's line search can reject it.
     """
     with np.errstate(all="ignore"):
