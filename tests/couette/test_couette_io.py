@@ -79,7 +79,7 @@ def test_bad_input_to_library_functions():
     with pytest.raises(InputError, match="momentum condition 'sticky'"):
         Wall(momentum="sticky")
     with pytest.raises(InputError, match="wall type"):
-        Wall.of_type("bumpy")
+        Wall.of_type("grooved")  # "bumpy" is a wall type since issue 33
     with pytest.raises(InputError, match="mean solid fraction"):
         run("visc-div", PlanarCell(0.02, 1.0), Wall(), Wall(), 0.66, Material(1e-3, 2500.0, 0.9))
 

@@ -98,6 +98,9 @@ def compare_cmd(
     model_file: Path = model_file_option(),
     n_cells: int = typer.Option(200, "--cells", help="Grid cells across the gap (DEM case)."),
     fmt: OutputFormat = typer.Option(OutputFormat.table, "--format", help="table, json, csv or markdown."),
+    wall: str = typer.Option("johnson-jackson", "--wall", help="Walls of the DEM case: johnson-jackson (e_w = e, "
+                             "specularity fitted per model to the DEM slip) or bumpy (the DEM's wall spheres from its "
+                             "header, e_w = e, nothing fitted; the cell is then the layer the sphere centres reach)."),
 ) -> None:
     """Models on one figure (u/U, phi, sqrt(theta)/U vs y/d) with DEM points, profile errors and wall stresses against the DEM."""
     from ..couette.compare import compare_with_dem
@@ -117,16 +120,26 @@ def compare_cmd(
         from ..data.table import resolve
 
         dem = resolve(dem)  # a missing file: one line naming it and the shipped files
-        rows, extra = compare_with_dem(dem, chosen, n_cells=n_cells, walls=walls)
+        rows, extra = compare_with_dem(dem, chosen, n_cells=n_cells, walls=walls, wall=wall)
         c = extra["case"]
-        band_note = _couette_bands(rows, chosen, model_file, extra["dem"], walls, n_cells)
+        bumpy = wall == "bumpy"
+        if bumpy:
+            band_note = "±1σ bands: computed for Johnson-Jackson walls only" if model_file is not None else ""
+            cell = extra["cell"]
+            walls_note = (f"bumpy walls (spheres d_w = {c.wall_sphere_diameter:g} d, gap {c.wall_sphere_gap:g} d, "
+                          f"from the DEM header), e_w = e, nothing fitted; cell = the layer of the centres, gap "
+                          f"{cell.gap:.4g} d, mean phi {cell.mean_phi:.4g}")
+        else:
+            band_note = _couette_bands(rows, chosen, model_file, extra["dem"], walls, n_cells)
+            walls_note = f"JJ walls, e_w = e, specularity fitted per model to the DEM slip at |y| = {extra['dem'].slip_y:g} d"
         datasets = {m.label or m.name: extra["datasets"][m.name] for m in chosen if m.name in extra["datasets"]}
         emit(rows, fmt, title=(f"Models vs DEM ({dem.name}: e = {c.e:g}, mean phi = {c.mean_phi:g}, gap = {c.gap:g} d, U = {c.wall_speed:g}); "
-                               f"JJ walls, e_w = e, specularity fitted per model to the DEM slip at |y| = {extra['dem'].slip_y:g} d"))
+                               f"{walls_note}"))
         if band_note:
             typer.echo(band_note, err=fmt == OutputFormat.json)
         path = plot_profiles(datasets, out, dem=extra["dem"],
-                             title=f"DEM Couette e = {c.e:g}, mean phi = {c.mean_phi:g}; specularity calibrated per model")
+                             title=f"DEM Couette e = {c.e:g}, mean phi = {c.mean_phi:g}; "
+                                   + ("bumpy walls, nothing fitted" if bumpy else "specularity calibrated per model"))
     else:
         from ..couette.config import load_config, run_config
 

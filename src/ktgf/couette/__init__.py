@@ -1,6 +1,6 @@
 """Steady Couette shear cells (planar and annular) for every closure model (model.md §§7, 9).
 
-Modules: :mod:`.geometry` (cells, grids, metrics), :mod:`.walls` (Johnson–Jackson, prescribed,
+Modules: :mod:`.geometry` (cells, grids, metrics), :mod:`.walls` (Johnson–Jackson, bumpy, prescribed,
 zero-flux walls), :mod:`.equations` (discrete balances), :mod:`.solver` (Newton, pseudo-transient
 and homotopy continuation), :mod:`.run` (Dataset output),
 :mod:`.config` (validated TOML configs), :mod:`.compare` (four models, DEM data), :mod:`.chute`
@@ -17,8 +17,9 @@ Example::
     ds.attrs["validity"], ds["u"], ds["phi"], ds["theta"], ds["wall_shear_stress"]
 
 Command line: ``ktgf couette run examples/couette_planar.toml``, ``ktgf couette compare``
-(four models and the DEM profile), ``ktgf couette sweep CONFIG --specularity 0.001:1:7
---wall-restitution 0.8,0.9 --workers 2``, ``ktgf plot couette out.nc``.
+(four models and the DEM profile; ``--wall bumpy``: the DEM's wall spheres, nothing fitted),
+``ktgf couette sweep CONFIG --specularity 0.001:1:7 --wall-restitution 0.8,0.9 --workers 2``,
+``ktgf plot couette out.nc``.
 """
 
 from .chute import InclinedLayer, solve_chute

@@ -12,10 +12,20 @@ velocity at the outermost occupied DEM bins (|y| = 9.25 in the shared file) equa
 there (mean of both walls).  One scalar per model is fitted to one number; the profiles (u, φ, √θ)
 and the wall stresses are predictions.  A model read from a model file that holds walls
 (``ktgf calibrate`` on Couette data) keeps them instead.
+
+Bumpy walls (``wall="bumpy"``): the DEM's own walls, a layer of fixed spheres whose diameter and gap the
+file's header states (:func:`dem_bumpy_wall`), with e_w = e and the conditions of
+:func:`ktgf.couette.walls.bumpy_wall_fluxes`: nothing is fitted, so every number is a prediction.  The
+continuum cell is then the layer the sphere centres can reach, |y| ≤ H/2 − h with h the height of a sphere
+resting in a hollow of the wall, holding the same particles (:func:`bumpy_dem_case`): the kinetic theory's
+fields are those of the centres, and the wall condition is written for the centres in contact with the wall
+spheres.  (The Johnson–Jackson cell keeps the slab between the planes tangent to the wall spheres; the
+wall stresses are sensitive to this choice, ``docs/dense.md`` §5.1.)
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 from typing import Any
@@ -24,7 +34,7 @@ import numpy as np
 
 from ..data import CouetteCase, CouetteData, read_couette
 from ..closures import PAPER_MODELS, get_model
-from ..errors import ConvergenceError
+from ..errors import ConvergenceError, InputError
 from .geometry import PlanarCell
 from .run import Material, run
 from .walls import Wall
@@ -34,10 +44,34 @@ from .walls import Wall
 DemProfile = CouetteData
 
 
+WALL_KINDS = ("johnson-jackson", "bumpy")
+
+
+def dem_bumpy_wall(case: CouetteCase, name: str = "the DEM file") -> Wall:
+    """The DEM cell's wall as a bumpy wall: wall-sphere diameter and gap from the header, e_w = e (nothing fitted)."""
+    if case.wall_sphere_diameter is None or case.wall_sphere_gap is None:
+        raise InputError(f"{name}: the header does not state the wall spheres (a line like '# geometry: ... walls = one "
+                         "hexagonal close-packed layer of 168 touching spheres each (d = 1, ...)'), needed by wall = bumpy")
+    return Wall.of_type("bumpy", restitution=case.e, wall_sphere_diameter=case.wall_sphere_diameter,
+                        wall_sphere_gap=case.wall_sphere_gap)
+
+
+def bumpy_dem_case(case: CouetteCase, wall: Wall) -> CouetteCase:
+    """The DEM case on the layer the sphere centres can reach between bumpy walls: gap H − 2h, same particles.
+
+    h = √(σ² − a²/3) (:attr:`ktgf.closures.bumpy_wall.BumpyWall.resting_height`, in d) is the height of the
+    centre of a sphere resting in a hollow of the wall above the wall-sphere centres, the farthest a centre
+    can go; the header's mean φ is over the slab H − d (``case.gap``), so φ̄' = φ̄ (H − d)/(H − 2h).
+    """
+    gap = case.gap + case.d - 2.0 * wall.spheres.resting_height * case.d
+    return dataclasses.replace(case, gap=gap, mean_phi=case.mean_phi * case.gap / gap)
+
+
 def dem_cell(specularity: float, model: Any, case: CouetteCase, *, wall_restitution: float | None = None,
-             n_cells: int = 200, stretch: float = 1.5, start=None):
-    """The continuum counterpart of a DEM cell with JJ walls of the given specularity (e_w = e by default)."""
-    wall = Wall(specularity=specularity, restitution=case.e if wall_restitution is None else wall_restitution)
+             n_cells: int = 200, stretch: float = 1.5, start=None, wall: Wall | None = None):
+    """The continuum counterpart of a DEM cell with JJ walls of the given specularity (e_w = e by default), or ``wall``."""
+    if wall is None:
+        wall = Wall(specularity=specularity, restitution=case.e if wall_restitution is None else wall_restitution)
     return run(model, PlanarCell(case.gap, case.wall_speed), wall, wall, case.mean_phi,
                Material(case.d, case.rho_s, case.e), n_cells=n_cells, stretch=stretch, start=start)
 
@@ -88,22 +122,35 @@ def wall_stresses(ds) -> tuple[float, float]:
 
 
 def compare_with_dem(dem_path: str | Path, models=PAPER_MODELS, *, n_cells: int = 200,
-                     walls: dict[str, dict[str, float]] | None = None) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+                     walls: dict[str, dict[str, float]] | None = None,
+                     wall: str = "johnson-jackson") -> tuple[list[dict[str, Any]], dict[str, Any]]:
     """Each model in the DEM file's case: specularity calibrated on the DEM slip (or ``walls[name]``), errors, wall stresses.
 
     ``models`` are registry names or :class:`~ktgf.closures.Model` objects.  Returns (rows, extra)
     with one row per model: φ', RMS profile errors, wall shear stress ``tau_wall`` and pressure
     ``p`` with the DEM's ``tau_wall_dem``, ``p_dem`` and relative errors, max φ and ``valid``
     (converged and max φ below φ_rcp).  A model whose solve fails gets a row saying so.
+    ``wall="bumpy"``: every model between the DEM's bumpy walls (:func:`dem_bumpy_wall`; φ' is then NaN and
+    ``walls`` is not used) on the layer of the centres (:func:`bumpy_dem_case`; ``extra["cell"]``), nothing fitted.
     """
+    if wall not in WALL_KINDS:
+        raise InputError(f"wall = {wall!r} is unknown; valid: {', '.join(WALL_KINDS)}")
     dem = read_couette(dem_path)
+    bumpy = dem_bumpy_wall(dem.case, dem.path.name) if wall == "bumpy" else None
+    cell = dem.case if bumpy is None else bumpy_dem_case(dem.case, bumpy)
     walls = walls or {}
     rows, datasets = [], {}
     for item in models:
         m = get_model(item)
         row: dict[str, Any] = {"model": m.label or m.name}
         try:
-            if m.name in walls:
+            if bumpy is not None:
+                spec = math.nan
+                ds = dem_cell(spec, m, cell, n_cells=n_cells, wall=bumpy)
+                how = (f"bumpy walls of the DEM ({dem.path.name}: spheres d_w = {bumpy.wall_sphere_diameter:g} d, gap "
+                       f"{bumpy.wall_sphere_gap:g} d), e_w = {bumpy.restitution:g}, on the layer of the centres (gap "
+                       f"{cell.gap:.4g} d, mean phi {cell.mean_phi:.4g}); nothing fitted")
+            elif m.name in walls:
                 w = walls[m.name]
                 spec = float(w.get("specularity", math.nan))
                 ds = dem_cell(spec, m, dem.case, wall_restitution=w.get("wall_restitution"), n_cells=n_cells)
@@ -129,7 +176,7 @@ def compare_with_dem(dem_path: str | Path, models=PAPER_MODELS, *, n_cells: int 
             "max_phi": float(ds.attrs["max_phi"]), "valid": bool(ds.attrs["physically_valid"]), "message": "",
         })
         datasets[m.name] = ds
-    return rows, {"datasets": datasets, "dem": dem, "target_u": dem.slip_speed(), "case": dem.case}
+    return rows, {"datasets": datasets, "dem": dem, "target_u": dem.slip_speed(), "case": dem.case, "cell": cell}
 
 
 def dem_slip_target(dem: CouetteData) -> float:

@@ -14,9 +14,11 @@ Example (``examples/couette_planar.toml``)::
     wall_speed = 1.0              # m/s
 
     [walls]                       # both walls; [walls.bottom] / [walls.top] override
-    type = "johnson-jackson"      # johnson-jackson | prescribed | zero-flux | no-slip-adiabatic
+    type = "johnson-jackson"      # johnson-jackson | prescribed | zero-flux | no-slip-adiabatic | bumpy
     specularity = 0.1
     restitution = 0.9
+    # type = "bumpy": wall_sphere_diameter = 1.0 and wall_sphere_gap = 0.0 (units of d; the default,
+    # touching spheres of the particles' size) replace the specularity
 
     [numerics]
     n_cells = 200
@@ -84,6 +86,8 @@ class WallConfig(_Strict):
     heat_flux: Literal["total", "conductive"] | None = None
     friction_angle: float | None = Field(None, ge=0, lt=90, description="wall friction angle delta_w [degrees]")
     slip_regularisation: float | None = Field(None, gt=0, le=1)
+    wall_sphere_diameter: float | None = Field(None, gt=0, description="bumpy wall: wall-sphere diameter d_w/d")
+    wall_sphere_gap: float | None = Field(None, ge=0, description="bumpy wall: gap between wall spheres s/d")
 
     @field_validator("type")
     @classmethod

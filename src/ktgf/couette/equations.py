@@ -17,8 +17,9 @@ and three equations:
   dp/dr = ρu²/r in the annular one), the last row replaced by the inventory ⟨φ⟩ = φ̄.
 
 At the walls the outer half-cell fluxes are the wall conditions of :mod:`ktgf.couette.walls`
-(or the row is replaced by a Dirichlet condition).  The scheme is conservative: at a solution
-the shear stress is the same in every interval and on both walls, and the shear work summed
+(or the row is replaced by a Dirichlet condition); a bumpy wall's normal stress N is the model's
+pressure at the wall node, so its shear stress and heat flux also depend on φ there.  The scheme
+is conservative: at a solution the shear stress is the same in every interval and on both walls, and the shear work summed
 over the intervals plus the slip work equals the wall power exactly, so the energy budget
 closes to the solver tolerance.  The truncation error is O(Δx²) inside and O(Δx) in the wall
 half-cells, which gives second-order global accuracy (tested by mesh refinement).
@@ -35,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from .frictional_stress import frictional_terms
-from .walls import Wall, jj_friction, jj_frictional_wall_stress, jj_heat_loss
+from .walls import Wall, bumpy_wall_fluxes, jj_friction, jj_frictional_wall_stress, jj_heat_loss
 
 N_VARS = 3  # u, ln θ, ψ per node
 
@@ -166,26 +167,34 @@ class Problem:
         P = F_kinetic * dw  # frictional work is dissipated at the contacts (frictional_stress.py)
         gamma = 1.5 * phi * theta * c.zeta0[node]
         chi_w = self.model.chi(phi[[0, -1]])
+        p = c.p[node] + p_fric
         F_wall = np.zeros(2)
         E_wall = np.zeros(2)
         slip = np.zeros(2)
+        wall_dissipation = np.zeros(2)
         for k, (i, sign) in enumerate(((0, 1.0), (-1, -1.0))):
             wall = self.walls[k]
             slip[k] = u[i] - self.u_wall[k]
             cf = jj_friction(wall, phi[i], chi_w[k], theta[i])
+            bumpy = bumpy_wall_fluxes(wall, p[i], theta[i], slip[k]) if wall.is_bumpy else None
+            if bumpy is not None:  # N = the flow's normal stress at the wall node (p_yy = p in these models)
+                wall_dissipation[k] = bumpy[2]
+            if wall.momentum == "bumpy":
+                F_wall[k] = sign * self.S_wall[k] * bumpy[0]
             if wall.momentum == "johnson-jackson":
                 F_wall[k] = sign * self.S_wall[k] * cf * slip[k]
                 if wall.friction_angle > 0.0:  # its work is dissipated at the wall contacts, not fed to θ
                     scale = wall.slip_regularisation * abs(self.u_wall[1] - self.u_wall[0])
                     F_wall[k] += sign * self.S_wall[k] * jj_frictional_wall_stress(wall, p_fric[i], slip[k], scale)
-            if wall.energy == "johnson-jackson":
-                E_wall[k] = sign * self.B_wall[k] * jj_heat_loss(wall, phi[i], chi_w[k], theta[i], slip[k])
-                if wall.heat_flux == "conductive":  # JJ set κ∂θ/∂n only: add the ω∂φ/∂x part
+            if wall.energy in ("johnson-jackson", "bumpy"):
+                loss = bumpy[1] if wall.energy == "bumpy" else jj_heat_loss(wall, phi[i], chi_w[k], theta[i], slip[k])
+                E_wall[k] = sign * self.B_wall[k] * loss
+                if wall.heat_flux == "conductive":  # the condition sets κ∂θ/∂n only: add the ω∂φ/∂x part
                     E_wall[k] += self.B_wall[k] * c.omega[node][i] * self._wall_gradient(phi, k)
-        p = c.p[node] + p_fric
         return {
             "u": u, "theta": theta, "phi": phi, "p": p, "eta": c.eta[node],
             "F": F, "E": E, "P": P, "gamma": gamma, "F_wall": F_wall, "E_wall": E_wall, "slip": slip,
+            "wall_dissipation": wall_dissipation,
             "K": self.centrifugal * self.geometry.centripetal(u, self.x, phi, p),
             "p_frictional": p_fric, "frictional_work": (F - F_kinetic) * dw,
         }

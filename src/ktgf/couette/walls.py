@@ -6,7 +6,10 @@ momentum
     ``johnson-jackson``  partial slip, η ∂u_t/∂n = (π√3/6) φ' (φ/φ_pk) ρ_s χ √θ u_sl
                          (Johnson & Jackson 1987, JFM 176, 67);
     ``prescribed``       the medium moves at the wall speed minus a prescribed lag (``slip``; 0 = no slip);
-    ``free-slip``        zero shear stress.
+    ``free-slip``        zero shear stress;
+    ``bumpy``            a wall of fixed spheres (diameter ``wall_sphere_diameter`` d_w/d, gap ``wall_sphere_gap``
+                         s/d, hexagonal layer, rows along the slip): shear stress S = N F(u_sl/√θ), N the
+                         flow's normal stress at the wall (:mod:`ktgf.closures.bumpy_wall`; no fitted parameter).
     A Johnson–Jackson wall with a wall friction angle δ_w > 0 (``friction_angle``) adds the frictional
     wall traction p_f tan δ_w in the direction of the slip (Johnson & Jackson 1987; :func:`jj_frictional_wall_stress`).
 energy
@@ -14,7 +17,9 @@ energy
                          D = (π√3/(4φ_pk)) (1 − e_w²) ρ_s φ χ θ^{3/2} (dissipation at the wall) and
                          G = (π√3/(6φ_pk)) φ' ρ_s φ χ √θ |u_sl|² (slip work);
     ``prescribed``       θ = ``temperature`` at the wall;
-    ``adiabatic``        zero heat flux.
+    ``adiabatic``        zero heat flux;
+    ``bumpy``            q·n = N √θ G(u_sl/√θ, e_w) into the medium = S u_sl − D (slip work minus the collisional
+                         dissipation at the wall spheres; :mod:`ktgf.closures.bumpy_wall`).
 
 Choices made here (documented defaults, exposed as options):
 
@@ -40,11 +45,14 @@ import math
 from dataclasses import dataclass
 from typing import Literal
 
+import numpy as np
+
+from ..closures.bumpy_wall import BumpyWall, wall_fluxes
 from ..errors import InputError
 from ..validation import check_positive, check_range
 
-MOMENTUM_CONDITIONS = ("johnson-jackson", "prescribed", "free-slip")
-ENERGY_CONDITIONS = ("johnson-jackson", "prescribed", "adiabatic")
+MOMENTUM_CONDITIONS = ("johnson-jackson", "prescribed", "free-slip", "bumpy")
+ENERGY_CONDITIONS = ("johnson-jackson", "prescribed", "adiabatic", "bumpy")
 HEAT_FLUX_FORMS = ("total", "conductive")
 #: Preset wall types: (momentum, energy).
 WALL_TYPES = {
@@ -52,6 +60,7 @@ WALL_TYPES = {
     "prescribed": ("prescribed", "prescribed"),
     "zero-flux": ("free-slip", "adiabatic"),
     "no-slip-adiabatic": ("prescribed", "adiabatic"),
+    "bumpy": ("bumpy", "bumpy"),
 }
 
 SQRT3_PI = math.sqrt(3.0) * math.pi
@@ -63,8 +72,8 @@ class Wall:
 
     Parameters
     ----------
-    momentum : {"johnson-jackson", "prescribed", "free-slip"}
-    energy : {"johnson-jackson", "prescribed", "adiabatic"}
+    momentum : {"johnson-jackson", "prescribed", "free-slip", "bumpy"}
+    energy : {"johnson-jackson", "prescribed", "adiabatic", "bumpy"}
     specularity : float
         Johnson–Jackson specularity coefficient φ' (0 < φ' ≤ 1).
     restitution : float
@@ -85,10 +94,15 @@ class Wall:
     slip_regularisation : float
         ε_w of the frictional traction's direction u_sl/√(u_sl² + (ε_w U)²), U the cell's velocity
         difference (default 10⁻³, as the frictional viscosity's ``regularisation``).
+    wall_sphere_diameter : float
+        Bumpy wall: diameter of the wall spheres in units of the flowing particle diameter, d_w/d > 0 (default 1).
+    wall_sphere_gap : float
+        Bumpy wall: gap between neighbouring wall spheres in units of d, 0 ≤ s/d < √3 (1 + d_w/d)/2 − d_w/d
+        (default 0, touching; above that bound a flowing sphere passes between them).
     """
 
-    momentum: Literal["johnson-jackson", "prescribed", "free-slip"] = "johnson-jackson"
-    energy: Literal["johnson-jackson", "prescribed", "adiabatic"] = "johnson-jackson"
+    momentum: Literal["johnson-jackson", "prescribed", "free-slip", "bumpy"] = "johnson-jackson"
+    energy: Literal["johnson-jackson", "prescribed", "adiabatic", "bumpy"] = "johnson-jackson"
     specularity: float = 0.5
     restitution: float = 0.9
     packing_limit: float = 0.64
@@ -97,6 +111,8 @@ class Wall:
     heat_flux: Literal["total", "conductive"] = "total"
     friction_angle: float = 0.0
     slip_regularisation: float = 1e-3
+    wall_sphere_diameter: float = 1.0
+    wall_sphere_gap: float = 0.0
 
     def __post_init__(self) -> None:
         if self.heat_flux not in HEAT_FLUX_FORMS:
@@ -113,6 +129,12 @@ class Wall:
                     why="degrees")
         check_range("wall slip regularisation slip_regularisation", self.slip_regularisation, low=0.0, high=1.0,
                     low_open=True, why="fraction of the cell's velocity difference")
+        check_range("bumpy wall sphere diameter wall_sphere_diameter", self.wall_sphere_diameter, low=0.0,
+                    low_open=True, why="d_w/d, in units of the flowing particle diameter")
+        largest_gap = math.sqrt(3.0) * 0.5 * (1.0 + self.wall_sphere_diameter) - self.wall_sphere_diameter
+        check_range("bumpy wall sphere gap wall_sphere_gap", self.wall_sphere_gap, low=0.0, high=largest_gap,
+                    high_open=True, why=f"s/d; at s/d >= {largest_gap:.4g} a flowing sphere passes between the wall "
+                    f"spheres of d_w/d = {self.wall_sphere_diameter:g}")
         if self.energy == "prescribed":
             if self.temperature is None:
                 raise InputError("wall temperature is required when the wall energy condition is 'prescribed'")
@@ -127,7 +149,20 @@ class Wall:
         return cls(momentum=momentum, energy=energy, **params)  # type: ignore[arg-type]
 
     def describe(self) -> dict[str, object]:
-        return dict(self.__dict__)
+        """The wall's settings (the wall-sphere geometry only for a bumpy wall)."""
+        out = dict(self.__dict__)
+        if not self.is_bumpy:
+            del out["wall_sphere_diameter"], out["wall_sphere_gap"]
+        return out
+
+    @property
+    def is_bumpy(self) -> bool:
+        return "bumpy" in (self.momentum, self.energy)
+
+    @property
+    def spheres(self) -> BumpyWall:
+        """The wall-sphere layer of a bumpy wall (hexagonal, rows along the slip)."""
+        return BumpyWall(d_w=self.wall_sphere_diameter, gap=self.wall_sphere_gap)
 
 
 def jj_friction(wall: Wall, phi, chi, theta):
@@ -168,3 +203,23 @@ def jj_frictional_wall_stress(wall: Wall, p_f, slip, slip_scale):
     (``docs/friction.md`` §8).  Exactly 0 for δ_w = 0.
     """
     return p_f * math.tan(math.radians(wall.friction_angle)) * slip / (slip * slip + slip_scale * slip_scale) ** 0.5
+
+
+def bumpy_wall_fluxes(wall: Wall, normal_stress, theta, slip):
+    """(S, D − Q, D) of a bumpy wall: shear stress along the slip, heat flux out of the medium, wall dissipation.
+
+    S = N F(v/√θ), Q = N √θ G(v/√θ, e_w) = S v − D with F, G of :func:`ktgf.closures.bumpy_wall.wall_fluxes` (the
+    kinetics of Maxwellian spheres hitting the wall's spheres; derivation and tests there, ``docs/dense_physics.md``
+    §6).  ``normal_stress`` N is the flow's normal stress at the wall, ``theta`` θ and ``slip`` v = u − u_wall
+    in any consistent units (S in those of N; D − Q and D in N × velocity).  NumPy arrays; a non-finite state (a
+    Newton trial point) gives NaN instead of an input error, so the solver's line search can reject it.
+    """
+    with np.errstate(all="ignore"):
+        root = np.sqrt(theta)
+        ratio = np.asarray(slip / root, dtype=float)
+    if not np.all(np.isfinite(ratio)) or not np.all(np.isfinite(normal_stress)):
+        nan = np.full(np.shape(ratio), np.nan)
+        return nan, nan, nan
+    f = wall_fluxes(wall.spheres, ratio, wall.restitution)
+    return (normal_stress * f.shear_over_normal, -normal_stress * root * f.energy_over_normal,
+            normal_stress * root * f.dissipation_over_normal)

@@ -95,6 +95,8 @@ class CouetteCase:
     """The case a DEM Couette file describes, in DEM units (d = m = 1, ρ_s = 6/π).
 
     ``gap`` is the continuum cell, H − d (slab between the planes tangent to the wall spheres).
+    ``wall_sphere_diameter`` and ``wall_sphere_gap`` (units of d) describe the walls' spheres when the
+    header's geometry line does (``walls = ... layer of N touching spheres each (d = 1 ...``), else None.
     """
 
     e: float
@@ -107,6 +109,8 @@ class CouetteCase:
     p_wall_sigma: float
     d: float = 1.0
     rho_s: float = RHO_S_DEM
+    wall_sphere_diameter: float | None = None
+    wall_sphere_gap: float | None = None
 
 
 @dataclass(frozen=True)
@@ -158,6 +162,27 @@ COUETTE_HEADER = {
     "tau": (rf"wall shear stress tau\s*=\s*{_NUM}\s*\+-\s*{_NUM}", "# wall shear stress tau = 0.65518 +- 0.0035"),
     "p_yy": (rf"wall normal stress p_yy\s*=\s*{_NUM}\s*\+-\s*{_NUM}", "# wall normal stress p_yy = 2.6588 +- 0.0091"),
 }
+#: The optional wall geometry: the walls' line, the wall-sphere diameter in it, and their gap unless they touch.
+WALL_LINE = r"walls\s*=\s*[^\n]*"
+WALL_SPHERE_DIAMETER = rf"spheres each\s*\(d\s*=\s*{_NUM}"
+WALL_SPHERE_GAP = rf"gap\s*=\s*{_NUM}"
+
+
+def _wall_spheres(text: str, name: str) -> tuple[float | None, float | None]:
+    """(d_w/d, s/d) from the header's walls line, or None for what it does not state."""
+    line = re.search(WALL_LINE, text)
+    size = re.search(WALL_SPHERE_DIAMETER, line.group(0)) if line else None
+    if line is None or size is None:
+        return None, None
+    d_w = float(size.group(1))
+    if not d_w > 0.0:
+        raise InputError(f"data file {name}: header field wall-sphere diameter = {d_w:g} is out of range: valid d > 0")
+    if "touching" in line.group(0):
+        return d_w, 0.0
+    gap = re.search(WALL_SPHERE_GAP, line.group(0))
+    if gap is not None and not float(gap.group(1)) >= 0.0:
+        raise InputError(f"data file {name}: header field wall-sphere gap = {gap.group(1)} is out of range: valid gap >= 0")
+    return d_w, None if gap is None else float(gap.group(1))
 
 
 def read_couette_case(path: str | Path | Table) -> CouetteCase:
@@ -177,8 +202,9 @@ def read_couette_case(path: str | Path | Table) -> CouetteCase:
         if not ok:
             raise InputError(f"data file {path.name}: header field {name} = {value:g} is out of range")
     (tau, dtau), (p, dp) = found["tau"], found["p_yy"]
+    d_w, s_w = _wall_spheres(text, path.name)
     return CouetteCase(e=e, mean_phi=phi, gap=H - 1.0, wall_speed=U, tau_wall=abs(tau), tau_wall_sigma=dtau,
-                       p_wall=p, p_wall_sigma=dp)
+                       p_wall=p, p_wall_sigma=dp, wall_sphere_diameter=d_w, wall_sphere_gap=s_w)
 
 
 def read_couette(path: str | Path) -> CouetteData:
