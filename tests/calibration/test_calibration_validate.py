@@ -181,3 +181,26 @@ def test_couette_file_with_a_broken_header_is_bad_input(data_dir, tmp_path):
     f = tmp_path / "c.csv"
     f.write_text(text.replace("wall shear stress tau", "wall stress"))
     _one_line_exit_2(["validate", "--model", "dense", "--data", str(f)], "header field tau not found")
+
+
+def test_couette_rows_use_the_dem_walls_when_the_header_states_them(dense_table, data_dir):
+    """The shared cell's header states its wall spheres: validate runs the bumpy walls (nothing fitted) and its
+    rows are compare_with_dem's with wall="bumpy"; without the header line it falls back to JJ fitted to the slip."""
+    from ktgf.couette.compare import compare_with_dem
+
+    name = "dem_couette_e0.9_phi0.50.csv"
+    rows = {r["quantity"]: r for r in dense_table["rows"] if r["file"] == name}
+    assert all(r["note"].startswith("bumpy walls") for r in rows.values())
+    (ref,), _ = compare_with_dem(data_dir / name, ["dense"], n_cells=int(CELLS), wall="bumpy")
+    assert rows["tau_wall"]["model"] == pytest.approx(ref["tau_wall"], rel=1e-9)
+    assert rows["p_wall"]["model"] == pytest.approx(ref["p"], rel=1e-9)
+
+
+def test_couette_without_wall_spheres_in_the_header_gets_jj_walls_fitted_to_the_slip(data_dir, tmp_path):
+    name = "dem_couette_e0.9_phi0.50.csv"
+    text = (data_dir / name).read_text().replace("walls = one hexagonal close-packed layer of 168 touching spheres each "
+                                                 "(d = 1, rows along x)", "walls = rough")
+    assert "walls = rough" in text
+    (tmp_path / name).write_text(text)
+    v = validate(get_model("dense"), [tmp_path / name], n_cells=int(CELLS))
+    assert len(v.rows) == 2 and all(r["note"].startswith("JJ walls, specularity") for r in v.rows)

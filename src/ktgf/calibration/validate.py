@@ -9,9 +9,10 @@ frictional shear (``mu, phi, e, T, p_star, tau_over_p, Trot_over_T``)
     T, p*, τ/p and T_rot/T of :func:`ktgf.shear.steady.steady_shear` with the
     model at the row's μ (a frictionless model gets Walton friction, as ``ktgf shear --mu``).
 Couette (``y, phi, ux, theta``; case from the header)
-    wall shear stress and wall pressure of :func:`ktgf.couette.compare.compare_with_dem`:
-    Johnson–Jackson walls, e_w = e, the specularity fitted to the DEM slip (one wall number; the
-    stresses are predictions) unless the model file holds walls.
+    wall shear stress and wall pressure of :func:`ktgf.couette.compare.compare_with_dem`: the
+    DEM's bumpy walls where the header states the wall spheres (nothing fitted, on the layer of the
+    centres), else Johnson–Jackson walls, e_w = e, the specularity fitted to the DEM slip (one wall
+    number; the stresses are predictions); the model file's walls if it holds walls.
 homogeneous cooling (``phi, e, A_main, A_early``)
     the cooling rate A = ζ0/√T (:func:`ktgf.hcs.cooling_rate`, d = 1, T = 1) against both Haff fits,
     and p/(nT) of the cooling state; the model at μ = 0.
@@ -147,11 +148,15 @@ def _couette(model: Any, path: Path, walls: dict[str, float] | None, n_cells: in
 
     d = read_couette(path)  # a file error is bad input (exit 2); a model that gives no answer is a note
     m0 = _at_mu(model, 0.0)
+    # the DEM's own walls where its header states them: nothing fitted; else JJ walls fitted to the slip
+    bumpy = not walls and d.case.wall_sphere_diameter is not None and d.case.wall_sphere_gap is not None
     try:
-        (r,), _ = compare_with_dem(path, [m0], n_cells=n_cells, walls={m0.name: walls} if walls else None)
+        (r,), _ = compare_with_dem(path, [m0], n_cells=n_cells, walls={m0.name: walls} if walls else None,
+                                   wall="bumpy" if bumpy else "johnson-jackson")
     except (ConvergenceError, InputError) as exc:
         raise _NoAnswer(f"{path.name}: no Couette prediction: {exc}") from None
     how = (f"walls from the model file (specularity {r['specularity']:.4g})" if walls else
+           "bumpy walls of the DEM's header, nothing fitted" if bumpy else
            f"JJ walls, specularity {r['specularity']:.4g} fitted to the DEM slip")
     note = how + ("" if r["valid"] else f"; profile INVALID (max phi {r['max_phi']:.3g}) {r['message']}".rstrip())
     state = f"mean phi={d.case.mean_phi:g} e={d.case.e:g}"
