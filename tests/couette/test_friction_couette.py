@@ -4,28 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.friction_couette import SCALE, frictional_wall_problem, halving_changes
 
 from ktgf import get_model
 from ktgf.couette import PlanarCell, Wall
 from ktgf.couette.equations import Problem
-from ktgf.couette.geometry import stretched_nodes
 from ktgf.couette.run import Material, run
 from ktgf.couette.solver import naive_start, solve
 from ktgf.errors import InputError
-
-#: ρ_s V² [Pa] of the test cell (2500 kg/m³, V = 1 m/s): the Johnson–Jackson stress (Pa) in solver units.
-SCALE = 2500.0
-
-
-def frictional_wall_problem(mu, mean_phi, angle=0.0, stress="schaeffer", eps=1e-3, n=80, e=0.7):
-    """The map's cell: 20 d planar, JJ walls φ' = 0.2, e_w = 0.85 with wall friction angle δ_w = ``angle`` (degrees).
-
-    ``eps`` is both the frictional viscosity's regularisation and the wall's slip regularisation ε_w."""
-    model = get_model("frictional", mu=mu, stress=stress, regularisation=eps)
-    g = PlanarCell(20.0, 1.0)
-    x0, x1 = g.bounds(1.0)
-    w = Wall(specularity=0.2, restitution=0.85, friction_angle=angle, slip_regularisation=eps)
-    return Problem(model, g, w, w, mean_phi, e, stretched_nodes(x0, x1, n, 1.5), v_scale=1.0, stress_scale=SCALE)
 
 
 def _problem(mu, mean_phi, stress="schaeffer", eps=1e-3, n=80, e=0.7):
@@ -96,24 +82,6 @@ def test_energy_budget_closes_with_the_frictional_work(tmp_path):
     assert ds.attrs["energy_budget_relative_error"] < 1e-8
     assert float(ds["p_frictional"].max()) > 0.5 * float(ds["p"].max())  # the frictional stress dominates here
     assert ds["p_frictional"].attrs["units"] == "Pa"
-
-
-def halving_changes(mu, mean_phi, eps, angle=0.0, stress="schaeffer", start=None, res_tol=1e-8):
-    """Profiles at ε and ε/2 (the second started from the first; ε also the wall's ε_w): their differences.
-
-    Returns a dict: du (max |Δu|/U), dphi, dlnt (max |Δ ln θ|), dtau (|Δτ_w/τ_w|), dslip (|Δu_sl|/U at the bottom
-    wall), min_rate (min γ̇/(U/H) at ε), and X (the solution at ε/2)."""
-    a = frictional_wall_problem(mu, mean_phi, angle, stress, eps=eps)
-    Xa, _ = solve(a, start)
-    b = frictional_wall_problem(mu, mean_phi, angle, stress, eps=eps / 2)
-    Xb, info = solve(b, Xa)
-    assert info["residual"] < res_tol
-    (ua, ta, pa), (ub, tb, pb) = a.unpack(Xa), b.unpack(Xb)
-    tA, tB = a.terms(Xa), b.terms(Xb)
-    return {"du": np.abs(ua - ub).max(), "dphi": np.abs(pa - pb).max(), "dlnt": np.abs(np.log(ta / tb)).max(),
-            "dtau": abs(tB["F"].mean() / tA["F"].mean() - 1), "dslip": abs(tA["slip"][0] - tB["slip"][0]),
-            "min_rate": float(np.abs(np.diff(ua) / a.dx).min() / a.reference_shear_rate), "X": Xb,
-            "residual": info["residual"]}
 
 
 def _halving(mu, mean_phi, eps):
