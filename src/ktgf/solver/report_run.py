@@ -1,4 +1,4 @@
-"""Ready-made solver cases called by other parts of ktgf (the reproduction report)."""
+"""The solver run the reproduction report calls (a ready-made cooling box: :mod:`ktgf.report.cooling_gas`)."""
 
 from __future__ import annotations
 
