@@ -83,9 +83,9 @@ def plot_run(
 
     what = "time series written by `ktgf run`"
     ds = read_dataset(timeseries, ("time",), what)
-    case = str(ds.attrs.get("case", "cooling"))
-    if case != "cooling":
-        typer.echo(f"wrote {plot_sheared_run(require(ds, timeseries, needs(case), what), out)}")
+    case = ds.attrs.get("case")  # written by every case but the cooling box (Simulation.dataset)
+    if case is not None:
+        typer.echo(f"wrote {plot_sheared_run(require(ds, timeseries, needs(str(case)), what), out)}")
         return
     require(ds, timeseries, ("tau", "theta_mean", "theta_haff", "ke_transverse", "ke_longitudinal",
                              "density_variance"), what)

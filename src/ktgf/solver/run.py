@@ -600,7 +600,7 @@ class Simulation:
                  "kinetic_energy": "m2 s-2", "ke_transverse": "m2 s-2", "ke_longitudinal": "m2 s-2",
                  "tau": "1", "density_variance": "1", "phi_max": "1", "mode_density": "1", "mode_velocity": "1"}
         units.update({f"dt_{name}": "s" for name in limit_names})
-        units.update({name: CASE_UNITS[name] for name in self.case.columns})
+        units.update({**CASE_UNITS, **self.case.units})
         for name, unit in units.items():
             if name in ds:
                 ds[name].attrs["units"] = unit

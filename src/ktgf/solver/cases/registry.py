@@ -37,13 +37,15 @@ class Case:
     ``hcs``: a freely cooling gas (HCS dissipation, Haff clock τ); ``boundary``: the boundary kind it
     needs on one axis; ``imposed_shear``: its boundaries impose γ̇; ``inclined``: it takes
     ``case.inclination_deg`` and ``initial.shear_rate``; ``columns``: its time-series columns;
-    ``steady_monitors``: the columns whose change decides steadiness.
+    ``units``: those of its columns not in :data:`~ktgf.solver.flows.CASE_UNITS`; ``steady_monitors``:
+    the columns whose change decides steadiness.
     """
 
     name, label = "", ""  # case.kind, and as the progress bar shows it
     hcs = imposed_shear = inclined = False
     boundary: str | None = None
     columns: tuple[str, ...] = ()
+    units: dict[str, str] = {}
     steady_monitors: tuple[str, ...] = ()
 
     @property
