@@ -14,7 +14,6 @@ import math
 
 import numpy as np
 import pytest
-
 from helpers.chute_case import bagnold_case
 
 from ktgf.closures import get_model
@@ -58,8 +57,8 @@ def test_1d_depth_exponent_falls_to_three_halves():
 
 
 def _deep_run(depth_d: float) -> dict:
-    from ktgf.solver.config import parse_config
     from ktgf.solver.cases.chute import chute_reference, compare_chute
+    from ktgf.solver.config import parse_config
     from ktgf.solver.run import Simulation
 
     cfg = bagnold_case(depth_d, ANGLE)

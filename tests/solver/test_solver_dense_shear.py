@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 
 from ktgf.errors import InputError
-from ktgf.solver.config import load_config, parse_config
 from ktgf.solver.cases import get_case
 from ktgf.solver.cases.uniform_shear import uniform_shear_reference
+from ktgf.solver.config import load_config, parse_config
 from ktgf.solver.run import Simulation
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -19,8 +19,8 @@ import numpy as np
 import pytest
 
 from ktgf.errors import InputError
-from ktgf.solver.config import parse_config
 from ktgf.solver.cases.uniform_shear import uniform_shear_reference
+from ktgf.solver.config import parse_config
 from ktgf.solver.io import load_checkpoint, save_checkpoint
 from ktgf.solver.run import Simulation
 from ktgf.solver.sequencing import map_state, remap_axis, totals

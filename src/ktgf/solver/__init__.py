@@ -55,11 +55,10 @@ GPU
 
 from __future__ import annotations
 
-from .report_run import report_cooling_run
 from .config import Config, load_config, parse_config
 from .grid import Grid
 from .physics import Physics
 from .run import Simulation
 from .stepping import Numerics, advance
 
-__all__ = ["Config", "Grid", "Numerics", "Physics", "Simulation", "advance", "load_config", "parse_config", "report_cooling_run"]
+__all__ = ["Config", "Grid", "Numerics", "Physics", "Simulation", "advance", "load_config", "parse_config"]

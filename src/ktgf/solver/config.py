@@ -1,38 +1,10 @@
 """Validated run configuration (TOML → pydantic), checked completely before anything is compiled.
 
-Example (``examples/hcs_3d.toml``)::
-
-    [model]
-    name = "ret"            # any registered model (`ktgf models`)
-    restitution = 0.8
-    [particles]
-    diameter = 1e-3         # m
-    density = 2500.0        # kg/m^3
-    [initial]
-    solid_fraction = 0.25
-    temperature = 1e-4      # m^2/s^2
-    perturbation = "random" # "random", "mode" (HCS eigenmode), "shear-mode" (uniform-shear normal mode) or "none"
-    amplitude = 0.05        # rms velocity / sqrt(theta0), or mode amplitude
-    [grid]
-    cells = [32, 32, 32]    # 1, 2 or 3 entries: the dimension
-    relative_to = "transverse"   # box side = factor × critical size L_perp (or "longitudinal": L_par)
-    factor = 1.5            # ... or give `length` in m, or `length_d` in particle diameters
-    [time]
-    end = 60.0
-    unit = "tau"            # "tau" (collision units along Haff's law; outputs equally spaced in tau), "haff" (t/t0) or "s"
-    outputs = 60
-
-Cases other than the cooling box (``examples/uniform_shear.toml``): ``[case] kind`` and one
-boundary per axis, e.g. a Lees–Edwards box sheared at γ̇ = 50/s along x with y the gradient::
-
-    [case]
-    kind = "uniform-shear"
-    [boundaries]
-    y = { kind = "lees-edwards", shear_rate = 50.0, flow = "x" }
-    [time]
-    end = 200.0
-    unit = "strain"         # gamma_dot * t
-
+Tables ``[model]``, ``[particles]``, ``[initial]``, ``[grid]``, ``[numerics]``, ``[time]``, ``[output]``,
+``[parallel]``, ``[case]`` and ``[boundaries]`` (one per non-periodic axis), with the fields and ranges of
+the sections below; examples: ``examples/hcs_3d.toml`` (the cooling box), ``examples/uniform_shear.toml``
+(``[case] kind = "uniform-shear"``, ``y = { kind = "lees-edwards", shear_rate = 50.0, flow = "x" }``).
+The case's own checks are its :meth:`~ktgf.solver.cases.Case.check` (:mod:`ktgf.solver.cases`).
 Errors name the field (``grid.cells.0``, ``initial.solid_fraction``) and the valid range.
 """
 
@@ -49,7 +21,7 @@ from ..couette.config import WallsConfig
 from ..errors import InputError, KtgfError
 from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
 from ..io import plain, read_toml
-from .boundaries import LEES_EDWARDS, WALL
+from .boundaries import AXES, LEES_EDWARDS, WALL
 from .cases import CASES, get_case, kinds
 from .stencil import LIMITERS, RIEMANN_SOLVERS
 from .grid import MIN_CELLS
@@ -187,9 +159,6 @@ class ParallelSection(_Section):
     devices: int = Field(1, ge=1, description="JAX devices to shard the first grid axis over")
 
 
-_AXES = ("x", "y", "z")
-
-
 class BoundarySection(_Section):
     kind: Literal["periodic", "lees-edwards", "wall"] = "periodic"
     shear_rate: float | None = Field(None, gt=0.0, description="Lees-Edwards shear rate du_flow/dx_axis [1/s]")
@@ -219,8 +188,8 @@ class BoundariesSection(_Section):
 
     @model_validator(mode="after")
     def _one_shear(self) -> BoundariesSection:
-        le = [a for a in _AXES if getattr(self, a).kind == "lees-edwards"]
-        walls = [a for a in _AXES if getattr(self, a).kind == "wall"]
+        le = [a for a in AXES if getattr(self, a).kind == "lees-edwards"]
+        walls = [a for a in AXES if getattr(self, a).kind == "wall"]
         if len(le) > 1:
             raise ValueError(f"at most one axis can be lees-edwards (one shear gradient); got {', '.join(le)}")
         if len(walls) > 1 or (le and walls):
@@ -234,10 +203,10 @@ class BoundariesSection(_Section):
         return self
 
     def wall_axis(self) -> str | None:
-        return next((a for a in _AXES if getattr(self, a).kind == "wall"), None)
+        return next((a for a in AXES if getattr(self, a).kind == "wall"), None)
 
     def shear_axis(self) -> str | None:
-        return next((a for a in _AXES if getattr(self, a).kind == "lees-edwards"), None)
+        return next((a for a in AXES if getattr(self, a).kind == "lees-edwards"), None)
 
 
 class CaseSection(_Section):
@@ -314,7 +283,6 @@ def _check_friction(cfg: Config, model: Any, source: str) -> None:
 
 def check_physics(cfg: Config, source: str = "config") -> None:
     """Cross-field checks that need the model: φ0 below the packing limit, a valid model name/options."""
-
     try:
         model = get_model(cfg.model.name, **cfg.model.options)
     except KtgfError as exc:
@@ -342,7 +310,6 @@ def check_physics(cfg: Config, source: str = "config") -> None:
     check_case(cfg, source)
     _check_friction(cfg, model, source)
     if cfg.grid.relative_to is not None:
-
         kp, kl = critical_wavenumbers(model.reduced(phi0, cfg.model.restitution, hcs=True))
         k = kp if cfg.grid.relative_to == "transverse" else kl
         if not float(k) > 0:
@@ -356,32 +323,30 @@ def check_physics(cfg: Config, source: str = "config") -> None:
 def check_case(cfg: Config, source: str = "config") -> None:
     """The case and its boundaries fit together and fit the grid (one-line errors naming the field)."""
     ndim, kind, b = len(cfg.grid.cells), cfg.case.kind, cfg.boundaries
-    for a in _AXES[ndim:]:
+    for a in AXES[ndim:]:
         if getattr(b, a).kind != "periodic":
             raise InputError(f"{source}: field boundaries.{a}.kind = {getattr(b, a).kind!r}: the grid has {ndim} "
-                             f"axis/axes ({', '.join(_AXES[:ndim])}); axis {a} has no boundary to set")
+                             f"axis/axes ({', '.join(AXES[:ndim])}); axis {a} has no boundary to set")
     shear, wall, case = b.shear_axis(), b.wall_axis(), get_case(kind)
     if not case.inclined and cfg.case.inclination_deg is not None:
         raise InputError(f"{source}: field case.inclination_deg applies to case.kind = {kinds(lambda c: c.inclined)} only")
     if case.boundary is not None and (shear if case.boundary == LEES_EDWARDS else wall) is None:
         raise InputError(f"{source}: field case.kind = {kind!r} needs one boundaries.<axis> with kind = "
-                         f"{case.boundary!r} (valid axes: {', '.join(_AXES[:ndim])})")
+                         f"{case.boundary!r} (valid axes: {', '.join(AXES[:ndim])})")
     case.check(cfg, source, shear, wall)
     if not case.inclined and cfg.initial.shear_rate is not None:
         raise InputError(f"{source}: field initial.shear_rate sets the start of a chute only (other cases: the boundaries)")
-    if cfg.numerics.acoustics == "implicit" and cfg.time.scheme == "ssprk3":
-        raise InputError(f"{source}: field numerics.acoustics = 'implicit' needs time.scheme = 'imex' or 'auto' "
-                         "(got 'ssprk3', an explicit scheme)")
-    if cfg.numerics.sink == "implicit" and cfg.time.scheme == "ssprk3":
-        raise InputError(f"{source}: field numerics.sink = 'implicit' needs time.scheme = 'imex' or 'auto' "
-                         "(got 'ssprk3', an explicit scheme)")
+    for key in ("acoustics", "sink"):
+        if getattr(cfg.numerics, key) == "implicit" and cfg.time.scheme == "ssprk3":
+            raise InputError(f"{source}: field numerics.{key} = 'implicit' needs time.scheme = 'imex' or 'auto' "
+                             "(got 'ssprk3', an explicit scheme)")
     if cfg.numerics.acoustics == "implicit" and shear is not None:
         raise InputError(f"{source}: field numerics.acoustics = 'implicit' is not available with a 'lees-edwards' "
                          f"boundary (boundaries.{shear}); valid: 'explicit'")
     for axis, need in ((shear, LEES_EDWARDS), (wall, WALL)):
         if axis is not None and case.boundary != need:
             raise InputError(f"{source}: field boundaries.{axis}.kind = {need!r} needs case.kind = "
-                             f"{kinds(lambda c: c.boundary == need)}")
+                             f"{kinds(lambda c, need=need: c.boundary == need)}")
     if wall is not None:
         try:
             getattr(b, wall).walls.build_pair()
@@ -414,9 +379,9 @@ def check_shear_mode(cfg: Config, source: str = "config") -> None:
     if get_case(cfg.case.kind).boundary != LEES_EDWARDS:  # a normal mode of uniform shear
         raise InputError(f"{source}: field initial.perturbation = 'shear-mode' needs case.kind = "
                          f"{kinds(lambda c: c.boundary == LEES_EDWARDS)} (got {cfg.case.kind!r})")
-    flow = _AXES.index(getattr(b, b.shear_axis()).flow)
+    flow = AXES.index(getattr(b, b.shear_axis()).flow)
     if flow < len(ini.mode) and ini.mode[flow] != 0:
-        raise InputError(f"{source}: field initial.mode = {ini.mode} varies along the flow axis {_AXES[flow]}: "
+        raise InputError(f"{source}: field initial.mode = {ini.mode} varies along the flow axis {AXES[flow]}: "
                          f"valid mode[{flow}] = 0 (a normal mode of uniform shear has k_flow = 0)")
     try:  # the analysis refuses e = 1 and shear-dependent dissipation
         theta = initial_temperature(cfg)

@@ -3,12 +3,9 @@
 The sheared cases start from the linear profile u_f = γ̇(x_a − L_a/2) (γ̇ = U/L_a in the Couette
 cell; a chute: u_f = ``initial.shear_rate`` · x_a) plus the configured perturbation.
 
-Steady state.  With ``time.steady_tol`` a sheared run stops at the first output at which every
-steady monitor of its case changed by less than the tolerance since the previous output
-(:func:`steady_change`: φ, θ pointwise relative, u profiles relative to max|u|).  For a transient
-relaxing as e^{−λt} the change per output interval Δt is ≈ (1 − e^{−λΔt}) times the remaining
-deviation, so with outputs about 1/λ apart the remaining deviation is about the tolerance (it is
-larger for denser outputs).
+Steady state (``time.steady_tol``, docs/solver.md): the first output at which every steady monitor of
+the case changed by less than the tolerance since the previous one (``Case.steady_change``).  Relaxing
+as e^{−λt}, the change per output interval Δt is ≈ (1 − e^{−λΔt}) times the remaining deviation.
 
 Box-averaged stress tensor.  P = pI − τ with p = ρθp*(φ) and τ = η(∇u + ∇uᵀ − (2/3)∇·u I) +
 λ_b∇·u I (model.md §1), the velocity gradients by central differences across the (ghost-padded)
@@ -143,21 +140,6 @@ def profiles(U: Any, grid: Grid, rho_s: float) -> dict[str, list[float]]:
     return {"u_profile": list((rho * W[1 + f]).sum(axis=others) / mass),
             "phi_profile": list(rho.mean(axis=others) / rho_s),
             "theta_profile": list((rho * W[4]).sum(axis=others) / mass)}
-
-
-def steady_change(names: tuple[str, ...], history: dict[str, list]) -> float | None:
-    """Max relative change of the columns ``names`` (a case's steady monitors) between the last two
-    outputs (module docstring; None before two outputs)."""
-    if len(history["time"]) < 2:
-        return None
-    change = 0.0
-    for name in names:
-        new, old = (np.asarray(history[name][i], dtype=float) for i in (-1, -2))
-        scale = np.max(np.abs(new)) if name == "u_profile" else np.abs(new)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            rel = np.abs(new - old) / scale
-        change = max(change, float(np.max(np.where(np.isfinite(rel), rel, np.inf))))
-    return change
 
 
 def profile_errors(history: dict[str, list], ref: Any, y: np.ndarray, u_scale: float | None = None) -> dict[str, float]:

@@ -18,8 +18,7 @@ from pathlib import Path
 from ..errors import InputError
 
 LOCK = ".ktgf-run.lock"
-#: Files a run writes into its folder, with the time series of every case (``--overwrite`` deletes these
-#: and nothing else).
+#: Files a run writes into its folder, and every case's time series (``--overwrite`` deletes these only).
 RUN_FILES = ("checkpoint.npz", "fields_*.vti", "slice_*.png", ".*.tmp*")
 
 

@@ -39,8 +39,7 @@ from ..io import write_netcdf
 from .config import Config, box_lengths, config_value, initial_temperature
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
 from .cases import get_case
-from .flows import CASE_UNITS, PROFILES, VERIFICATION_FILE
-from .flows import describe as describe_boundaries
+from .flows import CASE_UNITS, PROFILES, VERIFICATION_FILE, describe
 from .grid import Grid
 from .kinematics import gradient_axis, shear_rate
 from .initial import haff_time, perturb, random_velocity, shear_mode, single_mode, t_of_tau, tau_of_t, uniform_fields
@@ -115,12 +114,6 @@ def _x64(enabled: bool) -> Any:
     return ctx(enabled)
 
 
-def _precision(cfg: Config) -> Any:
-    # x64 mode in both cases: the clock (t, dt) is float64 even when the state is float32
-    # (numerics.precision), as the step loop of :func:`advance` expects.
-    return _x64(True)
-
-
 def _in_precision(method: Callable[..., Any]) -> Callable[..., Any]:
     """Run a :class:`Simulation` method in the precision of its config (not the process-wide setting)."""
 
@@ -136,11 +129,12 @@ class Simulation:
     """A run of any case described by a config (everything validated here, before any compilation)."""
 
     def precision(self) -> Any:
-        """Context manager of the run: JAX's x64 mode on inside it only (the state's dtype follows numerics.precision)."""
-        return _precision(self.cfg)
+        """Context manager of the run: JAX's x64 mode on inside it only (the state's dtype follows numerics.precision:
+        the clock t, dt is float64 even when the state is float32, as the step loop of :func:`advance` expects)."""
+        return _x64(True)
 
     def __init__(self, cfg: Config, directory: str | Path | None = None) -> None:
-        with _precision(cfg):  # the Haff time and output times are computed with JAX too
+        with _x64(True):  # the Haff time and output times are computed with JAX too
             self._setup(cfg, directory)
 
     def _setup(self, cfg: Config, directory: str | Path | None) -> None:
@@ -542,15 +536,11 @@ class Simulation:
             var = int(np.argmax(nonfinite.reshape(5, -1).any(axis=1)))
             field, idx = PRIMITIVE_NAMES[var], np.unravel_index(np.argmax(nonfinite[var]), self.grid.cells)
             value = W[var][idx]
-        elif status == 2:
-            field, idx = "granular_temperature", np.unravel_index(np.argmin(W[4]), self.grid.cells)
-            value = W[4][idx]
-        elif status == 3:
-            field, idx = "solid_fraction", np.unravel_index(np.argmax(phi), self.grid.cells)
-            value = phi[idx]
-        elif status == 4:
-            field, idx = "density", np.unravel_index(np.argmin(W[0]), self.grid.cells)
-            value = W[0][idx]
+        elif status in (2, 3, 4):  # the cell of the extreme value
+            field, f, pick = {2: ("granular_temperature", W[4], np.argmin), 3: ("solid_fraction", phi, np.argmax),
+                              4: ("density", W[0], np.argmin)}[status]
+            idx = np.unravel_index(pick(f), self.grid.cells)
+            value = f[idx]
         elif status == 6:
             field, idx, value = "implicit_residual_over_tolerance", (), float(residual)
         else:
@@ -612,7 +602,7 @@ class Simulation:
         if self.started_from is not None:
             ds.attrs["from_run"] = f"{self.started_from['from_run']} ({self.started_from['cells']} cells, mapped)"
         if not cooling:
-            ds.attrs.update({"case": self.case.name, "boundaries": describe_boundaries(self.grid),
+            ds.attrs.update({"case": self.case.name, "boundaries": describe(self.grid),
                              "shear_rate_per_s": shear_rate(self.grid)})
         ds.attrs.update(self.run_summary(history))
         return ds

@@ -1,10 +1,6 @@
-"""``chute``: a gravity-driven layer on an inclined base.
-
-A base wall at rest (bumpy Johnson–Jackson) at x_a = 0, a lid at x_a = H (default zero-flux: free
-slip, adiabatic) and g = g(sin ζ e_f − cos ζ e_a); it starts from u_f = ``initial.shear_rate`` · x_a
-plus the perturbation.  Its steady state is the 1D inclined-layer solver's
-(:func:`ktgf.couette.chute.solve_chute`, same column and walls).
-"""
+"""``chute``: a layer on a base wall at rest (x_a = 0) under a lid (x_a = H, default zero-flux) with
+g = g(sin ζ e_f − cos ζ e_a); start u_f = ``initial.shear_rate`` · x_a + perturbation; reference: the 1D
+inclined-layer solver (:func:`ktgf.couette.chute.solve_chute`, same column and walls)."""
 
 from __future__ import annotations
 

@@ -21,9 +21,6 @@ class Cooling(Case):
                              f"{getattr(cfg.boundaries, shear or wall).kind!r} needs case.kind = 'uniform-shear' or "
                              "'couette' (the cooling case is a periodic box)")
 
-    def start(self, U: Any, cfg: Any, grid: Any) -> Any:
-        return U  # no base flow
-
     def clock(self, t: float, tau: float | None = None, shear_rate: float = 0.0) -> str:
         """``t = … s  τ = …`` (τ = ∫ν dt, collisions per particle)."""
         return f"t = {t:.4g} s  τ = {tau:.3g}"

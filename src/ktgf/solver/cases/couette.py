@@ -1,8 +1,5 @@
-"""``couette``: a planar Couette cell, Johnson–Jackson walls on one axis moving at ∓U/2 along the flow.
-
-It starts from u_f = (U/L_a)(x_a − L_a/2) plus the perturbation; its steady state is the 1D Couette
-solver's (:func:`ktgf.couette.run.run`, same model, same walls, same inventory).
-"""
+"""``couette``: Johnson–Jackson walls on one axis moving at ∓U/2 along the flow; start u_f = (U/L_a)(x_a −
+L_a/2) + perturbation; reference: the 1D Couette solver (:func:`ktgf.couette.run.run`, same walls, inventory)."""
 
 from __future__ import annotations
 

@@ -1,9 +1,6 @@
-"""``uniform-shear``: a Lees–Edwards box sheared at rate γ̇ (:mod:`ktgf.solver.boundaries`).
-
-Its steady homogeneous state is the closed form :func:`ktgf.shear.steady.steady_shear`; the run's
-viscosity is η = −⟨P_fa⟩/γ̇ and its pressure p = ⟨tr P⟩/3 (P the box-averaged stress,
-:func:`ktgf.solver.flows.stress_tensor`: in steady uniform shear P_fa = −ηγ̇ and P_aa = p).
-"""
+"""``uniform-shear``: a Lees–Edwards box sheared at γ̇ (:mod:`ktgf.solver.boundaries`); reference: the closed
+form :func:`ktgf.shear.steady.steady_shear`.  With P the box-averaged stress (:func:`~ktgf.solver.flows.stress_tensor`;
+steady: P_fa = −ηγ̇, P_aa = p) the run's viscosity is η = −⟨P_fa⟩/γ̇ and its pressure p = ⟨tr P⟩/3."""
 
 from __future__ import annotations
 
