@@ -215,10 +215,10 @@ class CaseSection(_Section):
     inclination_deg: float | None = Field(None, gt=0.0, lt=90.0, description="chute: base inclination [degrees]")
     gravity: float = Field(9.81, gt=0.0, description="chute: acceleration of gravity g [m/s^2]")
 
-    @field_validator("kind")
+    @field_validator("kind", mode="before")
     @classmethod
-    def _kind(cls, v: str) -> str:
-        if v not in CASES:
+    def _kind(cls, v: Any) -> Any:
+        if not isinstance(v, str) or v not in CASES:
             *head, last = [repr(k) for k in CASES]
             raise ValueError(f"Input should be {', '.join(head)} or {last}")
         return v
