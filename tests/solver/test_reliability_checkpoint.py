@@ -237,7 +237,7 @@ def test_fresh_run_over_a_finished_one_refuses_and_overwrite_clears_it(tmp_path:
     code, err = _run(_case(tmp_path, vtk_every=0), "-o", run, "--overwrite")
     assert code == 0, err
     assert sorted(p.name for p in run.glob("fields_*.vti")) == ["fields_00000.vti", "fields_00004.vti"]
-    assert sorted(p.name for p in run.iterdir()) == ["checkpoint.npz", "fields_00000.vti", "fields_00004.vti", "cooling.nc"]
+    assert sorted(p.name for p in run.iterdir()) == ["checkpoint.npz", "cooling.nc", "fields_00000.vti", "fields_00004.vti"]
 
 
 def test_checkpoint_roundtrip_is_exact_and_written_atomically(tmp_path: Path) -> None:
