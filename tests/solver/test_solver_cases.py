@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+import ktgf
 from ktgf.errors import InputError
 from ktgf.solver.cases import CASES, Case, get_case, register
 from ktgf.solver.config import parse_config
@@ -76,8 +77,9 @@ def test_a_boundary_that_does_not_fit_the_case_is_one_line_naming_the_field(text
 def test_ktgf_run_exits_2_on_a_misfitted_boundary(tmp_path: Path) -> None:
     text, message = MISFITS[0]
     (tmp_path / "bad.toml").write_text(BASE + text)
-    res = subprocess.run([sys.executable, "-m", "ktgf", "run", "bad.toml", "--no-progress"], cwd=tmp_path,
-                         env=os.environ.copy(), capture_output=True, text=True, timeout=300, check=False)
+    env = {**os.environ, "PYTHONPATH": str(Path(ktgf.__file__).parents[1])}  # this ktgf, from any folder
+    res = subprocess.run([sys.executable, "-m", "ktgf", "run", "bad.toml", "--no-progress"], cwd=tmp_path, env=env,
+                         capture_output=True, text=True, timeout=300, check=False)
     lines = res.stderr.strip().splitlines()
     assert res.returncode == 2 and len(lines) == 1 and message in lines[0], res.stderr
     assert not (tmp_path / "ktgf-run").exists()
