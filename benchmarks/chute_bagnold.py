@@ -117,7 +117,7 @@ def run(depth: float, angle: float, cells_per_d: float, thin: bool, folder: Path
 def summarize(folder: Path) -> dict:
     """The comparison of a run's last checkpoint (finished or not) with the 1D solver on 4 cells per d."""
     from ktgf.solver.config import parse_config
-    from ktgf.solver.flows import chute_reference, compare_chute, steady_change
+    from ktgf.solver.cases.chute import chute_reference, compare_chute
     from ktgf.solver.io import load_checkpoint
     from ktgf.solver.run import Simulation
 
@@ -129,7 +129,7 @@ def summarize(folder: Path) -> dict:
     fine = int(4 * depth)  # 4 cells per d: the 1D solver's own θ error is then below 1e-2 (oned)
     cmp = compare_chute(h, sim.phys, sim.grid, sim.phi0, n_cells=fine)
     u = np.asarray(h["u_profile"][-1])
-    change = steady_change("chute", h)
+    change = sim.case.steady_change(h)
     timing = json.loads((folder / "timing.json").read_text()) if (folder / "timing.json").exists() else {}
     ref = chute_reference(sim.phys, sim.grid, sim.phi0, n_cells=fine)
     result = {

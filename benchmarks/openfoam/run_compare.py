@@ -76,7 +76,7 @@ def run_ktgf(cfg_path: Path, work: Path) -> dict:
                        work, work / "log.ktgf")
     import xarray as xr
 
-    with xr.open_dataset(work / "ktgf" / "hcs.nc") as ds:
+    with xr.open_dataset(work / "ktgf" / "cooling.nc") as ds:
         series = {k: ds[v].values.tolist() for k, v in (("t", "time"), ("theta", "theta_mean"),
                                                          ("density_variance", "density_variance"))}
         return {"wall_s": wall, "cpu_s": cpu, **series, "steps": int(ds.attrs["step_count"]),

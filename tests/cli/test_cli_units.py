@@ -203,13 +203,14 @@ def test_shipped_couette_example_stays_below_random_close_packing() -> None:
 
 def test_progress_clock_names_the_case_and_its_time_unit() -> None:
     """The progress line of a sheared run counts strain γ̇t, not the cooling box's τ (and says which case)."""
-    from ktgf.solver.run import PROGRESS_LABELS, _Progress, progress_clock
+    from ktgf.solver.cases import get_case
+    from ktgf.solver.run import _Progress
 
-    assert progress_clock("cooling", 0.5, tau=3.25) == "t = 0.5 s  τ = 3.25"
-    assert progress_clock("uniform-shear", 0.02, shear_rate=250.0) == "t = 0.02 s  γ̇t = 5"
-    assert progress_clock("couette", 0.02, shear_rate=100.0) == "t = 0.02 s  γ̇t = 2"
-    assert progress_clock("chute", 1.5) == "t = 1.5 s"  # no imposed shear rate, no strain clock
-    assert PROGRESS_LABELS["uniform-shear"] != PROGRESS_LABELS["cooling"] == "HCS"
+    assert get_case("cooling").clock(0.5, tau=3.25) == "t = 0.5 s  τ = 3.25"
+    assert get_case("uniform-shear").clock(0.02, shear_rate=250.0) == "t = 0.02 s  γ̇t = 5"
+    assert get_case("couette").clock(0.02, shear_rate=100.0) == "t = 0.02 s  γ̇t = 2"
+    assert get_case("chute").clock(1.5) == "t = 1.5 s"  # no imposed shear rate, no strain clock
+    assert get_case("uniform-shear").label != get_case("cooling").label == "HCS"
     bar = _Progress(False, 0.04, float("nan"), None, 0.3, None, case="uniform-shear", shear_rate=250.0)
     assert bar.clock_text(0.04) == "t = 0.04 s  γ̇t = 10"
     assert "τ" not in bar.clock_text(0.04)

@@ -96,9 +96,9 @@ def _enable(monkeypatch, key: str, fake) -> None:
     if key == "couette":
         monkeypatch.setattr(couette, "report_profiles", fake)
     else:
-        import ktgf.solver
+        from ktgf.report import cooling_gas
 
-        monkeypatch.setattr(ktgf.solver, "report_cooling_run", fake)
+        monkeypatch.setattr(cooling_gas, "report_cooling_run", fake)
 
 
 @pytest.mark.analytic

@@ -27,7 +27,7 @@ import pytest
 
 from ktgf.closures import get_model
 from ktgf.solver import cell_program, cxx, flux_kernel, fluxes
-from ktgf.solver.friction import for_case
+from ktgf.solver.cases import get_case
 from ktgf.solver.grid import Grid
 from ktgf.solver.initial import random_velocity
 from ktgf.solver.physics import Physics
@@ -213,7 +213,7 @@ def _warnings(caplog) -> list[str]:
 def test_without_a_compiler_the_jax_path_runs_and_says_why_once(no_compiler, monkeypatch, caplog) -> None:
     grid = Grid((6, 8, 10), (6 * D, 8 * 1.3 * D, 10 * 0.8 * D))
     m = get_model("ret")
-    phys = for_case(Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max), "cooling", grid)
+    phys = get_case("cooling").physics(Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max), grid)
     U = tuple(jnp.asarray(random_velocity(grid, phys, 0.3, 1e-4, 0.05, 4)))
     num = Numerics(scheme="ssprk3")
     builds = []
@@ -245,7 +245,7 @@ def test_without_a_compiler_the_jax_path_runs_and_says_why_once(no_compiler, mon
 
 def test_a_cell_program_that_cannot_be_built_is_said_once(no_compiler, caplog) -> None:
     m = get_model("ret")
-    phys = for_case(Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max), "cooling", Grid((4, 4, 4), (4 * D,) * 3))
+    phys = get_case("cooling").physics(Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max), Grid((4, 4, 4), (4 * D,) * 3))
     with caplog.at_level(logging.WARNING, logger="ktgf"):
         assert cell_program.for_physics(phys, np.float64) is None
         assert cell_program.for_physics(phys, np.float32) is None
@@ -263,7 +263,7 @@ jax.config.update("jax_enable_x64", True)
 logging.basicConfig(level=logging.WARNING, format="%(message)s")
 from ktgf.closures import get_model
 from ktgf.solver import cxx, fluxes
-from ktgf.solver.friction import for_case
+from ktgf.solver.cases import get_case
 from ktgf.solver.grid import Grid
 from ktgf.solver.initial import random_velocity
 from ktgf.solver.physics import Physics
@@ -272,7 +272,7 @@ probed = cxx.toolchain
 cxx.toolchain = lambda path: dataclasses.replace(probed(path), openmp=(), openmp_error="told so by the test")
 m = get_model("ret")
 grid = Grid((6, 8, 16), (6e-3, 8e-3, 16e-3))
-phys = for_case(Physics(m, 0.8, 1e-3, 2500.0, 0.99 * m.phi_max), "cooling", grid)
+phys = get_case("cooling").physics(Physics(m, 0.8, 1e-3, 2500.0, 0.99 * m.phi_max), grid)
 U = tuple(jnp.asarray(random_velocity(grid, phys, 0.3, 1e-4, 0.2, 4)))
 num = Numerics(scheme="ssprk3")
 text = jax.jit(lambda U: advance.__wrapped__(U, 0.0, 1e30, 3, grid, phys, num)).lower(U).as_text()

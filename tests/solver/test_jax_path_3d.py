@@ -107,7 +107,7 @@ def test_a_3d_couette_cell_keeps_the_1d_solver_profile(jax_path) -> None:
     import tomllib
 
     from ktgf.solver import Simulation, parse_config
-    from ktgf.solver.flows import couette_reference
+    from ktgf.solver.cases.couette import couette_reference
 
     sim = Simulation(parse_config(tomllib.loads(COUETTE)))  # the config's grid, physics and numerics; not run
     grid, phys = sim.grid, sim.phys

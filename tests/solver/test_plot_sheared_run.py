@@ -34,7 +34,7 @@ def _timeseries(example: str, tmp_path: Path) -> tuple[Path, float]:
         else:
             history[name] = list(rng.random(n))
     history["time"] = [0.0, 0.01, 0.02]
-    path = tmp_path / "hcs.nc"
+    path = tmp_path / sim.case.timeseries
     write_netcdf(sim.dataset(history, steps=10), path)
     return path, shear_rate(sim.grid)
 

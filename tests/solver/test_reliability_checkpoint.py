@@ -188,12 +188,12 @@ def test_harmless_changes_are_accepted_on_resume(finished: Path, ck: Path, tmp_p
     # another folder and VTK cadence, the same end: nothing left to do, same time series
     code, err = _resume(tmp_path, ck, vtk_every=1)
     assert code == 0, err
-    same, ref = xr.load_dataset(tmp_path / "out" / "hcs.nc"), xr.load_dataset(finished / "hcs.nc")
+    same, ref = xr.load_dataset(tmp_path / "out" / "cooling.nc"), xr.load_dataset(finished / "cooling.nc")
     assert np.array_equal(same.theta_mean.values, ref.theta_mean.values)
     # a later end time: the run goes on from t_end along the new output schedule
     code, err = _run(_case(tmp_path, "later.toml", end=6.0), "-o", tmp_path / "later", "--resume", ck)
     assert code == 0, err
-    ds = xr.load_dataset(tmp_path / "later" / "hcs.nc")
+    ds = xr.load_dataset(tmp_path / "later" / "cooling.nc")
     assert np.array_equal(ds.theta_mean.values[:5], ref.theta_mean.values)
     assert ds.sizes["time"] == 7 and np.all(np.diff(ds.time.values) > 0)
     assert float(ds.tau[-1]) == pytest.approx(6.0, rel=1e-12)
@@ -237,7 +237,7 @@ def test_fresh_run_over_a_finished_one_refuses_and_overwrite_clears_it(tmp_path:
     code, err = _run(_case(tmp_path, vtk_every=0), "-o", run, "--overwrite")
     assert code == 0, err
     assert sorted(p.name for p in run.glob("fields_*.vti")) == ["fields_00000.vti", "fields_00004.vti"]
-    assert sorted(p.name for p in run.iterdir()) == ["checkpoint.npz", "fields_00000.vti", "fields_00004.vti", "hcs.nc"]
+    assert sorted(p.name for p in run.iterdir()) == ["checkpoint.npz", "cooling.nc", "fields_00000.vti", "fields_00004.vti"]
 
 
 def test_checkpoint_roundtrip_is_exact_and_written_atomically(tmp_path: Path) -> None:

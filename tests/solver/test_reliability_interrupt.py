@@ -2,7 +2,7 @@
 
 Each case runs ``ktgf run`` with ``KTGF_TEST_INTERRUPT`` placing a SIGINT (or a SIGKILL) at a
 deterministic point of the run loop (ktgf.solver.interrupt.fault_hook), then resumes it and
-compares the time series (hcs.nc, every variable and the step count), the .vti files and the
+compares the time series (cooling.nc, every variable and the step count), the .vti files and the
 final state (checkpoint.npz) with an uninterrupted run, bit for bit.  The signal is real (the
 process signals itself); most cases run the CLI in-process (typer's CliRunner, compiled code
 cached), the crash and compile cases in a subprocess.
@@ -68,7 +68,7 @@ def reference(tmp_path_factory) -> Path:
 
 
 def _assert_same_run(run: Path, ref: Path) -> None:
-    a, b = xr.load_dataset(run / "hcs.nc"), xr.load_dataset(ref / "hcs.nc")
+    a, b = xr.load_dataset(run / "cooling.nc"), xr.load_dataset(ref / "cooling.nc")
     assert a.sizes == b.sizes and set(a.data_vars) == set(b.data_vars)
     assert np.array_equal(a.time.values, b.time.values)
     for name in b.data_vars:
@@ -88,7 +88,7 @@ def _check_interrupted_files(run: Path) -> None:
     k = ck["output_index"]
     assert all(len(v) == k for v in ck["history"].values())
     if k:
-        ds = xr.load_dataset(run / "hcs.nc")
+        ds = xr.load_dataset(run / "cooling.nc")
         assert ds.sizes["time"] == k and ds.attrs["run_complete"] == 0
         assert np.array_equal(ds.time.values, ck["history"]["time"])
         assert np.array_equal(ds.theta_mean.values, ck["history"]["theta_mean"])
@@ -165,7 +165,7 @@ def test_real_ctrl_c_at_any_moment(delay: float, reference: Path, tmp_path: Path
     run = tmp_path / "run"
     if proc.returncode != 130:  # the run had finished: only a signal during interpreter shutdown kills it
         assert proc.returncode in (0, -signal.SIGINT), err
-        assert xr.load_dataset(run / "hcs.nc").attrs["run_complete"] == 1
+        assert xr.load_dataset(run / "cooling.nc").attrs["run_complete"] == 1
     assert "Traceback" not in err and "Fatal Python error" not in err and "Exception ignored" not in err
     if (run / "checkpoint.npz").exists():
         res = _ktgf("run", "case.toml", "--no-progress", "--resume", "run/checkpoint.npz", cwd=tmp_path)

@@ -19,7 +19,8 @@ import pytest
 from ktgf.closures import get_model
 from ktgf.closures.models import list_models
 from ktgf.solver import cell_program, cxx
-from ktgf.solver.friction import cell_coefficients, for_case
+from ktgf.solver.cases import get_case
+from ktgf.solver.friction import cell_coefficients
 from ktgf.solver.grid import Grid
 from ktgf.solver.physics import Physics
 from ktgf.solver.state import conservative_fields, primitive_fields
@@ -71,7 +72,7 @@ def _run(program: cell_program.CellProgram, phys: Physics, U: tuple) -> list[np.
 def _physics(model: str, case: str = "cooling") -> Physics:
     m = get_model(model)
     grid = Grid((4, 4, 4), (4 * D,) * 3)
-    return for_case(Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max), case, grid)
+    return get_case(case).physics(Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max), grid)
 
 
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])

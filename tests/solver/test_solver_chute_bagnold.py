@@ -14,7 +14,6 @@ import math
 
 import numpy as np
 import pytest
-
 from helpers.chute_case import bagnold_case
 
 from ktgf.closures import get_model
@@ -58,15 +57,15 @@ def test_1d_depth_exponent_falls_to_three_halves():
 
 
 def _deep_run(depth_d: float) -> dict:
+    from ktgf.solver.cases.chute import chute_reference, compare_chute
     from ktgf.solver.config import parse_config
-    from ktgf.solver.flows import chute_reference, compare_chute, steady_change
     from ktgf.solver.run import Simulation
 
     cfg = bagnold_case(depth_d, ANGLE)
     sim = Simulation(parse_config(cfg))
     sim.run(progress=False, write_files=False)
     h = sim.history
-    change = steady_change("chute", h)
+    change = sim.case.steady_change(h)
     assert change is not None and change < cfg["time"]["steady_tol"], (depth_d, sim.time, change)
     fine = int(4 * depth_d)  # the 1D solver on 4 cells per d: its own u error is then < 2e-4
     u = np.asarray(h["u_profile"][-1])

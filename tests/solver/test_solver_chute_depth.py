@@ -18,7 +18,7 @@ import pytest
 from helpers.chute_case import chute_case
 
 from ktgf.solver.config import parse_config
-from ktgf.solver.flows import chute_reference
+from ktgf.solver.cases.chute import chute_reference
 from ktgf.solver.run import Simulation
 
 CELLS_PER_D = 3.2  # the chute example's resolution (32 cells over 10 d)

@@ -17,8 +17,9 @@ import numpy as np
 import pytest
 
 from ktgf.errors import InputError
+from ktgf.solver.cases import get_case
+from ktgf.solver.cases.uniform_shear import uniform_shear_reference
 from ktgf.solver.config import load_config, parse_config
-from ktgf.solver.flows import steady_change, uniform_shear_reference
 from ktgf.solver.run import Simulation
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -35,13 +36,13 @@ def _example(name: str, **changes: object) -> dict:
 @pytest.mark.contract
 def test_steady_change_is_the_largest_relative_change_of_the_monitors_between_the_last_two_outputs() -> None:
     h = {"time": [0.0, 1.0], "theta_mean": [2.0, 2.002], "viscosity": [1.0, 1.0], "pressure": [4.0, 3.996]}
-    assert steady_change("uniform-shear", h) == pytest.approx(max(0.002 / 2.002, 0.004 / 3.996))
-    assert steady_change("uniform-shear", {k: v[:1] for k, v in h.items()}) is None
-    assert steady_change("cooling", h) is None
+    assert get_case("uniform-shear").steady_change(h) == pytest.approx(max(0.002 / 2.002, 0.004 / 3.996))
+    assert get_case("uniform-shear").steady_change({k: v[:1] for k, v in h.items()}) is None
+    assert get_case("cooling").steady_change(h) is None
     # profiles: u relative to max|u| (u changes sign mid-gap), φ and θ pointwise
     p = {"time": [0.0, 1.0], "u_profile": [[-1.0, 0.0, 1.0], [-1.0, 0.01, 1.0]],
          "phi_profile": [[0.5, 0.5, 0.5]] * 2, "theta_profile": [[1.0, 2.0, 1.0], [1.0, 2.0, 1.001]]}
-    assert steady_change("couette", p) == pytest.approx(0.01)
+    assert get_case("couette").steady_change(p) == pytest.approx(0.01)
 
 
 @pytest.mark.contract

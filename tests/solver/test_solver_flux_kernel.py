@@ -34,7 +34,8 @@ from ktgf.solver.grid import Grid
 from ktgf.solver.initial import random_velocity
 from ktgf.solver.physics import Physics
 from ktgf.closures.models import list_models
-from ktgf.solver.friction import cell_coefficients, for_case
+from ktgf.solver.cases import get_case
+from ktgf.solver.friction import cell_coefficients
 from ktgf.solver.sources import cooling_source
 from ktgf.solver.state import primitive_fields
 from ktgf.solver.cell_terms import (LIMIT_TERMS, START_TERMS, STATUS_TERMS, kernel_stage_inputs, limit_terms,
@@ -151,7 +152,7 @@ STAGE_CASES = [("ret", {}, 0.3, 0.2, jnp.float64), ("ret", {}, 0.3, 0.2, jnp.flo
 def test_fused_stage_steps_match_jax(model: str, options: dict, phi: float, amplitude: float, dtype) -> None:
     grid = _grid()
     m = get_model(model, **options)
-    phys = for_case(Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max), "cooling", grid)
+    phys = get_case("cooling").physics(Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max), grid)
     U = _state(grid, phys, dtype, amplitude=amplitude, phi=phi)
     if m.friction.has_stress:  # the frictional stress is present in (nearly) every cell
         assert float(jnp.mean(cell_coefficients(primitive_fields(U), grid, phys).p_f > 0.0)) > 0.9
@@ -174,7 +175,7 @@ def test_fused_stage_on_few_planes_matches_jax() -> None:
     """The fused sweep's ring of planes on a grid of the fewest planes (4: planes -2, -1 are planes 2, 3, and
     the periodic images n0, n0 + 1 the kept planes 0, 1) and rows split unevenly over the threads (13 rows)."""
     grid = Grid((4, 13, 5), (4 * D, 13 * 0.9 * D, 5 * 1.2 * D))
-    phys = for_case(_physics("ret"), "cooling", grid)
+    phys = get_case("cooling").physics(_physics("ret"), grid)
     U = _state(grid, phys, jnp.float64, amplitude=0.2)
     num = Numerics(scheme="ssprk3")
     cells = _with_kernel(True, lambda: _steps(U, grid, phys, num))
@@ -189,14 +190,14 @@ import hashlib, sys
 import jax, jax.numpy as jnp, numpy as np
 jax.config.update("jax_enable_x64", True)
 from ktgf.closures import get_model
-from ktgf.solver.friction import for_case
+from ktgf.solver.cases import get_case
 from ktgf.solver.grid import Grid
 from ktgf.solver.initial import random_velocity
 from ktgf.solver.physics import Physics
 from ktgf.solver.stepping import Numerics, advance
 m = get_model("proposed")
 grid = Grid((24, 41, 16), (24e-3, 41e-3, 16e-3))
-phys = for_case(Physics(m, 0.8, 1e-3, 2500.0, 0.99 * m.phi_max), "cooling", grid)
+phys = get_case("cooling").physics(Physics(m, 0.8, 1e-3, 2500.0, 0.99 * m.phi_max), grid)
 U = tuple(jnp.asarray(random_velocity(grid, phys, 0.3, 1e-4, 0.05, 4)))
 out = advance(U, 0.0, 1e30, 6, grid, phys, Numerics(scheme="ssprk3"))
 assert int(out[2]) == 6 and int(out[3]) == 0
@@ -225,7 +226,7 @@ def test_a_library_for_the_row_length_gives_the_same_bits(monkeypatch, dtype) ->
     order, so three fused SSP-RK3 steps (and, float64, a flux divergence) are bit for bit that library's, and
     match the JAX path."""
     grid = Grid((4, 6, 16), (4 * D, 6 * 1.1 * D, 16 * 0.9 * D))
-    phys = for_case(_physics("ret"), "cooling", grid)
+    phys = get_case("cooling").physics(_physics("ret"), grid)
     U = _state(grid, phys, dtype, amplitude=0.2)
     num = Numerics(scheme="ssprk3")
 
@@ -307,7 +308,7 @@ def test_fused_loop_returns_the_last_good_state(stop: float, accepted: int, budg
     (:func:`state_status` and a select), and the returned state is the one the accepted steps alone give,
     bit for bit."""
     grid = _grid()
-    phys = dataclasses.replace(for_case(_physics("ret"), "cooling", grid), phi_stop=stop)
+    phys = dataclasses.replace(get_case("cooling").physics(_physics("ret"), grid), phi_stop=stop)
     U = list(_state(grid, phys, jnp.float64, phi=0.3))
     x = (np.arange(grid.cells[0]) + 0.5) / grid.cells[0]
     u = -0.02 * np.sin(2.0 * np.pi * x)[:, None, None]  # ≈ the thermal speed (0.016 m/s)
@@ -347,7 +348,7 @@ def test_stage_source_is_the_cooling_source(model: str) -> None:
     """s0 + s1∇·u (what the fused stage adds) equals −(3/2)ρθζ for any ∇·u, for every registered model."""
     grid = _grid()
     m = get_model(model)
-    phys = for_case(Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max), "uniform-shear", grid)
+    phys = get_case("uniform-shear").physics(Physics(m, 0.8, D, RHO_S, 0.99 * m.phi_max), grid)
     U = _state(grid, phys, jnp.float64, amplitude=0.2)
     W = primitive_fields(U)
     r = cell_coefficients(W, grid, phys)
@@ -381,7 +382,7 @@ def test_fused_stage_is_in_the_compiled_step_only_where_it_applies() -> None:
     text = _with_kernel(True, lambda: hlo(phys), cells=False)
     assert calls(text, flux_kernel.STAGE_TARGET) and not calls(text, flux_kernel.TARGET)  # the stage does the fluxes
     assert not calls(_with_kernel(True, lambda: hlo(phys), stage=False), flux_kernel.STAGE_TARGET)
-    sheared = for_case(_physics("frictional"), "uniform-shear", grid)  # closures with the velocity gradient
+    sheared = get_case("uniform-shear").physics(_physics("frictional"), grid)  # closures with the velocity gradient
     text = _with_kernel(True, lambda: hlo(sheared))
     assert calls(text, flux_kernel.STAGE_TARGET) and not calls(text, flux_kernel.CELLS_TARGET)
     with_gravity = Physics(phys.model, 0.8, D, RHO_S, phys.phi_stop, gravity=(0.0, -9.81, 0.0))
@@ -426,7 +427,7 @@ def test_step_limits_reduced_in_the_kernel(model: str, dtype) -> None:
     from ktgf.solver.cell_program import leaf_values
 
     grid = _grid()
-    phys = for_case(_physics(model), "cooling", grid)
+    phys = get_case("cooling").physics(_physics(model), grid)
     U = _state(grid, phys, dtype, phi=0.5)
     num = Numerics(scheme="ssprk3")
     program = _with_kernel(True, lambda: start_program(grid, phys, num, dtype))

@@ -23,7 +23,8 @@ from ktgf.hcs.haff import cooling_time, haff_temperature
 from ktgf.solver.boundaries import Boundaries
 from ktgf.solver.config import parse_config
 from ktgf.solver.flows import add_base_flow, stress_tensor
-from ktgf.solver.friction import FrictionalReduced, cell_coefficients, for_case
+from ktgf.solver.cases import get_case
+from ktgf.solver.friction import FrictionalReduced, cell_coefficients
 from ktgf.solver.grid import Grid
 from ktgf.solver.initial import uniform_fields
 from ktgf.solver.physics import Physics
@@ -34,7 +35,7 @@ D, RHO_S, E, RATE, THETA0 = 1e-3, 2500.0, 0.7, 50.0, 1e-4
 
 
 def _physics(model: Model, kind: str, grid: Grid) -> Physics:
-    return for_case(Physics(model, E, D, RHO_S, 0.99 * model.phi_max), kind, grid)
+    return get_case(kind).physics(Physics(model, E, D, RHO_S, 0.99 * model.phi_max), grid)
 
 
 def _shear_grid(n: int = 4) -> Grid:
@@ -184,7 +185,7 @@ def test_frictional_couette_keeps_the_1d_solution_within_one_percent() -> None:
     cells, docs/friction.md §7), the wall stress within 1 % (0.35 %).  ~140 s wall at load 8."""
     from test_solver_shear import _couette, _parse, run_from_profile_within_one_percent
 
-    from ktgf.solver.flows import couette_reference
+    from ktgf.solver.cases.couette import couette_reference
     from ktgf.solver.run import Simulation
 
     n, phi0 = 128, 0.5

@@ -14,7 +14,9 @@ from ktgf.errors import DivergenceError, InputError
 from ktgf.solver.config import load_config, parse_config
 from ktgf.solver.grid import Grid
 from ktgf.solver.io import load_checkpoint, read_vti, write_vti
-from ktgf.solver.run import CHECKPOINT, TIMESERIES, Simulation
+from ktgf.solver.run import CHECKPOINT, Simulation
+
+TIMESERIES = "cooling.nc"  # the time series of a cooling run
 
 BASE = {
     "model": {"name": "ret", "restitution": 0.8},

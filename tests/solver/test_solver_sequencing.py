@@ -19,8 +19,8 @@ import numpy as np
 import pytest
 
 from ktgf.errors import InputError
+from ktgf.solver.cases.uniform_shear import uniform_shear_reference
 from ktgf.solver.config import parse_config
-from ktgf.solver.flows import uniform_shear_reference
 from ktgf.solver.io import load_checkpoint, save_checkpoint
 from ktgf.solver.run import Simulation
 from ktgf.solver.sequencing import map_state, remap_axis, totals
@@ -228,7 +228,7 @@ def test_an_earlier_run_of_another_flow_is_refused_in_one_line_naming_the_field(
 def test_a_missing_or_unusable_source_is_refused_in_one_line(earlier, tmp_path: Path) -> None:
     folder, data = earlier
     for source, what in ((tmp_path / "nowhere", "does not exist"), (tmp_path, "holds no checkpoint.npz"),
-                         (folder / "hcs.nc", "netCDF time series holds no fields")):
+                         (folder / "couette.nc", "netCDF time series holds no fields")):
         bad = _couette([4, 16], [4.0, 10.0], tmp_path / "b", from_run=str(source))
         with pytest.raises(InputError, match=f"field initial.from_run.*{what}"):
             Simulation(parse_config(bad))

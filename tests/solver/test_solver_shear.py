@@ -20,7 +20,8 @@ from ktgf.closures import get_model
 from ktgf.errors import InputError
 from ktgf.solver.boundaries import Boundaries, pad
 from ktgf.solver.config import load_config, parse_config
-from ktgf.solver.flows import add_base_flow, stress_tensor, uniform_shear_reference
+from ktgf.solver.cases.uniform_shear import uniform_shear_reference
+from ktgf.solver.flows import add_base_flow, stress_tensor
 from ktgf.solver.grid import Grid
 from ktgf.solver.physics import Physics
 from ktgf.solver.run import Simulation, _x64
@@ -262,7 +263,7 @@ vtk = false
 def test_one_d_couette_solution_is_kept_by_the_3d_solver_within_one_percent() -> None:
     """Started from the 1D solver's steady profile, the 3D solver (32 cells across the gap) stays
     within 1 % of it in u, φ, θ and in the wall stress; mass is conserved to round-off."""
-    from ktgf.solver.flows import couette_reference
+    from ktgf.solver.cases.couette import couette_reference
 
     n = 32
     sim = Simulation(_parse(_couette([n], 10.0)))
@@ -391,10 +392,10 @@ def test_chute_config_errors_name_the_field(text: str, field: str) -> None:
 
 @pytest.mark.contract
 def test_chute_example_parses_and_its_gravity_points_down_the_slope() -> None:
-    from ktgf.solver.flows import gravity
+    from ktgf.solver.cases import get_case
 
     cfg = load_config(ROOT / "examples" / "chute_2d.toml")
-    g = gravity(cfg)
+    g = get_case("chute").gravity(cfg)
     z = math.radians(25.0)
     np.testing.assert_allclose(g, (9.81 * math.sin(z), -9.81 * math.cos(z), 0.0), rtol=1e-15)
 
@@ -417,7 +418,7 @@ def test_chute_reaches_the_1d_inclined_layer() -> None:
 @pytest.mark.parametrize("case", ["uniform-shear", "couette", "chute"])
 def test_sheared_case_resumes_bit_for_bit_and_writes_its_files(tmp_path: Path, case: str) -> None:
     """Ctrl-C mid-run, resume: the final state, the case columns and verification.json equal the
-    uninterrupted run's; hcs.nc, VTK and checkpoint are written for the case."""
+    uninterrupted run's; <case>.nc, VTK and checkpoint are written for the case."""
     import tomllib
 
     import xarray as xr
@@ -456,7 +457,7 @@ def test_sheared_case_resumes_bit_for_bit_and_writes_its_files(tmp_path: Path, c
     for v in ver:  # the run's timing differs between the two
         assert all(v["run"].pop(k) is not None for k in timing)
     assert ver[0] == ver[1]
-    ds = xr.open_dataset(tmp_path / "full" / "hcs.nc")
+    ds = xr.open_dataset(tmp_path / "full" / f"{case}.nc")
     assert ds.attrs["case"] == case and "stress_xy" in ds
     assert "solid_fraction" in read_vti(tmp_path / "full" / "fields_00004.vti")
 

@@ -1,4 +1,4 @@
-"""``ktgf run case.toml`` (the JAX finite-volume solver: every case) and ``ktgf plot run hcs.nc``."""
+"""``ktgf run case.toml`` (the JAX finite-volume solver: every case) and ``ktgf plot run <case>.nc``."""
 
 from __future__ import annotations
 
@@ -20,8 +20,8 @@ def run(
     progress: bool = typer.Option(True, "--progress/--no-progress", help="Show the progress bar."),
     overwrite: bool = typer.Option(False, "--overwrite", help="Delete the files of an earlier run in the output folder first."),
 ) -> None:
-    """Run a solver case (cooling box, uniform shear, Couette, chute); writes hcs.nc, checkpoint.npz,
-    .vti, .png files and, for a case with a reference, verification.json.
+    """Run a solver case (cooling box, uniform shear, Couette, chute); writes the time series <case>.nc
+    (e.g. cooling.nc), checkpoint.npz, .vti, .png files and, for a case with a reference, verification.json.
 
     Examples: examples/hcs_3d.toml (cooling box), uniform_shear.toml, uniform_shear_dense.toml (64³,
     φ 0.55), frictional_shear.toml (μ 0.5), couette_2d.toml, couette_dense.toml (φ 0.5, 64 cells
@@ -38,7 +38,7 @@ def run(
     with STOP:  # from here on Ctrl-C is a flag, also during imports and the first compilation
         try:
             from ..solver.config import load_config
-            from ..solver.run import TIMESERIES, Simulation
+            from ..solver.run import Simulation
 
             cfg = load_config(case)
             sim = Simulation(cfg, output_dir)
@@ -51,12 +51,12 @@ def run(
             typer.echo("interrupted; nothing written", err=True)
             raise typer.Exit(130) from None
     last = ds.isel(time=-1)
-    if sim.case == "cooling":
+    if sim.case.hcs:
         typer.echo(
             f"done: {sim.steps} steps, t = {float(last.time):.6g} s (tau = {float(last.tau):.4g}); "
             f"theta/theta_Haff = {float(last.theta_mean / last.theta_haff):.4f}, "
             f"density variance = {float(last.density_variance):.3g}, max phi = {float(last.phi_max):.4f}; "
-            f"time series in {sim.directory / TIMESERIES}"
+            f"time series in {sim.timeseries}"
         )
         return
     check = ""
@@ -64,14 +64,14 @@ def run(
         errors = ", ".join(f"{k} {v:.2e}" for k, v in sim.verification["max_rel_error"].items())
         check = f"; relative error against the {sim.verification['reference'].split(' (')[0]}: {errors}"
     typer.echo(
-        f"done ({sim.case}): {sim.steps} steps, t = {float(last.time):.6g} s; theta = {float(last.theta_mean):.4g} "
-        f"m2/s2, max phi = {float(last.phi_max):.4f}{check}; time series in {sim.directory / TIMESERIES}"
+        f"done ({sim.case.name}): {sim.steps} steps, t = {float(last.time):.6g} s; theta = {float(last.theta_mean):.4g} "
+        f"m2/s2, max phi = {float(last.phi_max):.4f}{check}; time series in {sim.timeseries}"
     )
 
 
 @handle_errors
 def plot_run(
-    timeseries: Path = typer.Argument(..., help="hcs.nc written by `ktgf run`."),
+    timeseries: Path = typer.Argument(..., help="<case>.nc written by `ktgf run` (e.g. cooling.nc)."),
     out: Path = typer.Option(Path("hcs.png"), "--out", "-o", help="Figure file (png/pdf/svg)."),
 ) -> None:
     """Plot a run's time series: for the cooling box θ/θ_Haff, transverse and longitudinal kinetic energy / θ
@@ -83,9 +83,9 @@ def plot_run(
 
     what = "time series written by `ktgf run`"
     ds = read_dataset(timeseries, ("time",), what)
-    case = str(ds.attrs.get("case", "cooling"))
-    if case != "cooling":
-        typer.echo(f"wrote {plot_sheared_run(require(ds, timeseries, needs(case), what), out)}")
+    case = ds.attrs.get("case")  # written by every case but the cooling box (Simulation.dataset)
+    if case is not None:
+        typer.echo(f"wrote {plot_sheared_run(require(ds, timeseries, needs(str(case)), what), out)}")
         return
     require(ds, timeseries, ("tau", "theta_mean", "theta_haff", "ke_transverse", "ke_longitudinal",
                              "density_variance"), what)

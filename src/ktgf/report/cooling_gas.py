@@ -8,7 +8,7 @@ models have different critical sizes; the paper's claim is that the Proposed RDF
 ability to predict the instability, so the section compares, box by box, whether each model's
 run does what its own linear theory predicts and whether the two models agree.
 
-The section calls ``ktgf.solver.report_cooling_run`` once per run::
+The section runs the 3D solver (:class:`ktgf.solver.Simulation`) through :func:`report_cooling_run` once per run::
 
     report_cooling_run(model: ktgf.Model, *, phi: float, e: float, box: float, n_cells: int,
                        t_end: float, seed: int, d: float, rho_s: float, theta0: float) -> xarray.Dataset
@@ -46,11 +46,70 @@ RHO_S_DEM = 6.0 / math.pi
 
 
 def run_box(model: Any, box: float, s: ReportSettings) -> xr.Dataset:
-    """One 3D cooling run (the only call into the solver)."""
-    from ..solver import report_cooling_run  # JAX is imported only when the section runs
-
+    """One 3D cooling run."""
     return report_cooling_run(model, phi=s.cooling_phi, e=s.cooling_e, box=box, n_cells=s.cooling_cells, t_end=s.cooling_t_end,
               seed=s.cooling_seed, d=1.0, rho_s=RHO_S_DEM, theta0=1.0)
+
+
+def report_cooling_run(model: Any, *, phi: float, e: float, box: float, n_cells: int, t_end: float, seed: int,
+                       d: float, rho_s: float, theta0: float, outputs: int = 60) -> xr.Dataset:
+    """A 3D homogeneous cooling gas in a periodic cube, summarised for the report (this section).
+
+    Parameters
+    ----------
+    model : Model
+        Registered model (rebuilt from its name and options inside the run config).
+    phi, e, theta0 : float
+        Uniform solid fraction, restitution and initial temperature [m²/s²].
+    box : float
+        Side of the cube in particle diameters.
+    n_cells : int
+        Cells per side.
+    t_end : float
+        End time in units of the initial collision time 1/ν0(θ0).
+    seed : int
+        Seed of the small random initial velocity field.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``time`` (units 1/ν0(θ0)) with ``theta_mean``, ``flow_energy`` (mean-flow kinetic energy over
+        the thermal energy (3/2)θ), ``phi_std`` (std of φ over mean φ); ``x``, ``y`` (units of d) with
+        the mid-plane fields ``phi_slice``, ``ux_slice``, ``uy_slice`` at the final time.
+    """
+    from ..closures.coefficients import nu0
+    from ..solver.config import parse_config
+    from ..solver.run import Simulation  # JAX is imported only when the section runs
+    from ..solver.state import primitive
+
+    collision_time = 1.0 / float(nu0(phi, theta0, d))
+    cfg = parse_config({
+        "model": {"name": model.name, "restitution": e, "options": model.options()},
+        "particles": {"diameter": d, "density": rho_s},
+        "initial": {"solid_fraction": phi, "temperature": theta0, "perturbation": "random", "seed": seed},
+        "grid": {"cells": [n_cells] * 3, "length_d": box},
+        "time": {"end": t_end * collision_time, "unit": "s", "outputs": outputs},
+        "output": {"vtk": False, "png": False},
+    })
+    sim = Simulation(cfg)
+    hist = sim.run(progress=False, write_files=False)
+    with sim.precision():
+        W = np.asarray(primitive(sim.state))
+    mid = n_cells // 2
+    centres = (np.arange(n_cells) + 0.5) * box / n_cells
+    ds = xr.Dataset(
+        {
+            "theta_mean": ("time", hist["theta_mean"].values),
+            "flow_energy": ("time", hist["kinetic_energy"].values / (1.5 * hist["theta_mean"].values)),
+            "phi_std": ("time", np.sqrt(hist["density_variance"].values)),
+            "phi_slice": (("x", "y"), W[0][:, :, mid] / rho_s),
+            "ux_slice": (("x", "y"), W[1][:, :, mid]),
+            "uy_slice": (("x", "y"), W[2][:, :, mid]),
+        },
+        coords={"time": hist["time"].values / collision_time, "x": centres, "y": centres},
+        attrs=hist.attrs,
+    )
+    return ds
 
 
 def inputs(s: ReportSettings) -> dict[str, Any]:

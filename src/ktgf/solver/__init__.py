@@ -2,7 +2,7 @@
 
 Boxes with per-axis boundaries — periodic, Lees–Edwards (uniform shear) or Johnson–Jackson walls —
 and an optional body force; the case (cooling box, uniform shear, planar Couette, chute) is data
-(:mod:`.flows`, :mod:`.boundaries`, docs/solver.md "Cases and boundaries").
+(:mod:`.cases`, one module each; :mod:`.boundaries`; docs/solver.md "Cases and boundaries").
 
 Conservative variables (ρ, ρu, E = ρ(|u|²/2 + 3θ/2)) on a uniform periodic grid in 1, 2 or 3
 dimensions (one code path; the velocity always has three components).  MUSCL-reconstructed
@@ -14,7 +14,7 @@ viscous and heat fluxes (acoustic CFL and cooling limits, :mod:`.imex`) or SSP-R
 diffusive limits).  Any registered closure model can be used; the solver never branches on its name.
 
 Modules: :mod:`.grid` (grid and its boundaries, a pytree), :mod:`.boundaries` (ghost cells of
-each boundary kind), :mod:`.flows` (the cases: start, diagnostics, references), :mod:`.state` (variables), :mod:`.physics`
+each boundary kind), :mod:`.cases` (the cases: checks, start, diagnostics, references), :mod:`.flows` (what they share), :mod:`.state` (variables), :mod:`.physics`
 (EoS, sound speed, SI transport from the Model), :mod:`.fluxes`, :mod:`.sources`,
 :mod:`.stepping` (RHS, Δt, IMEX/SSP-RK3, compiled ``advance`` with failure detection), :mod:`.imex`,
 :mod:`.initial` (HCS states), :mod:`.diagnostics`, :mod:`.io` (netCDF, checkpoints, VTK .vti,
@@ -55,11 +55,10 @@ GPU
 
 from __future__ import annotations
 
-from .cases import report_cooling_run
 from .config import Config, load_config, parse_config
 from .grid import Grid
 from .physics import Physics
 from .run import Simulation
 from .stepping import Numerics, advance
 
-__all__ = ["Config", "Grid", "Numerics", "Physics", "Simulation", "advance", "load_config", "parse_config", "report_cooling_run"]
+__all__ = ["Config", "Grid", "Numerics", "Physics", "Simulation", "advance", "load_config", "parse_config"]

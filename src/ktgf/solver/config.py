@@ -1,38 +1,10 @@
 """Validated run configuration (TOML → pydantic), checked completely before anything is compiled.
 
-Example (``examples/hcs_3d.toml``)::
-
-    [model]
-    name = "ret"            # any registered model (`ktgf models`)
-    restitution = 0.8
-    [particles]
-    diameter = 1e-3         # m
-    density = 2500.0        # kg/m^3
-    [initial]
-    solid_fraction = 0.25
-    temperature = 1e-4      # m^2/s^2
-    perturbation = "random" # "random", "mode" (HCS eigenmode), "shear-mode" (uniform-shear normal mode) or "none"
-    amplitude = 0.05        # rms velocity / sqrt(theta0), or mode amplitude
-    [grid]
-    cells = [32, 32, 32]    # 1, 2 or 3 entries: the dimension
-    relative_to = "transverse"   # box side = factor × critical size L_perp (or "longitudinal": L_par)
-    factor = 1.5            # ... or give `length` in m, or `length_d` in particle diameters
-    [time]
-    end = 60.0
-    unit = "tau"            # "tau" (collision units along Haff's law; outputs equally spaced in tau), "haff" (t/t0) or "s"
-    outputs = 60
-
-Cases other than the cooling box (``examples/uniform_shear.toml``): ``[case] kind`` and one
-boundary per axis, e.g. a Lees–Edwards box sheared at γ̇ = 50/s along x with y the gradient::
-
-    [case]
-    kind = "uniform-shear"
-    [boundaries]
-    y = { kind = "lees-edwards", shear_rate = 50.0, flow = "x" }
-    [time]
-    end = 200.0
-    unit = "strain"         # gamma_dot * t
-
+Tables ``[model]``, ``[particles]``, ``[initial]``, ``[grid]``, ``[numerics]``, ``[time]``, ``[output]``,
+``[parallel]``, ``[case]`` and ``[boundaries]`` (one per non-periodic axis), with the fields and ranges of
+the sections below; examples: ``examples/hcs_3d.toml`` (the cooling box), ``examples/uniform_shear.toml``
+(``[case] kind = "uniform-shear"``, ``y = { kind = "lees-edwards", shear_rate = 50.0, flow = "x" }``).
+The case's own checks are its :meth:`~ktgf.solver.cases.Case.check` (:mod:`ktgf.solver.cases`).
 Errors name the field (``grid.cells.0``, ``initial.solid_fraction``) and the valid range.
 """
 
@@ -49,6 +21,8 @@ from ..couette.config import WallsConfig
 from ..errors import InputError, KtgfError
 from ..hcs.stability import BOX_CONSTANT, critical_wavenumbers
 from ..io import plain, read_toml
+from .boundaries import AXES, LEES_EDWARDS, WALL
+from .cases import CASES, get_case, kinds
 from .stencil import LIMITERS, RIEMANN_SOLVERS
 from .grid import MIN_CELLS
 
@@ -185,11 +159,6 @@ class ParallelSection(_Section):
     devices: int = Field(1, ge=1, description="JAX devices to shard the first grid axis over")
 
 
-#: Case kinds (:mod:`ktgf.solver.flows`).
-CASE_KINDS = ("cooling", "uniform-shear", "couette", "chute")
-_AXES = ("x", "y", "z")
-
-
 class BoundarySection(_Section):
     kind: Literal["periodic", "lees-edwards", "wall"] = "periodic"
     shear_rate: float | None = Field(None, gt=0.0, description="Lees-Edwards shear rate du_flow/dx_axis [1/s]")
@@ -219,8 +188,8 @@ class BoundariesSection(_Section):
 
     @model_validator(mode="after")
     def _one_shear(self) -> BoundariesSection:
-        le = [a for a in _AXES if getattr(self, a).kind == "lees-edwards"]
-        walls = [a for a in _AXES if getattr(self, a).kind == "wall"]
+        le = [a for a in AXES if getattr(self, a).kind == "lees-edwards"]
+        walls = [a for a in AXES if getattr(self, a).kind == "wall"]
         if len(le) > 1:
             raise ValueError(f"at most one axis can be lees-edwards (one shear gradient); got {', '.join(le)}")
         if len(walls) > 1 or (le and walls):
@@ -234,18 +203,25 @@ class BoundariesSection(_Section):
         return self
 
     def wall_axis(self) -> str | None:
-        return next((a for a in _AXES if getattr(self, a).kind == "wall"), None)
+        return next((a for a in AXES if getattr(self, a).kind == "wall"), None)
 
     def shear_axis(self) -> str | None:
-        return next((a for a in _AXES if getattr(self, a).kind == "lees-edwards"), None)
+        return next((a for a in AXES if getattr(self, a).kind == "lees-edwards"), None)
 
 
 class CaseSection(_Section):
-    kind: Literal["cooling", "uniform-shear", "couette", "chute"] = Field(
-        "cooling", description="cooling (periodic box), uniform-shear (Lees-Edwards box), couette (two moving walls), "
-                               "chute (gravity-driven layer on an inclined base)")
+    kind: str = Field("cooling", description="a registered case (ktgf.solver.cases): cooling (periodic box), uniform-shear "
+                      "(Lees-Edwards box), couette (two moving walls), chute (gravity-driven layer on an inclined base)")
     inclination_deg: float | None = Field(None, gt=0.0, lt=90.0, description="chute: base inclination [degrees]")
     gravity: float = Field(9.81, gt=0.0, description="chute: acceleration of gravity g [m/s^2]")
+
+    @field_validator("kind", mode="before")
+    @classmethod
+    def _kind(cls, v: Any) -> Any:
+        if not isinstance(v, str) or v not in CASES:
+            *head, last = [repr(k) for k in CASES]
+            raise ValueError(f"Input should be {', '.join(head)} or {last}")
+        return v
 
 
 class Config(_Section):
@@ -287,18 +263,18 @@ def load_config(path: str | Path) -> Config:
 
 def _check_friction(cfg: Config, model: Any, source: str) -> None:
     """What the 3D solver does not do with frictional particles yet (docs/friction.md §7), one line each."""
-    kind = cfg.case.kind
-    if model.friction.has_stress and kind in ("cooling", "chute"):
+    kind, case = cfg.case.kind, get_case(cfg.case.kind)
+    if model.friction.has_stress and not case.imposed_shear:
         # The rate-independent viscosity is regularised with ε γ̇_ref, γ̇_ref the case's imposed shear rate.
         raise InputError(f"{source}: field model.options.stress = {model.friction.stress!r}: a frictional stress "
                          f"needs a case with an imposed shear rate for its regularisation (valid case.kind: "
-                         f"uniform-shear, couette; got {kind!r})")
-    if model.friction.mu > 0.0 and kind == "cooling":  # the HCS dissipation: Walton's rule has none at weak μ
+                         f"{kinds(lambda c: c.imposed_shear, ', ', str)}; got {kind!r})")
+    if model.friction.mu > 0.0 and case.hcs:  # the HCS dissipation: Walton's rule has none at weak μ
         try:
             model.reduced(cfg.initial.solid_fraction, cfg.model.restitution, hcs=True)
         except KtgfError as exc:
             raise InputError(f"{source}: field model.options.mu: {exc}") from None
-    wall = cfg.boundaries.wall_axis() if kind in ("couette", "chute") else None
+    wall = cfg.boundaries.wall_axis()  # check_case: only on a case between walls
     walls = getattr(cfg.boundaries, wall).walls if wall else None
     if walls is not None and any((w.friction_angle or 0.0) > 0.0 for w in walls.build_pair()):
         raise InputError(f"{source}: field boundaries.{wall}.walls.friction_angle: the 3D solver's walls have no "
@@ -307,7 +283,6 @@ def _check_friction(cfg: Config, model: Any, source: str) -> None:
 
 def check_physics(cfg: Config, source: str = "config") -> None:
     """Cross-field checks that need the model: φ0 below the packing limit, a valid model name/options."""
-
     try:
         model = get_model(cfg.model.name, **cfg.model.options)
     except KtgfError as exc:
@@ -335,7 +310,6 @@ def check_physics(cfg: Config, source: str = "config") -> None:
     check_case(cfg, source)
     _check_friction(cfg, model, source)
     if cfg.grid.relative_to is not None:
-
         kp, kl = critical_wavenumbers(model.reduced(phi0, cfg.model.restitution, hcs=True))
         k = kp if cfg.grid.relative_to == "transverse" else kl
         if not float(k) > 0:
@@ -349,57 +323,36 @@ def check_physics(cfg: Config, source: str = "config") -> None:
 def check_case(cfg: Config, source: str = "config") -> None:
     """The case and its boundaries fit together and fit the grid (one-line errors naming the field)."""
     ndim, kind, b = len(cfg.grid.cells), cfg.case.kind, cfg.boundaries
-    for a in _AXES[ndim:]:
+    for a in AXES[ndim:]:
         if getattr(b, a).kind != "periodic":
             raise InputError(f"{source}: field boundaries.{a}.kind = {getattr(b, a).kind!r}: the grid has {ndim} "
-                             f"axis/axes ({', '.join(_AXES[:ndim])}); axis {a} has no boundary to set")
-    shear, wall = b.shear_axis(), b.wall_axis()
-    if kind != "chute" and cfg.case.inclination_deg is not None:
-        raise InputError(f"{source}: field case.inclination_deg applies to case.kind = 'chute' only")
-    if kind == "cooling" and cfg.time.steady_tol is not None:
-        raise InputError(f"{source}: field time.steady_tol applies to the sheared cases only (a cooling box has no "
-                         "steady state)")
-    if kind == "cooling" and (shear or wall):
-        raise InputError(f"{source}: field boundaries.{shear or wall}.kind = {getattr(b, shear or wall).kind!r} needs "
-                         "case.kind = 'uniform-shear' or 'couette' (the cooling case is a periodic box)")
-    if kind == "uniform-shear" and shear is None:
-        raise InputError(f"{source}: field case.kind = 'uniform-shear' needs one boundaries.<axis> with kind = "
-                         f"'lees-edwards' (valid axes: {', '.join(_AXES[:ndim])})")
-    if kind in ("couette", "chute") and wall is None:
-        raise InputError(f"{source}: field case.kind = {kind!r} needs one boundaries.<axis> with kind = 'wall' "
-                         f"(valid axes: {', '.join(_AXES[:ndim])})")
-    if kind == "couette" and not getattr(b, wall).wall_speed > 0:
-        raise InputError(f"{source}: field boundaries.{wall}.wall_speed = {getattr(b, wall).wall_speed:g} is out of "
-                         "range: valid wall_speed > 0 m/s for a Couette cell")
-    if kind == "chute" and getattr(b, wall).wall_speed != 0:
-        raise InputError(f"{source}: field boundaries.{wall}.wall_speed = {getattr(b, wall).wall_speed:g} is out of "
-                         "range: valid wall_speed = 0 for a chute (the base is at rest)")
-    if kind == "chute" and cfg.case.inclination_deg is None:
-        raise InputError(f"{source}: field case.inclination_deg is missing: a chute needs the base inclination "
-                         "(0 < inclination_deg < 90 degrees)")
-    if kind != "chute" and cfg.initial.shear_rate is not None:
+                             f"axis/axes ({', '.join(AXES[:ndim])}); axis {a} has no boundary to set")
+    shear, wall, case = b.shear_axis(), b.wall_axis(), get_case(kind)
+    if not case.inclined and cfg.case.inclination_deg is not None:
+        raise InputError(f"{source}: field case.inclination_deg applies to case.kind = {kinds(lambda c: c.inclined)} only")
+    if case.boundary is not None and (shear if case.boundary == LEES_EDWARDS else wall) is None:
+        raise InputError(f"{source}: field case.kind = {kind!r} needs one boundaries.<axis> with kind = "
+                         f"{case.boundary!r} (valid axes: {', '.join(AXES[:ndim])})")
+    case.check(cfg, source, shear, wall)
+    if not case.inclined and cfg.initial.shear_rate is not None:
         raise InputError(f"{source}: field initial.shear_rate sets the start of a chute only (other cases: the boundaries)")
-    if kind == "chute" and cfg.time.unit == "strain":
-        raise InputError(f"{source}: field time.unit = 'strain': a chute has no imposed shear rate; valid 's'")
-    if cfg.numerics.acoustics == "implicit" and cfg.time.scheme == "ssprk3":
-        raise InputError(f"{source}: field numerics.acoustics = 'implicit' needs time.scheme = 'imex' or 'auto' "
-                         "(got 'ssprk3', an explicit scheme)")
-    if cfg.numerics.sink == "implicit" and cfg.time.scheme == "ssprk3":
-        raise InputError(f"{source}: field numerics.sink = 'implicit' needs time.scheme = 'imex' or 'auto' "
-                         "(got 'ssprk3', an explicit scheme)")
+    for key in ("acoustics", "sink"):
+        if getattr(cfg.numerics, key) == "implicit" and cfg.time.scheme == "ssprk3":
+            raise InputError(f"{source}: field numerics.{key} = 'implicit' needs time.scheme = 'imex' or 'auto' "
+                             "(got 'ssprk3', an explicit scheme)")
     if cfg.numerics.acoustics == "implicit" and shear is not None:
         raise InputError(f"{source}: field numerics.acoustics = 'implicit' is not available with a 'lees-edwards' "
                          f"boundary (boundaries.{shear}); valid: 'explicit'")
-    if kind != "uniform-shear" and shear is not None:
-        raise InputError(f"{source}: field boundaries.{shear}.kind = 'lees-edwards' needs case.kind = 'uniform-shear'")
-    if kind not in ("couette", "chute") and wall is not None:
-        raise InputError(f"{source}: field boundaries.{wall}.kind = 'wall' needs case.kind = 'couette' or 'chute'")
+    for axis, need in ((shear, LEES_EDWARDS), (wall, WALL)):
+        if axis is not None and case.boundary != need:
+            raise InputError(f"{source}: field boundaries.{axis}.kind = {need!r} needs case.kind = "
+                             f"{kinds(lambda c, need=need: c.boundary == need)}")
     if wall is not None:
         try:
             getattr(b, wall).walls.build_pair()
         except KtgfError as exc:
             raise InputError(f"{source}: field boundaries.{wall}.walls: {exc}") from None
-    sheared = kind != "cooling"
+    sheared = not case.hcs
     if sheared and cfg.time.unit in ("tau", "haff"):
         raise InputError(f"{source}: field time.unit = {cfg.time.unit!r} is for the cooling case (Haff's law); "
                          f"valid for case.kind = {kind!r}: 's' or 'strain'")
@@ -423,12 +376,12 @@ def check_shear_mode(cfg: Config, source: str = "config") -> None:
                          "for an HCS longitudinal mode")
     if ini.perturbation != "shear-mode":
         return
-    if cfg.case.kind != "uniform-shear":
-        raise InputError(f"{source}: field initial.perturbation = 'shear-mode' needs case.kind = 'uniform-shear' "
-                         f"(got {cfg.case.kind!r})")
-    flow = _AXES.index(getattr(b, b.shear_axis()).flow)
+    if get_case(cfg.case.kind).boundary != LEES_EDWARDS:  # a normal mode of uniform shear
+        raise InputError(f"{source}: field initial.perturbation = 'shear-mode' needs case.kind = "
+                         f"{kinds(lambda c: c.boundary == LEES_EDWARDS)} (got {cfg.case.kind!r})")
+    flow = AXES.index(getattr(b, b.shear_axis()).flow)
     if flow < len(ini.mode) and ini.mode[flow] != 0:
-        raise InputError(f"{source}: field initial.mode = {ini.mode} varies along the flow axis {_AXES[flow]}: "
+        raise InputError(f"{source}: field initial.mode = {ini.mode} varies along the flow axis {AXES[flow]}: "
                          f"valid mode[{flow}] = 0 (a normal mode of uniform shear has k_flow = 0)")
     try:  # the analysis refuses e = 1 and shear-dependent dissipation
         theta = initial_temperature(cfg)

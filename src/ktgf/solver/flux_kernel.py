@@ -91,7 +91,6 @@ class Variant:
     row: int = 0
 
     def __post_init__(self) -> None:
-
         for value, valid in ((self.dtype, ("float64", "float32")), (self.limiter, LIMITERS),
                              (self.riemann, RIEMANN_SOLVERS), (self.kind, KINDS)):
             if value not in valid:

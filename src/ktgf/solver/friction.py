@@ -4,7 +4,7 @@ The closures are the friction part's own (:mod:`ktgf.closures.friction.model_slo
 Couette solver calls in :mod:`ktgf.couette.frictional_stress`); this module only evaluates them at
 the cells, once per stage (``docs/friction.md`` §7):
 
-* **Dissipation per case** (:func:`for_case`): the freely cooling box takes the homogeneous-cooling
+* **Dissipation per case** (:meth:`ktgf.solver.cases.Case.physics`): the freely cooling box takes the homogeneous-cooling
   dissipation (``Model.reduced(hcs=True)``), the sheared cases (uniform shear, Couette, chute) the
   steady-shear one, with the local shear measure dγ̇/√θ of a dissipation correction (extended
   kinetic theory), γ̇ = √(2 S:S) — |∂u_f/∂x_a| in simple shear, as in the Couette solver.
@@ -41,7 +41,7 @@ import jax.numpy as jnp
 from ..closures.coefficients import Reduced
 from .fluxes import pad_fields
 from .grid import Grid
-from .kinematics import shear_rate, velocity_gradients
+from .kinematics import velocity_gradients
 from .physics import Physics
 
 
@@ -49,14 +49,6 @@ from .physics import Physics
 #: (ζ_U including the frictional pressure work) plus the frictional fields [SI]: ``p_f`` = w p_f [Pa],
 #: ``c2_f`` = d(w p_f)/dρ [m²/s²], ``mu_f`` the frictional viscosity [Pa s], ``zeta_f`` = 2μ_f S:S/((3/2)ρθ) [1/s].
 FrictionalReduced = namedtuple("FrictionalReduced", Reduced._fields + ("p_f", "c2_f", "mu_f", "zeta_f"))
-
-
-def for_case(phys: Physics, kind: str, grid: Grid) -> Physics:
-    """The physics of a case: the HCS dissipation for ``cooling``, and the case's shear-rate scale."""
-    import dataclasses
-
-
-    return dataclasses.replace(phys, hcs=kind == "cooling", shear_rate_scale=abs(float(shear_rate(grid))))
 
 
 def needs_rate(phys: Physics) -> bool:

@@ -87,10 +87,6 @@ class Grid:
         """Total number of cells."""
         return int(np.prod(self.cells))
 
-    @property
-    def cell_volume(self) -> float:
-        return float(np.prod(self.spacing))
-
     def centres(self, axis: int) -> np.ndarray:
         """Cell-centre coordinates along one axis [m]."""
         return (np.arange(self.cells[axis]) + 0.5) * self.spacing[axis]

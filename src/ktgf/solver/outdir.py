@@ -18,8 +18,8 @@ from pathlib import Path
 from ..errors import InputError
 
 LOCK = ".ktgf-run.lock"
-#: Files a run writes into its folder (``--overwrite`` deletes these and nothing else).
-RUN_FILES = ("checkpoint.npz", "hcs.nc", "fields_*.vti", "slice_*.png", ".*.tmp*")
+#: Files a run writes into its folder, and every case's time series (``--overwrite`` deletes these only).
+RUN_FILES = ("checkpoint.npz", "fields_*.vti", "slice_*.png", ".*.tmp*")
 
 
 def _alive(pid: int) -> bool:
@@ -98,8 +98,10 @@ class RunLock:
 
 def run_files(directory: str | Path) -> list[Path]:
     """The files of a run found in ``directory`` (sorted)."""
+    from .cases import CASES
+
     d = Path(directory)
-    return sorted({p for pattern in RUN_FILES for p in d.glob(pattern) if p.is_file() and p.name != LOCK})
+    return sorted({p for pattern in (*RUN_FILES, *(c.timeseries for c in CASES.values())) for p in d.glob(pattern) if p.is_file() and p.name != LOCK})
 
 
 def clear_run_files(directory: str | Path) -> list[Path]:

@@ -43,7 +43,7 @@ class Physics:
     hcs : bool
         The case is a freely cooling gas: the closures' homogeneous-cooling dissipation
         (``Model.reduced(hcs=True)``, frictional models: rotation at its HCS ratio) instead of the
-        steady-shear one of the sheared cases (static; :func:`~ktgf.solver.friction.for_case`).
+        steady-shear one of the sheared cases (static; :meth:`ktgf.solver.cases.Case.physics`).
     shear_rate_scale : float
         γ̇_ref [1/s] of the case (U/H, Lees–Edwards γ̇): the scale of the frictional viscosity's
         regularisation ε γ̇_ref (``docs/friction.md`` §8; 0 for a case without one).

@@ -1,4 +1,4 @@
-"""Run a case (cooling box, uniform shear: :mod:`.flows`) from a :class:`~ktgf.solver.config.Config`:
+"""Run a case (:mod:`.cases`) from a :class:`~ktgf.solver.config.Config`:
 outputs, checkpoints, progress, resume.
 
 The host loop calls the compiled :func:`~ktgf.solver.stepping.advance` up to each output
@@ -7,7 +7,7 @@ state and the next output time (a chunk boundary never shortens a step), so a ru
 from any checkpoint reproduces the uninterrupted run bit for bit.
 
 * Ctrl-C / SIGTERM set a flag (:mod:`.interrupt`) polled between chunks; the run then writes
-  ``checkpoint.npz`` and ``hcs.nc`` for the outputs recorded so far and raises
+  ``checkpoint.npz`` and the time series (``<case>.nc``) for the outputs recorded so far and raises
   :class:`~.interrupt.Interrupted`.  The time series is also written at every checkpoint.
 * The output folder is locked for the run (:mod:`.outdir`); a fresh run will not start over
   another run's files without ``overwrite``.
@@ -38,13 +38,10 @@ from ..errors import DivergenceError, InputError, KtgfError
 from ..io import write_netcdf
 from .config import Config, box_lengths, config_value, initial_temperature
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
-from .flows import (CASE_COLUMNS, CASE_UNITS, PROFILES, VERIFICATION_FILE, add_base_flow, case_diagnostics,
-                    gradient_axis, shear_rate, steady_change, verification)
-from .flows import boundaries as case_boundaries
-from .flows import gravity as case_gravity
-from .flows import describe as describe_boundaries
-from .friction import for_case
+from .cases import get_case
+from .flows import CASE_UNITS, PROFILES, VERIFICATION_FILE, describe
 from .grid import Grid
+from .kinematics import gradient_axis, shear_rate
 from .initial import haff_time, perturb, random_velocity, shear_mode, single_mode, t_of_tau, tau_of_t, uniform_fields
 from .interrupt import STOP, Interrupted, fault_hook
 from ..plotting.fields import save_slices
@@ -55,7 +52,6 @@ from .state import PRIMITIVE_NAMES, conservative, primitive
 from .stepping import LIMIT_NAMES, STATUS_MESSAGES, Numerics, advance, binding_limit, choose_scheme, limits, state_status, step
 
 CHECKPOINT = "checkpoint.npz"
-TIMESERIES = "hcs.nc"
 HISTORY_KEYS = ("time", *SCALARS, *PER_AXIS, *(f"dt_{n}" for n in LIMIT_NAMES))
 #: Config fields that may differ between a checkpoint and the run resuming it: where and how
 #: often files are written, the chunk size (the step sequence does not depend on it) and the
@@ -118,12 +114,6 @@ def _x64(enabled: bool) -> Any:
     return ctx(enabled)
 
 
-def _precision(cfg: Config) -> Any:
-    # x64 mode in both cases: the clock (t, dt) is float64 even when the state is float32
-    # (numerics.precision), as the step loop of :func:`advance` expects.
-    return _x64(True)
-
-
 def _in_precision(method: Callable[..., Any]) -> Callable[..., Any]:
     """Run a :class:`Simulation` method in the precision of its config (not the process-wide setting)."""
 
@@ -139,11 +129,12 @@ class Simulation:
     """A run of any case described by a config (everything validated here, before any compilation)."""
 
     def precision(self) -> Any:
-        """Context manager of the run: JAX's x64 mode on inside it only (the state's dtype follows numerics.precision)."""
-        return _precision(self.cfg)
+        """Context manager of the run: JAX's x64 mode on inside it only (the state's dtype follows numerics.precision:
+        the clock t, dt is float64 even when the state is float32, as the step loop of :func:`advance` expects)."""
+        return _x64(True)
 
     def __init__(self, cfg: Config, directory: str | Path | None = None) -> None:
-        with _precision(cfg):  # the Haff time and output times are computed with JAX too
+        with _x64(True):  # the Haff time and output times are computed with JAX too
             self._setup(cfg, directory)
 
     def _setup(self, cfg: Config, directory: str | Path | None) -> None:
@@ -151,19 +142,20 @@ class Simulation:
         check_memory(tuple(cfg.grid.cells), cfg.numerics.precision)
         self.model = get_model(cfg.model.name, **cfg.model.options)
         phi_stop = cfg.numerics.phi_stop if cfg.numerics.phi_stop is not None else 0.99 * self.model.phi_max
+        self.case = get_case(cfg.case.kind)
         self.phys = Physics(self.model, cfg.model.restitution, cfg.particles.diameter, cfg.particles.density, phi_stop,
-                            case_gravity(cfg))
-        self.case = cfg.case.kind
-        bc = case_boundaries(cfg)
+                            self.case.gravity(cfg))
+        bc = self.case.boundaries(cfg)
         self.grid = Grid(tuple(cfg.grid.cells), box_lengths(cfg), None if bc.all_periodic else bc)
-        self.phys = for_case(self.phys, self.case, self.grid)  # the case's dissipation and shear-rate scale
-        self.history_keys = (*HISTORY_KEYS, *CASE_COLUMNS[self.case])
+        self.phys = self.case.physics(self.phys, self.grid)  # the case's dissipation and shear-rate scale
+        self.history_keys = (*HISTORY_KEYS, *self.case.columns)
         n = cfg.numerics
         self.num = Numerics(n.cfl, n.cfl_diffusion, n.cfl_source, n.limiter, n.riemann, scheme="ssprk3",
                             implicit_tol=n.implicit_tol, implicit_maxiter=n.implicit_maxiter, sweeps=n.sweeps,
                             mixed=n.precision == "mixed")
         self.dtype = jnp.float64 if n.precision == "float64" else jnp.float32
         self.directory = Path(directory if directory is not None else cfg.output.directory)
+        self.timeseries = self.directory / self.case.timeseries
         self.started_from = None  # with initial.from_run: the earlier run's state mapped onto this grid
         if cfg.initial.from_run is not None:
             self.mapped, self.started_from = start_from_run(cfg, self.grid.cells, self.grid.lengths)
@@ -218,7 +210,7 @@ class Simulation:
     # -- state -----------------------------------------------------------------------------
     @_in_precision
     def initial_state(self) -> Any:
-        """The configured HCS initial state (conservative, on the configured devices)."""
+        """The configured initial state (conservative, on the configured devices)."""
         ini = self.cfg.initial
         if self.started_from is not None:  # the base flow is in the earlier state
             U = self.mapped
@@ -235,7 +227,7 @@ class Simulation:
             U, _ = shear_mode(self.grid, self.phys, self.phi0, tuple(ini.mode), ini.amplitude, ini.branch)
         else:
             U = conservative(*(jnp.asarray(f) for f in uniform_fields(self.grid, self.phys, self.phi0, self.theta0)))
-        return self.place(add_base_flow(U, self.grid, ini.shear_rate))
+        return self.place(self.case.start(U, self.cfg, self.grid))
 
     @_in_precision
     def place(self, U: Any) -> Any:
@@ -303,7 +295,7 @@ class Simulation:
         self.history = history
         ckpt = self.directory / CHECKPOINT
         bar = _Progress(progress, self.output_times[-1], self.t_haff, self.phys, self.phi0, self.theta0,
-                        case=self.case, shear_rate=shear_rate(self.grid))
+                        case=self.case.name, shear_rate=shear_rate(self.grid))
         chunks = 0
         first_chunk = True
         try:
@@ -360,7 +352,7 @@ class Simulation:
             ) from (None if isinstance(exc, Interrupted) else exc)
         self.state, self.time, self.steps = U, t, steps
         ds = self.dataset(history)
-        self.verification = verification(self.case, history, self.phys, self.grid, self.phi0)
+        self.verification = self.case.verification(history, self.phys, self.grid, self.phi0)
         if self.verification is not None:
             self.verification["steady"] = self.steady_summary(history)
             self.verification["run"] = {**self.run_summary(history), "precision": self.cfg.numerics.precision,
@@ -378,7 +370,7 @@ class Simulation:
                                         ("cpu_time_s", "cpu_time_s"))}
         if write_files:
             ds.attrs["run_complete"] = 1
-            write_netcdf(ds, self.directory / TIMESERIES)
+            write_netcdf(ds, self.timeseries)
             if self.verification is not None:
                 from ..io import atomic_path
 
@@ -387,15 +379,15 @@ class Simulation:
         return ds
 
     def _steady(self, history: dict[str, list]) -> bool:
-        """True when ``time.steady_tol`` is set and the last output is steady (:func:`~.flows.steady_change`)."""
+        """True when ``time.steady_tol`` is set and the last output is steady (:meth:`~.cases.Case.steady_change`)."""
         tol = self.cfg.time.steady_tol
-        change = steady_change(self.case, history) if tol is not None else None
+        change = self.case.steady_change(history) if tol is not None else None
         return change is not None and change < tol
 
     def steady_summary(self, history: dict[str, list]) -> dict[str, Any]:
         """The steady-state stop: tolerance, whether it was met, the last change and the time [s]."""
         tol = self.cfg.time.steady_tol
-        change = steady_change(self.case, history)
+        change = self.case.steady_change(history)
         return {"steady_tol": tol, "reached": bool(tol is not None and change is not None and change < tol),
                 "last_change": change, "time_s": history["time"][-1] if history["time"] else None,
                 "strain": (history["time"][-1] * shear_rate(self.grid)
@@ -413,7 +405,7 @@ class Simulation:
         if k > 0:
             ds = self.dataset(rows, steps=steps)
             ds.attrs["run_complete"] = 0
-            write_netcdf(ds, self.directory / TIMESERIES)
+            write_netcdf(ds, self.timeseries)
         save_checkpoint(ckpt, np.asarray(U), t, steps, k, rows, self.config_json())
 
     def _claim_folder(self, overwrite: bool) -> None:
@@ -511,7 +503,7 @@ class Simulation:
         lim = np.asarray(limits(U, self.grid, self.phys, self.num))
         for name, v in zip(LIMIT_NAMES, lim):
             history.setdefault(f"dt_{name}", []).append(float(v))
-        for name, v in case_diagnostics(self.case, U, t, self.grid, self.phys).items():
+        for name, v in self.case.diagnostics(U, t, self.grid, self.phys).items():
             history[name].append(v)
 
     def _write_fields(self, U: Any, t: float, k: int) -> None:
@@ -544,22 +536,18 @@ class Simulation:
             var = int(np.argmax(nonfinite.reshape(5, -1).any(axis=1)))
             field, idx = PRIMITIVE_NAMES[var], np.unravel_index(np.argmax(nonfinite[var]), self.grid.cells)
             value = W[var][idx]
-        elif status == 2:
-            field, idx = "granular_temperature", np.unravel_index(np.argmin(W[4]), self.grid.cells)
-            value = W[4][idx]
-        elif status == 3:
-            field, idx = "solid_fraction", np.unravel_index(np.argmax(phi), self.grid.cells)
-            value = phi[idx]
-        elif status == 4:
-            field, idx = "density", np.unravel_index(np.argmin(W[0]), self.grid.cells)
-            value = W[0][idx]
+        elif status in (2, 3, 4):  # the cell of the extreme value
+            field, f, pick = {2: ("granular_temperature", W[4], np.argmin), 3: ("solid_fraction", phi, np.argmax),
+                              4: ("density", W[0], np.argmin)}[status]
+            idx = np.unravel_index(pick(f), self.grid.cells)
+            value = f[idx]
         elif status == 6:
             field, idx, value = "implicit_residual_over_tolerance", (), float(residual)
         else:
             field, idx, value = "time_step", (), dt
         where = tuple(int(i) for i in idx)
         pos = ", ".join(f"{(i + 0.5) * h:.4g}" for i, h in zip(where, self.grid.spacing))
-        tau = float(tau_of_t(t, self.phys, self.phi0, self.theta0)) if self.case == "cooling" else float("nan")
+        tau = float(tau_of_t(t, self.phys, self.phi0, self.theta0)) if self.case.hcs else float("nan")
         saved = f"; last good state saved to {ckpt}" if write_files else ""
         err = DivergenceError(
             f"run stopped at t = {t:.6g} s (tau = {tau:.4g}, step {steps + 1}): {STATUS_MESSAGES[status]}: "
@@ -579,11 +567,11 @@ class Simulation:
         data = {name: ("time", np.asarray(history[name], dtype=float)) for name in SCALARS}
         data.update({name: (("time", "axis"), np.asarray(history[name], dtype=float).reshape(len(t), -1))
                      for name in PER_AXIS})
-        cooling = self.case == "cooling"
+        cooling = self.case.hcs
         if cooling:
             data["theta_haff"] = ("time", theta_haff)
         coords = {"time": t, "axis": list("xyz"[: self.grid.ndim])}
-        for name in CASE_COLUMNS[self.case]:
+        for name in self.case.columns:
             values = np.asarray(history[name], dtype=float)
             if name in PROFILES:  # profiles across the gap, one row per output
                 a = gradient_axis(self.grid)
@@ -602,7 +590,7 @@ class Simulation:
                  "kinetic_energy": "m2 s-2", "ke_transverse": "m2 s-2", "ke_longitudinal": "m2 s-2",
                  "tau": "1", "density_variance": "1", "phi_max": "1", "mode_density": "1", "mode_velocity": "1"}
         units.update({f"dt_{name}": "s" for name in limit_names})
-        units.update({name: CASE_UNITS[name] for name in CASE_COLUMNS[self.case]})
+        units.update({**CASE_UNITS, **self.case.units})
         for name, unit in units.items():
             if name in ds:
                 ds[name].attrs["units"] = unit
@@ -614,7 +602,7 @@ class Simulation:
         if self.started_from is not None:
             ds.attrs["from_run"] = f"{self.started_from['from_run']} ({self.started_from['cells']} cells, mapped)"
         if not cooling:
-            ds.attrs.update({"case": self.case, "boundaries": describe_boundaries(self.grid),
+            ds.attrs.update({"case": self.case.name, "boundaries": describe(self.grid),
                              "shear_rate_per_s": shear_rate(self.grid)})
         ds.attrs.update(self.run_summary(history))
         return ds
@@ -632,7 +620,7 @@ class Simulation:
 
 
 class _Progress:
-    """rich progress bar over simulated time, showing the case, its clock (:func:`progress_clock`), the step
+    """rich progress bar over simulated time, showing the case, its clock (:meth:`~.cases.Case.clock`), the step
     rate and the time left (no-op if disabled).
 
     The time left is extrapolated in τ = ∫ν dt (the collision count), not in t: a cooling gas takes
@@ -646,9 +634,9 @@ class _Progress:
         self.enabled, self.t_end = enabled, t_end
         self.args = (phys, phi0, theta0)
         self.clock = clock
-        self.case, self.shear_rate = case, shear_rate
+        self.case, self.shear_rate = get_case(case), shear_rate
         # A sheared case has no Haff clock; its steps are about equally long in t.
-        self._tau = (lambda t: float(tau_of_t(t, *self.args))) if case == "cooling" else float
+        self._tau = (lambda t: float(tau_of_t(t, *self.args))) if self.case.hcs else float
         self.tau_end = self._tau(t_end)
         self._steps, self._wall, self._first = 0, 0.0, True
         self._start: tuple[float, float] | None = None  # (τ, clock) at the end of the first chunk
@@ -659,7 +647,7 @@ class _Progress:
             from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
             self.bar = Progress(
-                TextColumn(f"[bold]{PROGRESS_LABELS.get(self.case, self.case)}"), BarColumn(),
+                TextColumn(f"[bold]{self.case.label}"), BarColumn(),
                 TextColumn("{task.fields[clock]}"), TextColumn("{task.fields[rate]} steps/s"), TimeElapsedColumn(),
                 TextColumn("left {task.fields[eta]}"),
             )
@@ -686,28 +674,12 @@ class _Progress:
         self.bar.update(self.task, completed=t, clock=self.clock_text(t), rate=rate, eta=eta)
 
     def clock_text(self, t: float) -> str:
-        """The simulated time as the case counts it: t and τ (cooling box), t and the strain γ̇t (sheared)."""
-        return progress_clock(self.case, t, self._tau(t) if self.case == "cooling" else None, self.shear_rate)
+        """The simulated time as the case counts it (:meth:`~.cases.Case.clock`)."""
+        return self.case.clock(t, self._tau(t), self.shear_rate)
 
     def __exit__(self, *exc: object) -> None:
         if self.enabled:
             self.bar.__exit__(*exc)
-
-
-#: Case names as the progress bar shows them.
-PROGRESS_LABELS = {"cooling": "HCS", "uniform-shear": "uniform shear", "couette": "Couette", "chute": "chute"}
-
-
-def progress_clock(case: str, t: float, tau: float | None = None, shear_rate: float = 0.0) -> str:
-    """The progress bar's clock: ``t = … s  τ = …`` for the cooling box (τ = ∫ν dt, collisions per
-    particle), ``t = … s  γ̇t = …`` (the strain) for a case with an imposed shear rate γ̇ [1/s],
-    ``t = … s`` otherwise (a chute, whose shear rate is not imposed)."""
-    text = f"t = {t:.4g} s"
-    if case == "cooling":
-        return f"{text}  τ = {tau:.3g}"
-    if shear_rate:
-        return f"{text}  γ̇t = {shear_rate * t:.3g}"
-    return text
 
 
 def _format_seconds(s: float) -> str:

@@ -33,6 +33,7 @@ import numpy as np
 
 from ..errors import InputError, KtgfError
 from .boundaries import PERIODIC
+from .flows import boundaries
 from .io import load_checkpoint
 from .state import NVAR
 
@@ -89,7 +90,6 @@ def _earlier_cost(path: str | Path, steps: int) -> dict[str, Any]:
 
 def start_from_run(cfg: Any, cells: tuple[int, ...], lengths: tuple[float, ...]) -> tuple[np.ndarray, dict[str, Any]]:
     """The state of ``cfg.initial.from_run`` mapped onto this grid (checked against ``cfg``), and a record of it."""
-    from .flows import boundaries
     from .config import box_lengths
 
     source = cfg.initial.from_run
@@ -134,8 +134,6 @@ def check_compatible(old: Any, new: Any, old_lengths: tuple[float, ...], new_len
     n_old, n_new = len(old.grid.cells), len(new.grid.cells)
     if n_old != n_new:
         raise InputError(f"field grid.cells has {n_new} axes, the earlier run {n_old} {where}: valid the same dimension")
-    from .flows import boundaries
-
     kinds = boundaries(new).kinds
     for ax, (lo, ln) in enumerate(zip(old_lengths, new_lengths)):
         ratio = ln / lo

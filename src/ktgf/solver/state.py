@@ -17,8 +17,7 @@ from typing import Any
 import jax.numpy as jnp
 
 NVAR = 5
-#: Names of the conservative and primitive components (for output and diagnoses).
-CONSERVATIVE_NAMES = ("density", "momentum_x", "momentum_y", "momentum_z", "total_energy")
+#: Names of the primitive components (for diagnoses).
 PRIMITIVE_NAMES = ("density", "velocity_x", "velocity_y", "velocity_z", "temperature")
 
 
@@ -49,7 +48,3 @@ def primitive(U: Any) -> Any:
     """Stacked primitive state (ρ, u_x, u_y, u_z, θ) of a stacked conservative state."""
     return jnp.stack(primitive_fields(U))
 
-
-def from_primitive(W: Any) -> Any:
-    """Inverse of :func:`primitive` (stacked)."""
-    return jnp.stack(conservative_fields(W))
