@@ -16,14 +16,14 @@ import numpy as np
 import pytest
 
 from ktgf.closures import get_model
-from ktgf.shear.steady import steady_shear
 from ktgf.closures.models import Model
 from ktgf.errors import InputError
 from ktgf.hcs.haff import cooling_time, haff_temperature
+from ktgf.shear.steady import steady_shear
 from ktgf.solver.boundaries import Boundaries
+from ktgf.solver.cases import get_case
 from ktgf.solver.config import parse_config
 from ktgf.solver.flows import add_base_flow, stress_tensor
-from ktgf.solver.cases import get_case
 from ktgf.solver.friction import FrictionalReduced, cell_coefficients
 from ktgf.solver.grid import Grid
 from ktgf.solver.initial import uniform_fields
@@ -183,7 +183,9 @@ def test_frictional_couette_keeps_the_1d_solution_within_one_percent() -> None:
     JJ walls, 10 d gap, 128 cells, started from the 1D steady profile: after strain 10 the 3D profiles are
     the 1D ones within 1 % in u, φ, θ (measured 0.08, 0.08, 0.92 %; θ converges at second order with the
     cells, docs/friction.md §7), the wall stress within 1 % (0.35 %).  ~140 s wall at load 8."""
-    from test_solver_shear import _couette, _parse, run_from_profile_within_one_percent
+    from helpers.couette_case import couette_case as _couette
+    from helpers.couette_case import parse as _parse
+    from helpers.couette_case import run_from_profile_within_one_percent
 
     from ktgf.solver.cases.couette import couette_reference
     from ktgf.solver.run import Simulation

@@ -9,21 +9,26 @@ import math
 
 import numpy as np
 import pytest
+from helpers.growth import measure_rate
 
-from ktgf.closures import list_models
+from ktgf.closures import get_model, list_models
 from ktgf.closures.coefficients import mean_free_path
 from ktgf.errors import InputError
 from ktgf.hcs.haff import cooling_time, haff_temperature
 from ktgf.solver.config import NumericsSection
 from ktgf.solver.grid import Grid
 from ktgf.solver.initial import random_velocity, uniform_fields
+from ktgf.solver.physics import Physics
 from ktgf.solver.state import conservative, primitive
 from ktgf.solver.stepping import Numerics, advance, explicit_rhs
 
-from test_solver_accuracy import _physics
-from test_solver_linear import measure_rate
-
 EPS32 = float(np.finfo(np.float32).eps)
+
+
+def _physics(model: str) -> Physics:
+    """The gas of test_solver_accuracy: e = 0.7, d = 1 mm, ρ_s = 2500 kg/m³."""
+    m = get_model(model)
+    return Physics(m, 0.7, 1e-3, 2500.0, 0.99 * m.phi_max)
 
 
 @pytest.mark.contract

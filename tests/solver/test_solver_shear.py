@@ -15,20 +15,22 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from helpers.chute_case import chute_case as _chute
+from helpers.couette_case import couette_case as _couette
+from helpers.couette_case import parse as _parse
+from helpers.couette_case import run_from_profile_within_one_percent
 
 from ktgf.closures import get_model
 from ktgf.errors import InputError
 from ktgf.solver.boundaries import Boundaries, pad
-from ktgf.solver.config import load_config, parse_config
 from ktgf.solver.cases.uniform_shear import uniform_shear_reference
+from ktgf.solver.config import load_config, parse_config
 from ktgf.solver.flows import add_base_flow, stress_tensor
 from ktgf.solver.grid import Grid
 from ktgf.solver.physics import Physics
 from ktgf.solver.run import Simulation, _x64
 from ktgf.solver.state import conservative
 from ktgf.solver.stepping import Numerics, rhs
-
-from helpers.chute_case import chute_case as _chute
 
 ROOT = Path(__file__).resolve().parents[2]
 D, RHO_S, E, PHI, RATE = 1e-3, 2500.0, 0.8, 0.3, 50.0
@@ -140,12 +142,6 @@ vtk = false
 """
 
 
-def _parse(text: str):
-    import tomllib
-
-    return parse_config(tomllib.loads(text))
-
-
 @pytest.mark.analytic
 def test_uniform_shear_run_relaxes_to_the_closed_form_and_conserves_mass() -> None:
     # 1D grid along the gradient x, flow along y (no image displacement: the velocity jump only).
@@ -229,35 +225,6 @@ def test_uniform_shear_example_parses() -> None:
 
 # --- planar Couette: Johnson–Jackson walls -------------------------------------------------------
 
-def _couette(cells: list[int], end: float, extra: str = "", lengths: str = "10.0", axis: str = "x",
-             flow: str = "y") -> str:
-    return f"""
-[case]
-kind = "couette"
-[model]
-name = "ret"
-restitution = 0.9
-[initial]
-solid_fraction = 0.3
-temperature = 1e-3
-perturbation = "none"
-[grid]
-cells = {cells}
-length_d = {lengths}
-[boundaries]
-{axis} = {{ kind = "wall", flow = "{flow}", wall_speed = 1.0, walls = {{ type = "johnson-jackson", specularity = 0.1, restitution = 0.9 }} }}
-[time]
-end = {end}
-unit = "strain"
-outputs = 2
-scheme = "imex"
-{extra}
-[output]
-png = false
-vtk = false
-"""
-
-
 @pytest.mark.analytic
 @pytest.mark.slow
 def test_one_d_couette_solution_is_kept_by_the_3d_solver_within_one_percent() -> None:
@@ -271,28 +238,6 @@ def test_one_d_couette_solution_is_kept_by_the_3d_solver_within_one_percent() ->
     U0 = run_from_profile_within_one_percent(sim, ref, 0.3)
     with sim.precision():
         assert abs(float(np.asarray(sim.state)[0].sum()) / float(np.asarray(U0)[0].sum()) - 1) < 1e-12
-
-
-def run_from_profile_within_one_percent(sim: Simulation, ref, phi_mean: float):
-    """Start ``sim`` (cells across the gap on axis 0) from the 1D profile ``ref``, run it, and check that
-    u, φ, θ and both wall shear stresses stay within 1 % of the reference; returns the initial state."""
-    n = sim.grid.cells[0]
-    y = sim.grid.centres(0) - 0.5 * sim.grid.lengths[0]
-    yr = ref["y"].values
-    u = np.zeros((3, n))
-    u[1] = np.interp(y, yr, ref["u"].values)
-    with sim.precision():
-        U0 = conservative(jnp.asarray(sim.phys.material_density * np.interp(y, yr, ref["phi"].values)),
-                          jnp.asarray(u), jnp.asarray(np.interp(y, yr, ref["theta"].values)))
-        # the exact inventory (interpolation moved it)
-        U0 = U0 * (phi_mean * sim.phys.material_density * n / float(U0[0].sum()))
-    sim.initial_state = lambda: sim.place(U0)
-    sim.run(progress=False, write_files=False)
-    ver = sim.verification
-    assert max(ver["max_rel_error"].values()) < 0.01, ver["max_rel_error"]
-    tau_run, tau_ref = ver["wall_shear_stress_Pa"]["run"], ver["wall_shear_stress_Pa"]["reference"]
-    assert abs(tau_run[0] / tau_ref[0] - 1) < 0.01 and abs(tau_run[1] / tau_ref[1] - 1) < 0.01
-    return U0
 
 
 @pytest.mark.analytic

@@ -72,20 +72,25 @@ def run(
 @handle_errors
 def plot_run(
     timeseries: Path = typer.Argument(..., help="<case>.nc written by `ktgf run` (e.g. cooling.nc)."),
-    out: Path = typer.Option(Path("hcs.png"), "--out", "-o", help="Figure file (png/pdf/svg)."),
+    out: Path = typer.Option(Path("run.png"), "--out", "-o", help="Figure file (png/pdf/svg)."),
 ) -> None:
     """Plot a run's time series: for the cooling box θ/θ_Haff, transverse and longitudinal kinetic energy / θ
     and density variance against τ; for a sheared case θ and its stresses against the strain γ̇t (and the
     profiles across the gap at the last output for the Couette cell and the chute)."""
+    from ..errors import InputError
     from ..io import read_dataset, require
     from ..plotting.cooling_gas import plot_cooling_run
     from ..plotting.sheared import needs, plot_sheared_run
+    from ..solver.cases import CASES
 
     what = "time series written by `ktgf run`"
     ds = read_dataset(timeseries, ("time",), what)
     case = ds.attrs.get("case")  # written by every case but the cooling box (Simulation.dataset)
     if case is not None:
-        typer.echo(f"wrote {plot_sheared_run(require(ds, timeseries, needs(str(case)), what), out)}")
+        if str(case) not in CASES:
+            raise InputError(f"{timeseries}: case {case!r} is not a case of this ktgf; valid: {', '.join(CASES)}")
+        c = CASES[str(case)]
+        typer.echo(f"wrote {plot_sheared_run(require(ds, timeseries, needs(c.panels, c.profiles), what), out, c.panels, c.profiles)}")
         return
     require(ds, timeseries, ("tau", "theta_mean", "theta_haff", "ke_transverse", "ke_longitudinal",
                              "density_variance"), what)

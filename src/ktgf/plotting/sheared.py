@@ -2,23 +2,17 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-#: Panels per case: (variables of the time series, y label); the units come from the file.
-PANELS = {
-    "uniform-shear": ((("theta_mean",), "θ"), (("pressure",), "p"), (("viscosity",), "η = −⟨P_fa⟩/γ̇")),
-    "couette": ((("theta_mean",), "θ"), (("wall_shear_stress_lower", "wall_shear_stress_upper"), "wall shear stress")),
-    "chute": ((("theta_mean",), "θ"), (("wall_shear_stress_lower", "wall_shear_stress_upper"), "wall shear stress")),
-}
-#: Wall-normal profiles drawn at the last output (Couette cell and chute).
+#: Wall-normal profiles drawn at the last output (cases that write them: ``Case.profiles``).
 PROFILES = (("u_profile", "u_f"), ("phi_profile", "φ"), ("theta_profile", "θ"))
 
 
-def needs(case: str) -> tuple[str, ...]:
-    """The variables :func:`plot_sheared_run` reads from the time series of ``case``."""
-    cols = [name for names, _ in PANELS[case] for name in names]
-    return ("time", *cols, *(name for name, _ in PROFILES if case != "uniform-shear"))
+def needs(panels: Sequence[tuple[Sequence[str], str]], profiles: bool) -> tuple[str, ...]:
+    """The variables :func:`plot_sheared_run` reads from a time series with these panels (and profiles)."""
+    return ("time", *(name for names, _ in panels for name in names), *(name for name, _ in PROFILES if profiles))
 
 
 def _unit(da: Any) -> str:
@@ -26,11 +20,12 @@ def _unit(da: Any) -> str:
     return f" [{unit}]" if unit and unit != "1" else ""
 
 
-def plot_sheared_run(ds: Any, out: str | Path) -> Path:
+def plot_sheared_run(ds: Any, out: str | Path, panels: Sequence[tuple[Sequence[str], str]], profiles: bool) -> Path:
     """Plot a sheared run's history against the strain γ̇t (or t [s] when no shear rate is imposed).
 
-    One panel per quantity of :data:`PANELS` (θ, the stresses the case measures) and, for the
-    wall-bounded cases, the velocity, solid fraction and temperature across the gap at the last output.
+    One panel per entry of ``panels`` ((variables, y label): θ, the stresses the case measures; the run's case
+    declares them, :attr:`ktgf.solver.cases.Case.panels`) and, with ``profiles``, the velocity, solid fraction
+    and temperature across the gap at the last output.
     """
     import matplotlib.pyplot as plt
 
@@ -39,8 +34,7 @@ def plot_sheared_run(ds: Any, out: str | Path) -> Path:
     case = str(ds.attrs["case"])
     rate = float(ds.attrs.get("shear_rate_per_s", 0.0))
     x, xlabel = (ds.time * rate, "strain γ̇t") if rate else (ds.time, "t [s]")
-    panels = PANELS[case]
-    profiles = case != "uniform-shear" and "normal" in ds.coords
+    profiles = profiles and "normal" in ds.coords
     n = len(panels) + (len(PROFILES) if profiles else 0)
     fig, axes = plt.subplots(1, n, figsize=(3.6 * n, 3.4))
     for ax, (names, label) in zip(axes, panels):

@@ -51,6 +51,8 @@ def compare_chute(history: dict[str, list], phys: Physics, grid: Grid, phi0: flo
 @register
 class Chute(Case):
     name, label, boundary, inclined = "chute", "chute", WALL, True
+    panels = ((("theta_mean",), "θ"), (("wall_shear_stress_lower", "wall_shear_stress_upper"), "wall shear stress"))
+    profiles = True
     columns, steady_monitors = WALL_CASE_COLUMNS, PROFILES
 
     def check(self, cfg: Any, source: str, shear: str | None, wall: str | None) -> None:

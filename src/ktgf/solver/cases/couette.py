@@ -55,6 +55,8 @@ def compare_couette(history: dict[str, list], phys: Physics, grid: Grid, phi0: f
 @register
 class Couette(Case):
     name, label, boundary, imposed_shear = "couette", "Couette", WALL, True
+    panels = ((("theta_mean",), "θ"), (("wall_shear_stress_lower", "wall_shear_stress_upper"), "wall shear stress"))
+    profiles = True
     columns, steady_monitors = WALL_CASE_COLUMNS, PROFILES
 
     def check(self, cfg: Any, source: str, shear: str | None, wall: str | None) -> None:

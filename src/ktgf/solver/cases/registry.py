@@ -39,7 +39,8 @@ class Case:
     needs on one axis; ``imposed_shear``: its boundaries impose γ̇; ``inclined``: it takes
     ``case.inclination_deg`` and ``initial.shear_rate``; ``columns``: its time-series columns;
     ``units``: those of its columns not in :data:`~ktgf.solver.flows.CASE_UNITS`; ``steady_monitors``:
-    the columns whose change decides steadiness.
+    the columns whose change decides steadiness; ``panels``: what ``ktgf plot run`` draws against time,
+    ((columns of one panel), y label) each; ``profiles``: it writes wall-normal profiles to plot.
     """
 
     name, label = "", ""  # case.kind, and as the progress bar shows it
@@ -48,6 +49,8 @@ class Case:
     columns: tuple[str, ...] = ()
     units: ClassVar[dict[str, str]] = {}
     steady_monitors: tuple[str, ...] = ()
+    panels: tuple[tuple[tuple[str, ...], str], ...] = ((("theta_mean",), "θ"),)
+    profiles = False
 
     @property
     def timeseries(self) -> str:

@@ -47,6 +47,7 @@ def peculiar_energy(U: Any, grid: Grid) -> float:
 @register
 class UniformShear(Case):
     name, label, boundary, imposed_shear = "uniform-shear", "uniform shear", LEES_EDWARDS, True
+    panels = ((("theta_mean",), "θ"), (("pressure",), "p"), (("viscosity",), "η = −⟨P_fa⟩/γ̇"))
     columns = (*(f"stress_{c}" for c in STRESS_COMPONENTS), "viscosity", "pressure", "peculiar_energy")
     steady_monitors = ("theta_mean", "viscosity", "pressure")
 
