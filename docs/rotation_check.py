@@ -1,0 +1,151 @@
+"""Reproduce the rotation figures of docs/friction.md §7 ("Rotation": issue 33's T_rot/T and τ/p gap).
+
+Run from the repository root:  python docs/rotation_check.py        (≈ 20 s, NumPy + SciPy)
+
+Walton's collision rule (μ = 0.5, e = 0.7, β0 = 1, q = 2/5: the shipped frictional DEM's contact) averaged over
+Maxwellian translational (T) and rotational (T_rot) velocities, as ``WaltonRestitution`` does, but with the
+mean flow of uniform shear kept in the relative contact velocity (our derivation, not a published closure):
+particle 2 sits at r1 + d k, so v1 − v2 = c1 − c2 − γ̇ d k_y x̂; both spins are Ω + w with Ω = −(γ̇/2) ẑ (half the
+vorticity; the DEM's T_rot = I⟨w'²⟩/3 is the fluctuation about it).  The mean relative contact velocity is then
+−d E·k (E the strain rate), of relative size s = γ̇d/√θ = 1/√T; s = 0 is WaltonRestitution.  Monte Carlo over
+(c1, c2, w1, w2, k) with collision weight max(g·k, 0), fixed seed; the steady ratio solves ⟨ΔE_rot⟩ = 0 with
+ΔE_rot the change of the fluctuating rotational energy.
+
+Printed: (1) per DEM state the measured T_rot/T, Walton's 0.497 and the finite-shear value at the DEM's s;
+(2) Walton's translational loss at the DEM's T_rot/T (how much the collisional cooling of translation falls
+if rotation is hotter); (3) the tangential impulse's share of the collisional shear stress, with the constant-β
+check against the first-order-in-s result 3η/(2(1 + e)) derived in docs/friction.md §7.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ktgf.calibration.registry_fits import frictional_states
+from ktgf.closures.friction.collisions import WaltonRestitution
+
+Q, E, MU, BETA0 = 0.4, 0.7, 0.5, 1.0
+INERTIA = Q / 4.0  # I/(m d²) with q = 4I/(m d²)
+N = 300_000
+
+
+class ShearedWalton:
+    """Monte Carlo averages of Walton's rule in uniform shear at s = γ̇d/√θ (m = d = θ = 1)."""
+
+    def __init__(self, mu: float = MU, beta0: float = BETA0, seed: int = 1) -> None:
+        rng = np.random.default_rng(seed)
+        self.mu, self.beta0 = mu, beta0
+        self.c1, self.c2, self.z1, self.z2 = (rng.standard_normal((N, 3)) for _ in range(4))
+        k = rng.standard_normal((N, 3))
+        self.k = k / np.linalg.norm(k, axis=1)[:, None]
+
+    def _collide(self, r: float, s: float):
+        k = self.k
+        w1, w2 = self.z1 * np.sqrt(r / INERTIA), self.z2 * np.sqrt(r / INERTIA)
+        spin = np.array([0.0, 0.0, -0.5 * s])
+        v12 = self.c1 - self.c2
+        v12[:, 0] -= s * k[:, 1]
+        g = v12 + 0.5 * np.cross(w1 + w2 + 2.0 * spin, k)
+        gn = np.einsum("ij,ij->i", g, k)
+        weight = np.clip(gn, 0.0, None)
+        gt = g - gn[:, None] * k
+        rho = np.linalg.norm(gt, axis=1)
+        beta = np.minimum(self.beta0, -1.0 + self.mu * (1.0 + E) * (1.0 + 1.0 / Q) * gn / np.maximum(rho, 1e-300))
+        eta = Q * (1.0 + beta) / (2.0 * (1.0 + Q))
+        jn = -0.5 * (1.0 + E) * gn[:, None] * k  # impulse on particle 1 (m = 1)
+        jt = -eta[:, None] * gt
+        return w1, w2, weight, jn, jt
+
+    def rotational_change(self, r: float, s: float) -> float:
+        """⟨ΔE_rot⟩ of the fluctuating spins per collision."""
+        w1, w2, weight, jn, jt = self._collide(r, s)
+        dw = 0.5 * np.cross(self.k, jn + jt) / INERTIA
+        de = 0.5 * INERTIA * (np.sum((w1 + dw) ** 2 - w1**2, 1) + np.sum((w2 + dw) ** 2 - w2**2, 1))
+        return float(np.sum(weight * de) / np.sum(weight))
+
+    def ratio(self, s: float) -> float:
+        """Steady T_rot/T: ⟨ΔE_rot⟩ = 0."""
+        return brentq(lambda r: self.rotational_change(r, s), 0.05, 5.0, xtol=1e-4)
+
+    def tangential_share(self, r: float, s: float) -> float:
+        """⟨J_t,x k_y⟩/⟨J_n,x k_y⟩: the tangential impulse's collisional shear stress over the normal impulse's.
+
+        Antithetic in s (the same samples at +s and −s, halved difference): the isotropic part, zero on
+        average but noisy, cancels sample by sample.
+        """
+        ky = self.k[:, 1]
+        sums = []
+        for sign in (1.0, -1.0):
+            _, _, weight, jn, jt = self._collide(r, sign * s)
+            sums.append((np.sum(weight * jt[:, 0] * ky), np.sum(weight * jn[:, 0] * ky)))
+        return float((sums[0][0] - sums[1][0]) / (sums[0][1] - sums[1][1]))
+
+
+def main() -> None:
+    t0 = time.perf_counter()
+    walton = WaltonRestitution(beta0=BETA0, q=Q)
+    r0 = walton.rotational_ratio(E, MU)
+    mc = ShearedWalton()
+    print(f"Walton's Maxwellian T_rot/T (quadrature) {r0:.4f}; this Monte Carlo at s = 0: {mc.ratio(0.0):.4f}\n")
+    states = frictional_states()
+    print("| φ | DEM T | s = 1/√T | DEM T_rot/T | Walton (err) | finite shear at s (err) "
+          "| translational loss/(1 − e²) at DEM T_rot/T (Walton: %.3f) |" % (walton.inelasticity(E, MU) / (1 - E**2)))
+    print("|---|---|---|---|---|---|---|")
+    for phi, temp, rdem in zip(states["phi"], states["T"], states["Trot_over_T"]):
+        s = 1.0 / np.sqrt(temp)
+        rs = mc.ratio(s)
+        loss = -walton._energy_changes(E, MU, float(rdem))[0] / (1 - E**2)
+        print(f"| {phi:.2f} | {temp:.3f} | {s:.2f} | {rdem:.3f} | {r0:.3f} ({100 * (r0 / rdem - 1):+.1f} %) "
+              f"| {rs:.3f} ({100 * (rs / rdem - 1):+.1f} %) | {loss:.3f} |")
+    print()
+    for s in (0.5, 2.2):
+        print(f"Walton μ = 0.5: tangential/normal collisional shear impulse at s = {s}: "
+              f"{mc.tangential_share(mc.ratio(s), s):.3f}")
+    rough = ShearedWalton(mu=1e6)  # always sticks: constant β = β0
+    eta = Q * (1.0 + BETA0) / (2.0 * (1.0 + Q))
+    print(f"constant β = {BETA0:g} (μ → ∞): {rough.tangential_share(0.5, 0.2):.3f} at s = 0.2 "
+          f"against 3η/(2(1 + e)) = {1.5 * eta / (1 + E):.3f}")
+    share = mc.tangential_share(mc.ratio(0.5), 0.5)
+    what_if(share)
+    print(f"\n{time.perf_counter() - t0:.1f} s wall")
+
+
+def what_if(share: float) -> None:
+    """The registered ``frictional`` at μ = 0.5 with its Maxwellian collisional viscosity 0.6 λ_b* raised by ``share``.
+
+    Not a closure: a measure of how far the tangential impulse's collisional shear stress, missing from the
+    transport coefficients, could move T and τ/p (p is unchanged: a tangential impulse has no normal part).
+    Same closed forms as ``ktgf.shear.steady`` (EKT length included), no refit, T_rot/T still Walton's.
+    """
+    import math
+
+    from ktgf.calibration.registry_fits import family_model, registered_parameters
+    from ktgf.shear.steady import SHEAR_PER_ASTAR, steady_shear
+
+    states = frictional_states()
+    phi = states["phi"]
+    model = family_model(mu=MU, **registered_parameters())
+    today = steady_shear(model, phi, E)
+    red = model.reduced(phi, E)
+    eta = red.eta + share * 0.6 * red.lambda_b
+    a0 = np.sqrt(1.5 * red.zeta0 / eta)
+    lam = model.dissipation.coefficient(phi, E, model.chi(phi))
+    k = SHEAR_PER_ASTAR * phi
+    a = np.where(lam * k * a0 > 1.0, (a0**2 / (lam * k)) ** (1.0 / 3.0), a0)
+    temp = 25.0 * math.pi / (9216.0 * phi**2 * a**2)
+    ratio = eta * a / red.p
+    print(f"\nwhat if 0.6 λ_b* carried the tangential share {share:.3f} (registered frictional, no refit):")
+    print("| φ | 0.6 λ_b*/η* | T today → what-if | τ/p today → what-if |")
+    print("|---|---|---|---|")
+    for i in range(phi.size):
+        print(f"| {phi[i]:.2f} | {0.6 * red.lambda_b[i] / red.eta[i]:.2f} "
+              f"| {100 * (today.T[i] / states['T'][i] - 1):+.1f} % → {100 * (temp[i] / states['T'][i] - 1):+.1f} % "
+              f"| {100 * (today.tau_over_p[i] / states['tau_over_p'][i] - 1):+.1f} % → "
+              f"{100 * (ratio[i] / states['tau_over_p'][i] - 1):+.1f} % |")
+
+
+if __name__ == "__main__":
+    main()
