@@ -13,13 +13,15 @@ vorticity; the DEM's T_rot = I⟨w'²⟩/3 is the fluctuation about it).  The me
 
 Printed: (1) per DEM state the measured T_rot/T, Walton's 0.497 and the finite-shear value at the DEM's s;
 (2) Walton's translational loss at the DEM's T_rot/T (how much the collisional cooling of translation falls
-if rotation is hotter); (3) the tangential impulse's share of the collisional shear stress, with the constant-β
-check against the first-order-in-s result 3η/(2(1 + e)) derived in docs/friction.md §7.
+if rotation is hotter) and what it would do to T and τ/p; (3) the tangential impulse's share of the collisional shear stress, with the constant-β
+check against the first-order-in-s result 3η/(2(1 + e)) derived in docs/friction.md §7.1, and what that
+share would do to T and τ/p.
 """
 
 from __future__ import annotations
 
 import time
+from typing import Any
 
 import numpy as np
 from scipy.optimize import brentq
@@ -109,16 +111,20 @@ def main() -> None:
     print(f"constant β = {BETA0:g} (μ → ∞): {rough.tangential_share(0.5, 0.2):.3f} at s = 0.2 "
           f"against 3η/(2(1 + e)) = {1.5 * eta / (1 + E):.3f}")
     share = mc.tangential_share(mc.ratio(0.5), 0.5)
-    what_if(share)
+    states = frictional_states()
+    loss = np.array([-walton._energy_changes(E, MU, float(r))[0] for r in states["Trot_over_T"]])
+    what_if("ζ0* × (translational loss at the DEM's T_rot/T)/(Walton's)", zeta_factor=loss / walton.inelasticity(E, MU))
+    what_if(f"0.6 λ_b* × (1 + {share:.3f}), the tangential share", eta_share=share)
     print(f"\n{time.perf_counter() - t0:.1f} s wall")
 
 
-def what_if(share: float) -> None:
-    """The registered ``frictional`` at μ = 0.5 with its Maxwellian collisional viscosity 0.6 λ_b* raised by ``share``.
+def what_if(label: str, *, zeta_factor: Any = 1.0, eta_share: float = 0.0) -> None:
+    """The registered ``frictional`` at μ = 0.5 with its ζ0* scaled or its Maxwellian collisional viscosity raised.
 
-    Not a closure: a measure of how far the tangential impulse's collisional shear stress, missing from the
-    transport coefficients, could move T and τ/p (p is unchanged: a tangential impulse has no normal part).
-    Same closed forms as ``ktgf.shear.steady`` (EKT length included), no refit, T_rot/T still Walton's.
+    Not a closure: a measure of how far (a) a hotter rotation (less translational loss, ``zeta_factor``) or (b) the
+    tangential impulse's collisional shear stress, missing from the transport coefficients (0.6 λ_b* raised by
+    ``eta_share``; p is unchanged: a tangential impulse has no normal part), could move T and τ/p.  Same closed
+    forms as ``ktgf.shear.steady`` (EKT length included), no refit, T_rot/T still Walton's.
     """
     import math
 
@@ -130,22 +136,22 @@ def what_if(share: float) -> None:
     model = family_model(mu=MU, **registered_parameters())
     today = steady_shear(model, phi, E)
     red = model.reduced(phi, E)
-    eta = red.eta + share * 0.6 * red.lambda_b
-    a0 = np.sqrt(1.5 * red.zeta0 / eta)
+    eta = red.eta + eta_share * 0.6 * red.lambda_b
+    a0 = np.sqrt(1.5 * red.zeta0 * zeta_factor / eta)
     lam = model.dissipation.coefficient(phi, E, model.chi(phi))
     k = SHEAR_PER_ASTAR * phi
     a = np.where(lam * k * a0 > 1.0, (a0**2 / (lam * k)) ** (1.0 / 3.0), a0)
     temp = 25.0 * math.pi / (9216.0 * phi**2 * a**2)
     ratio = eta * a / red.p
-    print(f"\nwhat if 0.6 λ_b* carried the tangential share {share:.3f} (registered frictional, no refit):")
-    print("| φ | 0.6 λ_b*/η* | T today → what-if | τ/p today → what-if |")
-    print("|---|---|---|---|")
+    print(f"\nwhat if {label} (registered frictional, no refit):")
+    print("| φ | ζ0 factor | 0.6 λ_b*/η* | T today → what-if | τ/p today → what-if |")
+    print("|---|---|---|---|---|")
+    factor = np.broadcast_to(zeta_factor, phi.shape)
     for i in range(phi.size):
-        print(f"| {phi[i]:.2f} | {0.6 * red.lambda_b[i] / red.eta[i]:.2f} "
+        print(f"| {phi[i]:.2f} | {factor[i]:.3f} | {0.6 * red.lambda_b[i] / red.eta[i]:.2f} "
               f"| {100 * (today.T[i] / states['T'][i] - 1):+.1f} % → {100 * (temp[i] / states['T'][i] - 1):+.1f} % "
               f"| {100 * (today.tau_over_p[i] / states['tau_over_p'][i] - 1):+.1f} % → "
               f"{100 * (ratio[i] / states['tau_over_p'][i] - 1):+.1f} % |")
-
 
 if __name__ == "__main__":
     main()
