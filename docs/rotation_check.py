@@ -115,6 +115,8 @@ def main() -> None:
     loss = np.array([-walton._energy_changes(E, MU, float(r))[0] for r in states["Trot_over_T"]])
     what_if("ζ0* × (translational loss at the DEM's T_rot/T)/(Walton's)", zeta_factor=loss / walton.inelasticity(E, MU))
     what_if(f"0.6 λ_b* × (1 + {share:.3f}), the tangential share", eta_share=share)
+    for value in (0.0, share):
+        cross_validate(value)
     print(f"\n{time.perf_counter() - t0:.1f} s wall")
 
 
@@ -152,6 +154,58 @@ def what_if(label: str, *, zeta_factor: Any = 1.0, eta_share: float = 0.0) -> No
               f"| {100 * (today.T[i] / states['T'][i] - 1):+.1f} % → {100 * (temp[i] / states['T'][i] - 1):+.1f} % "
               f"| {100 * (today.tau_over_p[i] / states['tau_over_p'][i] - 1):+.1f} % → "
               f"{100 * (ratio[i] / states['tau_over_p'][i] - 1):+.1f} % |")
+
+def cross_validate(share: float) -> None:
+    """Fit and leave-one-state-out errors of the family (μ_Z, k refitted, a, b, c held) with 0.6 λ_b* × (1 + share) at μ > 0.
+
+    share = 0 is the registered ``frictional`` (the table of docs/friction.md §6.0); T_rot/T is Walton's in both.
+    """
+    from dataclasses import dataclass
+
+    import ktgf.calibration.registry_fits as rf
+    from ktgf.closures.dissipation import CorrelationLength
+    from ktgf.closures.friction.model_slot import Friction
+    from ktgf.closures.garzo_dufty1999 import GarzoDufty1999
+    from ktgf.closures.jamming import FrictionalPowerLaw
+    from ktgf.closures.models import Model
+
+    @dataclass(frozen=True)
+    class TangentialShare(GarzoDufty1999):
+        share: float = 0.0
+
+        def reduced(self, phi: Any, e: Any, chi: Any, dchi: Any) -> Any:
+            red = super().reduced(phi, e, chi, dchi)
+            return red._replace(eta=red.eta + self.share * 0.6 * red.lambda_b)
+
+    def family(name: str = "family", *, mu: float = 0.0, a: float, exponent: float, c: float, mu_scale: float = 0.1,
+               amplitude_growth: float = 0.0) -> Model:
+        rdf = FrictionalPowerLaw(mu=mu, a=a, exponent=exponent, mu_scale=mu_scale, amplitude_growth=amplitude_growth)
+        model = Model(name, TangentialShare(share=share), rdf, dissipation=CorrelationLength(c=c))
+        return model.replace(friction=Friction(mu=mu, restitution="walton", beta0=BETA0))
+
+    original = rf.family_model
+    rf.family_model = family if share > 0.0 else original
+    try:
+        params = rf.registered_parameters()
+        frictionless = {k: params[k] for k in rf.FRICTIONLESS_PARAMETERS}
+        states = rf.frictional_states()
+        fit = rf.fit_frictional(frictionless, states)
+        loo = rf.leave_one_out(lambda sub: {**frictionless, **rf.fit_frictional(frictionless, sub).values}, states)
+    finally:
+        rf.family_model = original
+    res = np.expm1(fit.residuals)
+    pstar_fit, pstar_loo = (1 + res[0]) * (1 + res[1]) - 1, (1 + loo[0]) * (1 + loo[1]) - 1
+    trot = WaltonRestitution(beta0=BETA0, q=Q).rotational_ratio(E, MU) / states["Trot_over_T"] - 1
+    values = ", ".join(f"{k} = {v:.4g}" for k, v in fit.values.items())
+    print(f"\ntangential share {share:.3f}: refit {values}; fit / leave-one-state-out errors")
+    print("| φ | T | p* | p/(nT) | τ/p | T_rot/T |")
+    print("|---|---|---|---|---|---|")
+    for i in range(states["phi"].size):
+        cells = [(res[0, i], loo[0, i]), (pstar_fit[i], pstar_loo[i]), (res[1, i], loo[1, i]), (res[2, i], loo[2, i])]
+        print(f"| {states['phi'][i]:.2f} | " + " | ".join(f"{100 * a:+.1f} / {100 * b:+.1f} %" for a, b in cells)
+              + f" | {100 * trot[i]:+.1f} % |")
+    means = [np.nanmean(abs(x)) for x in (loo[0], pstar_loo, loo[1], loo[2], trot)]
+    print("| mean abs. LOO | " + " | ".join(f"{100 * m:.1f} %" for m in means) + " |")
 
 if __name__ == "__main__":
     main()
