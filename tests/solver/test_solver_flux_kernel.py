@@ -28,20 +28,35 @@ import numpy as np
 import pytest
 
 from ktgf.closures import get_model
+from ktgf.closures.models import list_models
 from ktgf.solver import flux_kernel, fluxes
 from ktgf.solver.boundaries import Boundaries
+from ktgf.solver.cases import get_case
+from ktgf.solver.cell_terms import (
+    LIMIT_TERMS,
+    START_TERMS,
+    STATUS_TERMS,
+    kernel_stage_inputs,
+    limit_terms,
+    status_terms,
+)
+from ktgf.solver.friction import cell_coefficients
 from ktgf.solver.grid import Grid
 from ktgf.solver.initial import random_velocity
 from ktgf.solver.physics import Physics
-from ktgf.closures.models import list_models
-from ktgf.solver.cases import get_case
-from ktgf.solver.friction import cell_coefficients
 from ktgf.solver.sources import cooling_source
 from ktgf.solver.state import primitive_fields
-from ktgf.solver.cell_terms import (LIMIT_TERMS, START_TERMS, STATUS_TERMS, kernel_stage_inputs, limit_terms,
-                                    status_terms)
-from ktgf.solver.stepping import (Numerics, advance, explicit_rhs, kernel_step_limits, ssprk3_step, start_program,
-                                  state_status, status_of_maxima, step_limits)
+from ktgf.solver.stepping import (
+    Numerics,
+    advance,
+    explicit_rhs,
+    kernel_step_limits,
+    ssprk3_step,
+    start_program,
+    state_status,
+    status_of_maxima,
+    step_limits,
+)
 
 D, RHO_S = 1e-3, 2500.0
 #: float64: the kernel does the operations of the JAX path in the same order; XLA's fusion may round
@@ -203,51 +218,6 @@ out = advance(U, 0.0, 1e30, 6, grid, phys, Numerics(scheme="ssprk3"))
 assert int(out[2]) == 6 and int(out[3]) == 0
 print(hashlib.sha256(np.asarray(out[0]).tobytes()).hexdigest())
 """
-
-
-@pytest.mark.contract
-def test_row_length_is_fixed_for_rows_of_16_to_1024_cells_in_multiples_of_8() -> None:
-    """Which grids get a library for their row length (the last axis), and what each variant is called."""
-    lengths = (8, 10, 16, 20, 24, 64, 1024, 1032)
-    rows = {n: flux_kernel.row_length(Grid((4, 4, n), (4 * D, 4 * D, n * D))) for n in lengths}
-    assert rows == {8: 0, 10: 0, 16: 16, 20: 0, 24: 24, 64: 64, 1024: 1024, 1032: 0}
-    v = flux_kernel.variant(jnp.float32, "vanleer", "hll", "stage", Grid((4, 4, 64), (4 * D,) * 3))
-    assert (v.row, v.suffix, str(v)) == (64, "__f32_vanleer_hll_stage_r64", "float32 vanleer/hll stage, rows of 64")
-    assert "-DKTGF_ROW=64" in v.macros and "-DKTGF_ROW=0" in flux_kernel.DEFAULT.macros
-    with pytest.raises(ValueError, match="rows of 1 cells"):
-        flux_kernel.Variant("float64", "vanleer", "hll", "stage", 1)
-
-
-@pytest.mark.contract
-@pytest.mark.parametrize("dtype", [jnp.float64, jnp.float32])
-def test_a_library_for_the_row_length_gives_the_same_bits(monkeypatch, dtype) -> None:
-    """A grid with rows of 16 cells runs the libraries built for that row length (:func:`.flux_kernel.row_length`:
-    every stencil offset a constant); they do the operations of the library for any row length in the same
-    order, so three fused SSP-RK3 steps (and, float64, a flux divergence) are bit for bit that library's, and
-    match the JAX path."""
-    grid = Grid((4, 6, 16), (4 * D, 6 * 1.1 * D, 16 * 0.9 * D))
-    phys = get_case("cooling").physics(_physics("ret"), grid)
-    U = _state(grid, phys, dtype, amplitude=0.2)
-    num = Numerics(scheme="ssprk3")
-
-    def rhs():  # float64 only: one more library build is enough
-        return jax.jit(lambda U: explicit_rhs(U, grid, phys, num, viscous=True))(U) if dtype == jnp.float64 else ()
-
-    def run(row: int):
-        monkeypatch.setattr(flux_kernel, "row_length", lambda g: row)
-        stage = flux_kernel.variant(dtype, num.limiter, num.riemann, "stage", grid)
-        hlo = _with_kernel(True, lambda: jax.jit(lambda U: advance.__wrapped__(U, 0.0, 1e30, 3, grid, phys, num))
-                           .lower(U).as_text())
-        assert flux_kernel.target(flux_kernel.CELLS_TARGET, stage) in hlo, row  # this library runs
-        return _with_kernel(True, lambda: _steps(U, grid, phys, num)), _with_kernel(True, rhs)
-
-    (fixed, fixed_rhs), (any_row, any_rhs) = run(16), run(0)
-    ref = _with_kernel(False, lambda: _steps(U, grid, phys, num))
-    assert int(fixed[2]) == 3 and int(fixed[3]) == 0
-    assert all(np.array_equal(np.asarray(a), np.asarray(b)) for a, b in zip(fixed[0], any_row[0], strict=True))
-    assert all(np.array_equal(np.asarray(a), np.asarray(b)) for a, b in zip(fixed_rhs, any_rhs, strict=True))
-    assert _close(fixed[0], ref[0]) < RTOL[dtype]
-    assert _close(fixed[0], U) > 100 * RTOL[dtype]
 
 
 @pytest.mark.contract
@@ -510,7 +480,7 @@ def test_a_library_refuses_a_call_of_another_variant(monkeypatch) -> None:
     want = divergence(jnp.float64, "vanleer", "hll", True)
     target = flux_kernel._target
     monkeypatch.setattr(flux_kernel, "_target",
-                        lambda base, *args: target(base, jnp.float64, "vanleer", "hll", "rhs", args[-1]))
+                        lambda base, *args: target(base, jnp.float64, "vanleer", "hll", "rhs"))
     got = divergence(jnp.float64, "vanleer", "hll", True)
     assert _close(got[0], want[0]) == 0.0 and float(jnp.max(jnp.abs(got[1] - want[1]))) == 0.0
     others = [(jnp.float64, "minmod", "hll", True, "float64 minmod/hll viscous"),
@@ -521,13 +491,6 @@ def test_a_library_refuses_a_call_of_another_variant(monkeypatch) -> None:
         with pytest.raises(jax.errors.JaxRuntimeError,
                            match=f"built for float64 vanleer/hll viscous, the call asks for {asked}"):
             jax.block_until_ready(divergence(dtype, limiter, riemann, viscous))
-    # A library built for rows of 16 cells refuses this grid's rows of 10.
-    assert grid.cells[-1] == 10
-    rows16 = flux_kernel.Variant("float64", "vanleer", "hll", "rhs", 16)
-    flux_kernel._library(rows16)
-    monkeypatch.setattr(flux_kernel, "_target", lambda base, *args: flux_kernel.target(base, rows16))
-    with pytest.raises(jax.errors.JaxRuntimeError, match="built for rows of 16 cells, the call's grid has rows of 10"):
-        jax.block_until_ready(divergence(jnp.float64, "vanleer", "hll", True))
 
 
 @pytest.mark.contract

@@ -42,10 +42,9 @@
 // (-DKTGF_REAL=double|float), the limiter and the Riemann solver (-DKTGF_LIMITER, -DKTGF_RIEMANN: indices of
 // fluxes.LIMITERS and fluxes.RIEMANN_SOLVERS), the kind (-DKTGF_KIND): KTGF_RHS and KTGF_EULER hold
 // KtgfFluxDivergence with and without the viscous fluxes, KTGF_STAGE the four stage entries and
-// KtgfRegisterCells (its own registry of cell programs); and the row length (-DKTGF_ROW: the cells along the
-// last axis, or 0 for any).  Each library instantiates the sweep once, so a build takes seconds, not the minutes
-// of all variants at once; its handlers refuse (InvalidArgument) a call that asks for another precision,
-// limiter, Riemann solver or viscous flag than the library's, or whose rows have another length.
+// KtgfRegisterCells (its own registry of cell programs).  Each library instantiates the sweep once, so a build
+// takes seconds, not the minutes of all variants at once; its handlers refuse (InvalidArgument) a call that asks
+// for another precision, limiter, Riemann solver or viscous flag than the library's.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -103,22 +102,11 @@ struct Consts {
   T omega_factor[3];  // (1/dx_a)/rho_s
 };
 
-// Cells per row (the last axis) this library is built for, or 0: any row length (-DKTGF_ROW; flux_kernel.py,
-// Variant.row).  A row length known here makes every stencil offset of the sweep a constant, so a face loop
-// needs no set-up of a pointer per (field, plane, row offset) first (about 400 integer instructions per loop
-// call with the length unknown).  Measured (docs/solver.md, "Rows of a known length"): in cache, one thread,
-// float32 1.18x faster at 64-cell rows and 1.63x at 16, float64 1.07x and 1.25x; bit-identical.
-#ifndef KTGF_ROW
-#define KTGF_ROW 0
-#endif
-constexpr long ROW = KTGF_ROW;
-static_assert(ROW == 0 || ROW >= 2, "KTGF_ROW: 0 (any) or a row length of at least 2 cells");
-
 // Cells per row of the grid of k, and the row stride of its padded fields and planes (GHOST cells per side).
 template <class T>
-KTGF_INLINE long row_cells(const Consts<T>& k) { return ROW ? ROW : k.n[2]; }
+KTGF_INLINE long row_cells(const Consts<T>& k) { return k.n[2]; }
 template <class T>
-KTGF_INLINE long row_stride(const Consts<T>& k) { return ROW ? ROW + 2 * GHOST : k.stride[1]; }
+KTGF_INLINE long row_stride(const Consts<T>& k) { return k.stride[1]; }
 
 // Planes: the sweeps read the cell fields plane by plane, through a table of three planes around the row's
 // plane i: P[(d0 + 1) * NFIELD + f] is field f of plane i + d0 (d0 = -1, 0, 1), a padded plane with row stride
@@ -541,14 +529,6 @@ ffi::Error check_variant(const char* entry, ffi::DataType type, int limiter, int
                                      ", the call asks for " + variant_name(type, limiter, riemann, viscous));
 }
 
-// Success if rows of n2 cells are what this library sweeps (any length if it is built with ROW 0), else the error
-// that says both.
-ffi::Error check_row(const char* entry, long n2) {
-  if (ROW == 0 || n2 == ROW) return ffi::Error::Success();
-  return ffi::Error::InvalidArgument(std::string(entry) + ": this library is built for rows of " + std::to_string(ROW) +
-                                     " cells, the call's grid has rows of " + std::to_string(n2));
-}
-
 // The grid constants of an (n0, n1, n2) grid with float64 params (dx, dy, dz, rho_s, ...), strides of padded fields.
 Consts<Real> consts(const long* n, const double* params) {
   Consts<Real> k;
@@ -584,7 +564,6 @@ ffi::Error run(const ffi::AnyBuffer* in, const double* params, Real* work, const
   for (int a = 0; a < 3; ++a) n[a] = long(dims[a]);
   if (n[0] < GHOST || n[1] < GHOST || n[2] < GHOST)
     return ffi::Error::InvalidArgument("flux kernel: at least 2 cells per axis");
-  if (auto err = check_row("flux kernel", n[2]); err.failure()) return err;
   const int nfield = BUILT_VISCOUS ? NFIELD : GG + 1;
   std::vector<const Real*> fields(NFIELD, nullptr);
   for (int f = 0; f < nfield; ++f) fields[f] = in[f].typed_data<Real>();
@@ -967,7 +946,6 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
   if (auto err = find_program(program, type, p); err.failure()) return err;
   long n[3];
   if (auto err = grid_shape(*state.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
-  if (auto err = check_row("KtgfSsprkStageCells", n[2]); err.failure()) return err;
   if (ring->element_type() != type || long(ring->element_count()) < ring_elements(n))
     return ffi::Error::InvalidArgument("stage kernel: the ring workspace is smaller than KtgfRingElements");
   const double* par = params.typed_data();

@@ -20,9 +20,9 @@ float64 — and when it is switched on: :data:`.fluxes.FLUX_KERNEL` (default fro
 variable ``KTGF_FLUX_KERNEL``; ``0`` switches it off).  The JAX path remains the reference and
 the path for GPUs, sharding, walls and Lees–Edwards boundaries.
 
-Build: one shared library per *variant* (:class:`Variant`: precision × limiter × Riemann solver × kind × row
-length, the kind one of :data:`KINDS` — the viscous flux divergence, the inviscid one of the IMEX scheme, or the
-SSP-RK3 stage entries; the row length that of the grid's last axis where :func:`row_length` fixes it, else any),
+Build: one shared library per *variant* (:class:`Variant`: precision × limiter × Riemann solver × kind, the
+kind one of :data:`KINDS` — the viscous flux divergence, the inviscid one of the IMEX scheme, or the SSP-RK3
+stage entries),
 compiled when a solver first needs it (:func:`applies`) by :mod:`.cxx` (the C++ compiler ``$CXX`` or the first
 found, ``-O3`` and the flags it accepts: ``-march=native``, OpenMP threads) into ``$KTGF_CACHE_DIR`` (default
 ``~/.cache/ktgf``), and kept there; a variant is chosen by ``-D`` macros, so each build
@@ -81,64 +81,46 @@ _loaded: dict[Any, Any] = {}
 @dataclass(frozen=True)
 class Variant:
     """One build of the kernel: the state precision (``"float64"`` or ``"float32"``), the limiter (one of
-    :data:`.stencil.LIMITERS`), the Riemann solver (:data:`.stencil.RIEMANN_SOLVERS`), the kind (:data:`KINDS`) and
-    the row length: the cells along the grid's last axis the library sweeps, 0 for any (:func:`row_length`)."""
+    :data:`.stencil.LIMITERS`), the Riemann solver (:data:`.stencil.RIEMANN_SOLVERS`) and the kind (:data:`KINDS`).
+
+    (Libraries built for one row length, with constant stencil offsets, were removed: in one process, SSP-RK3,
+    RET, they gained 1.025× at 64³ float64, 1.028× float32, 0.99–1.02× at 32³ and lost at 16³; each row length
+    cost a build of 10–15 s.)"""
 
     dtype: str
     limiter: str
     riemann: str
     kind: str
-    row: int = 0
 
     def __post_init__(self) -> None:
         for value, valid in ((self.dtype, ("float64", "float32")), (self.limiter, LIMITERS),
                              (self.riemann, RIEMANN_SOLVERS), (self.kind, KINDS)):
             if value not in valid:
                 raise ValueError(f"no flux kernel variant for {value!r}; valid: {valid}")
-        if self.row != 0 and self.row < 2:
-            raise ValueError(f"no flux kernel variant for rows of {self.row} cells; valid: 0 (any) or at least 2")
 
     def __str__(self) -> str:
-        return f"{self.dtype} {self.limiter}/{self.riemann} {self.kind}" + (f", rows of {self.row}" if self.row else "")
+        return f"{self.dtype} {self.limiter}/{self.riemann} {self.kind}"
 
     @property
     def suffix(self) -> str:
-        """What this variant's FFI target names add to the base names, e.g. ``__f64_vanleer_hll_stage`` (any row
-        length) or ``__f64_vanleer_hll_stage_r64``."""
-        return f"__f{self.dtype[5:]}_{self.limiter}_{self.riemann}_{self.kind}" + (f"_r{self.row}" if self.row else "")
+        """What this variant's FFI target names add to the base names, e.g. ``__f64_vanleer_hll_stage``."""
+        return f"__f{self.dtype[5:]}_{self.limiter}_{self.riemann}_{self.kind}"
 
     @property
     def macros(self) -> tuple[str, ...]:
         """The ``-D`` flags that select the variant in flux_kernel.cc."""
-
         return (f"-DKTGF_REAL={'double' if self.dtype == 'float64' else 'float'}",
                 f"-DKTGF_LIMITER={LIMITERS.index(self.limiter)}",
-                f"-DKTGF_RIEMANN={RIEMANN_SOLVERS.index(self.riemann)}", f"-DKTGF_KIND={KINDS.index(self.kind)}",
-                f"-DKTGF_ROW={self.row}")
+                f"-DKTGF_RIEMANN={RIEMANN_SOLVERS.index(self.riemann)}", f"-DKTGF_KIND={KINDS.index(self.kind)}")
 
 
-#: The variant :func:`available` builds: the SSP-RK3 stage of the default numerics in float64, for any row length.
+#: The variant :func:`available` builds: the SSP-RK3 stage of the default numerics in float64.
 DEFAULT = Variant("float64", "vanleer", "hll", "stage")
-#: Rows whose length :func:`row_length` fixes in the build: from ROW_MIN to ROW_MAX cells, in multiples of ROW_STEP.
-ROW_MIN, ROW_MAX, ROW_STEP = 16, 1024, 8
 
 
-def row_length(grid: Any) -> int:
-    """The row length of the library that sweeps ``grid``: the cells along its last axis where they are
-    :data:`ROW_MIN` to :data:`ROW_MAX` in multiples of :data:`ROW_STEP`, else 0 (a library for any length).
-
-    A library built for one row length has every stencil offset as a constant, so its loops need no set-up per
-    row (docs/solver.md at cef4049, "Rows of a known length": in cache, one thread, float32 1.63x faster at 16-cell
-    rows and 1.18x at 64, float64 1.25x and 1.07x).  Each new length costs one build (10-15 s, then cached); shorter rows
-    would gain too, but grids of 8 cells and fewer a side are small tests, where a build costs more than it saves."""
-    n = int(grid.cells[-1])
-    return n if ROW_MIN <= n <= ROW_MAX and n % ROW_STEP == 0 else 0
-
-
-def variant(dtype: Any, limiter: str, riemann: str, kind: str, grid: Any = None) -> Variant:
-    """The :class:`Variant` of a state of ``dtype`` (any form :func:`jax.numpy.dtype` takes) on ``grid`` (None:
-    the library for any row length)."""
-    return Variant(jnp.dtype(dtype).name, limiter, riemann, kind, 0 if grid is None else row_length(grid))
+def variant(dtype: Any, limiter: str, riemann: str, kind: str) -> Variant:
+    """The :class:`Variant` of a state of ``dtype`` (any form :func:`jax.numpy.dtype` takes)."""
+    return Variant(jnp.dtype(dtype).name, limiter, riemann, kind)
 
 
 def target(base: str, v: Variant) -> str:
@@ -207,12 +189,12 @@ def applies(grid: Any, dtype: Any, kind: str, limiter: str, riemann: str) -> boo
     periodic = grid.boundaries is None or grid.boundaries.all_periodic
     return (grid.ndim == 3 and periodic and jnp.dtype(dtype) in (jnp.float32, jnp.float64)
             and jax.default_backend() == "cpu" and jax.device_count() == 1
-            and _usable(variant(dtype, limiter, riemann, kind, grid)))
+            and _usable(variant(dtype, limiter, riemann, kind)))
 
 
-def _target(base: str, dtype: Any, limiter: str, riemann: str, kind: str, grid: Any) -> str:
-    """The FFI target of the entry ``base`` in the library of that variant on ``grid``, loaded if it is not yet."""
-    v = variant(dtype, limiter, riemann, kind, grid)
+def _target(base: str, dtype: Any, limiter: str, riemann: str, kind: str) -> str:
+    """The FFI target of the entry ``base`` in the library of that variant, loaded if it is not yet."""
+    v = variant(dtype, limiter, riemann, kind)
     _library(v)
     return target(base, v)
 
@@ -239,7 +221,7 @@ def flux_divergence(W: Any, eos: Any, transport: Any, grid: Any, rho_s: Any, lim
     fields, work = _cell_fields(W, eos, transport, grid, viscous)
     field = jax.ShapeDtypeStruct(tuple(grid.cells), W[0].dtype)
     kind = "rhs" if viscous else "euler"
-    call = jax.ffi.ffi_call(_target(TARGET, W[0].dtype, limiter, riemann, kind, grid), (field,) * 6 + (work,))
+    call = jax.ffi.ffi_call(_target(TARGET, W[0].dtype, limiter, riemann, kind), (field,) * 6 + (work,))
     params = jnp.stack([jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)])
     out = call(*fields, params, **_schemes(limiter, riemann), viscous=np.int32(viscous))
     return list(out[:5]), out[5]
@@ -259,7 +241,7 @@ def ssprk_stage(U0: Any, Uk: Any, W: Any, eos: Any, transport: Any, source: tupl
     field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
     # U' is written over Uk (each cell reads its own Uk only, after the fluxes): no new buffers, and
     # none of the loop-carry copies XLA inserts when a stage's output cannot take its input's place.
-    call = jax.ffi.ffi_call(_target(STAGE_TARGET, dtype, limiter, riemann, "stage", grid), (field,) * 5 + (work,),
+    call = jax.ffi.ffi_call(_target(STAGE_TARGET, dtype, limiter, riemann, "stage"), (field,) * 5 + (work,),
                             input_output_aliases={len(fields) + 6 + v: v for v in range(5)})
     params = _stage_params(a, dt, grid, rho_s, dtype)
     return tuple(call(*fields, params, *state, **_schemes(limiter, riemann))[:5])
@@ -269,7 +251,7 @@ def _register(program: Any, limiter: str, riemann: str, grid: Any) -> None:
     """Makes a :class:`~.cell_program.CellProgram` known to the stage library of its precision with ``limiter`` and
     ``riemann`` on ``grid``, whose calls use it (each library has its own registry; once per process, library and
     program)."""
-    v = variant(program.dtype, limiter, riemann, "stage", grid)
+    v = variant(program.dtype, limiter, riemann, "stage")
     done = _loaded.setdefault("programs", set())
     if (v, program.key) not in done:
         bits = 8 * program.dtype.itemsize
@@ -287,7 +269,7 @@ def cell_limits(Uk: Any, program: Any, leaf: Any, grid: Any, limiter: str, riema
     stages, whose library this call uses (the pass does not depend on them)."""
     _register(program, limiter, riemann, grid)
     dtype = Uk[0].dtype
-    call = jax.ffi.ffi_call(_target(LIMITS_TARGET, dtype, limiter, riemann, "stage", grid),
+    call = jax.ffi.ffi_call(_target(LIMITS_TARGET, dtype, limiter, riemann, "stage"),
                             jax.ShapeDtypeStruct((program.nlim,), dtype))
     return call(leaf, *(jnp.asarray(f, dtype) for f in Uk), program=np.int64(program.key))
 
@@ -314,7 +296,7 @@ def _stage_cells(state: list, program: Any, leaf: Any, a: Any, dt: Any, grid: An
     mode rate)."""
     _register(program, limiter, riemann, grid)
     dtype = state[0].dtype
-    stage = variant(dtype, limiter, riemann, "stage", grid)
+    stage = variant(dtype, limiter, riemann, "stage")
     field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
     maxima = jax.ShapeDtypeStruct((program.nlim if mode == "rate" else 0,), dtype)
     call = jax.ffi.ffi_call(target(CELLS_TARGET, stage), (field,) * 5 + (maxima, _ring(grid, dtype, stage)),
