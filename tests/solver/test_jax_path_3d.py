@@ -16,6 +16,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from helpers.couette_case import couette_case
 
 from ktgf.closures import get_model
 from ktgf.closures.coefficients import mean_free_path
@@ -130,23 +131,5 @@ def test_a_3d_couette_cell_keeps_the_1d_solver_profile(jax_path) -> None:
     assert abs(float(jnp.sum(U[0])) / float(jnp.sum(U0[0])) - 1.0) < 1e-12
 
 
-COUETTE = """
-[case]
-kind = "couette"
-[model]
-name = "ret"
-restitution = 0.9
-[initial]
-solid_fraction = 0.3
-temperature = 1e-3
-perturbation = "none"
-[grid]
-cells = [32, 4, 4]
-length_d = [10.0, 1.25, 1.25]
-[boundaries]
-x = { kind = "wall", flow = "y", wall_speed = 1.0, walls = { type = "johnson-jackson", specularity = 0.1, restitution = 0.9 } }
-[time]
-end = 2.0
-unit = "strain"
-scheme = "ssprk3"
-"""
+COUETTE = couette_case([32, 4, 4], 2.0, lengths="[10.0, 1.25, 1.25]").replace('scheme = "imex"', 'scheme = "ssprk3"')
+

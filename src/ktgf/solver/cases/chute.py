@@ -8,12 +8,12 @@ import math
 from typing import Any
 
 from ...errors import InputError
-from ..boundaries import AXES, WALL
-from ..flows import PROFILES, WALL_CASE_COLUMNS, profile_errors, wall_case_diagnostics
+from ..boundaries import AXES
+from ..flows import profile_errors
 from ..grid import Grid
 from ..kinematics import gradient_axis
 from ..physics import Physics
-from .registry import Case, register
+from .registry import WallCase, register
 
 
 def chute_reference(phys: Physics, grid: Grid, phi0: float, n_cells: int = 256) -> Any:
@@ -49,11 +49,8 @@ def compare_chute(history: dict[str, list], phys: Physics, grid: Grid, phi0: flo
 
 
 @register
-class Chute(Case):
-    name, label, boundary, inclined = "chute", "chute", WALL, True
-    panels = ((("theta_mean",), "θ"), (("wall_shear_stress_lower", "wall_shear_stress_upper"), "wall shear stress"))
-    profiles = True
-    columns, steady_monitors = WALL_CASE_COLUMNS, PROFILES
+class Chute(WallCase):
+    name, label, inclined = "chute", "chute", True
 
     def check(self, cfg: Any, source: str, shear: str | None, wall: str | None) -> None:
         speed = getattr(cfg.boundaries, wall).wall_speed
@@ -75,9 +72,6 @@ class Chute(Case):
         g[f] = cfg.case.gravity * math.sin(z)
         g[a] = -cfg.case.gravity * math.cos(z)
         return tuple(g)
-
-    def diagnostics(self, U: Any, t: float, grid: Grid, phys: Physics) -> dict[str, Any]:
-        return wall_case_diagnostics(U, t, grid, phys)
 
     def verification(self, history: dict[str, list], phys: Physics, grid: Grid, phi0: float) -> dict[str, Any]:
         return {**self.about(phys, phi0), **compare_chute(history, phys, grid, phi0)}

@@ -8,12 +8,11 @@ from typing import Any
 import numpy as np
 
 from ...errors import InputError
-from ..boundaries import WALL
-from ..flows import PROFILES, WALL_CASE_COLUMNS, profile_errors, wall_case_diagnostics
+from ..flows import profile_errors
 from ..grid import Grid
 from ..kinematics import gradient_axis
 from ..physics import Physics
-from .registry import Case, register
+from .registry import WallCase, register
 
 
 def couette_reference(phys: Physics, grid: Grid, phi0: float, n_cells: int = 400) -> Any:
@@ -53,20 +52,14 @@ def compare_couette(history: dict[str, list], phys: Physics, grid: Grid, phi0: f
 
 
 @register
-class Couette(Case):
-    name, label, boundary, imposed_shear = "couette", "Couette", WALL, True
-    panels = ((("theta_mean",), "θ"), (("wall_shear_stress_lower", "wall_shear_stress_upper"), "wall shear stress"))
-    profiles = True
-    columns, steady_monitors = WALL_CASE_COLUMNS, PROFILES
+class Couette(WallCase):
+    name, label, imposed_shear = "couette", "Couette", True
 
     def check(self, cfg: Any, source: str, shear: str | None, wall: str | None) -> None:
         speed = getattr(cfg.boundaries, wall).wall_speed
         if not speed > 0:
             raise InputError(f"{source}: field boundaries.{wall}.wall_speed = {speed:g} is out of range: valid "
                              "wall_speed > 0 m/s for a Couette cell")
-
-    def diagnostics(self, U: Any, t: float, grid: Grid, phys: Physics) -> dict[str, Any]:
-        return wall_case_diagnostics(U, t, grid, phys)
 
     def verification(self, history: dict[str, list], phys: Physics, grid: Grid, phi0: float) -> dict[str, Any]:
         return {**self.about(phys, phi0), **compare_couette(history, phys, grid, phi0)}

@@ -8,7 +8,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..flows import add_base_flow, boundaries
+from ..boundaries import WALL
+from ..flows import PROFILES, WALL_CASE_COLUMNS, add_base_flow, boundaries, wall_case_diagnostics
 from ..grid import Grid
 from ..kinematics import shear_rate
 from ..physics import Physics
@@ -102,3 +103,17 @@ class Case:
         """The progress bar's clock: ``t = … s``, with ``γ̇t = …`` (the strain) for an imposed γ̇ [1/s]."""
         text = f"t = {t:.4g} s"
         return f"{text}  γ̇t = {shear_rate * t:.3g}" if shear_rate else text
+
+
+class WallCase(Case):
+    """A case with walls on one axis: the wall stresses and slips and the wall-normal profiles as its columns,
+    steady when the profiles stop changing, the profiles plotted (the Couette cell, the chute)."""
+
+    boundary = WALL
+    panels = ((("theta_mean",), "θ"), (("wall_shear_stress_lower", "wall_shear_stress_upper"), "wall shear stress"))
+    profiles = True
+    columns, steady_monitors = WALL_CASE_COLUMNS, PROFILES
+
+    def diagnostics(self, U: Any, t: float, grid: Grid, phys: Physics) -> dict[str, Any]:
+        return wall_case_diagnostics(U, t, grid, phys)
+
