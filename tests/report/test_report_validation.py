@@ -61,3 +61,8 @@ def test_summary_shows_fitted_and_predicted_rows_apart(tmp_path, data_dir):
     assert rows[0].case.startswith("Fitted models, all DEM files")
     assert any("quote the predicted rows" in c for c in s.caveats)
     assert not any("validation" in t for t in s.recommendations)
+    assert not any("Dense and Frictional" in c for c in s.caveats)  # equal at μ = 0 in the fit rows: not a ranking tie
+    from ktgf.report.summary import summary_html
+
+    page = summary_html([ctx.result])
+    assert "Fitted models" in page and "<b>" not in page.split("Fitted models", 1)[1].split("</table>")[0]

@@ -157,7 +157,7 @@ def _caveats(s: Summary, by: dict[str, SectionResult], hcs: SectionResult | None
         if signed and all(v > 0 for v in signed.values()):
             s.caveats.append(f"Every model cools faster than the DEM (mean {min(signed.values()) * 100:+.1f} % to "
                              f"{max(signed.values()) * 100:+.1f} %): velocity correlations that Enskog-type theories neglect.")
-    ties = {tuple(r.best) for r in s.rows if len(r.best) > 1}
+    ties = {tuple(r.best) for r in s.rows if len(r.best) > 1 and r.regime != "validation"}  # validation rows: not ranked
     if ties:
         s.caveats.append("Ties are models whose numbers coincide (within 1e-4): " + "; ".join(_join(list(t)) for t in sorted(ties))
                          + ". Below the freezing point φ_f the models of one theory share χ and viscosity, so those data cannot tell them apart.")
@@ -198,8 +198,9 @@ def summary_html(results: list[SectionResult]) -> str:
         head = "".join(f"<th>{html.escape(_label(n))}</th>" for n in names)
         body = []
         for r in s.rows:
+            bold = set(r.best) if r.regime != "validation" else set()  # the fitted models' rows rank nobody
             cells = "".join(
-                (f"<td>{'<b>' if n in r.best else ''}{html.escape(_fmt(r.errors[n], r.percent))}{'</b>' if n in r.best else ''}</td>"
+                (f"<td>{'<b>' if n in bold else ''}{html.escape(_fmt(r.errors[n], r.percent))}{'</b>' if n in bold else ''}</td>"
                  if n in r.errors else "<td>—</td>") for n in names)
             link = f'<a href="{html.escape(r.data)}">{html.escape(r.data.rsplit("/", 1)[-1])}</a>' if r.data else "—"
             body.append(f'<tr><td class="l">{html.escape(r.case)}</td><td class="l">{html.escape(r.measure)}</td>{cells}'
