@@ -311,11 +311,11 @@ def test_the_sequencing_examples_chain_their_output_folders() -> None:
     configs = [parse_config(tomllib.loads((ROOT / "examples" / f"{n}.toml").read_text())) for n in SEQUENCE]
     assert [c.grid.cells[1] for c in configs] == [32, 64, 128]
     assert configs[0].initial.from_run is None
-    for before, after in zip(configs, configs[1:]):
-        assert after.initial.from_run == before.output.directory and after.initial.perturbation == "none"
-    dense = [parse_config(tomllib.loads((ROOT / "examples" / f"{n}.toml").read_text()))
-             for n in ("couette_dense", "couette_dense_3d")]
-    assert dense[1].initial.from_run == dense[0].output.directory and dense[1].grid.cells == [64, 64, 64]
+    for before, after in zip(SEQUENCE, configs[1:]):
+        assert after.initial.from_run == f"{before}.toml" and after.initial.perturbation == "none"
+    for slab, cube in (("couette_dense", "couette_dense_3d"), ("couette_dense055", "couette_dense055_3d")):
+        cfg = parse_config(tomllib.loads((ROOT / "examples" / f"{cube}.toml").read_text()))
+        assert cfg.initial.from_run == f"{slab}.toml" and cfg.grid.cells == [64, 64, 64]
 
 
 @pytest.mark.analytic
@@ -325,17 +325,16 @@ def test_the_sequenced_dense_couette_at_128_cells_reaches_the_1d_solver_within_o
     """φ̄ 0.55, 32 → 64 → 128 cells across the 10 d gap (the three examples as shipped, run from one
     folder): the last stage is within 1 % of the 1D Couette solver in u, φ, θ and in the wall stress,
     and its verification.json adds up the steps of the whole sequence."""
-    from ktgf.solver.config import load_config
+    from ktgf.solver.chain import run_chain
 
     monkeypatch.chdir(tmp_path)
-    steps = []
-    for name in SEQUENCE:
-        sim = Simulation(load_config(ROOT / "examples" / f"{name}.toml"))
-        sim.run(progress=False)
-        steps.append(sim.steps)
-        assert sim.verification["steady"]["reached"], (name, sim.verification["steady"])
-    ver = json.loads((tmp_path / "couette_dense_seq128_run" / "verification.json").read_text())
-    assert ver["cells_across_gap"] == 128 and ver["run"]["sequence"]["steps"] == sum(steps)
+    run_chain(ROOT / "examples" / f"{SEQUENCE[-1]}.toml", progress=False)  # runs the stages before it first
+    stages = [json.loads((tmp_path / f"{name}_run" / "verification.json").read_text()) for name in SEQUENCE]
+    for name, stage in zip(SEQUENCE, stages):
+        assert stage["steady"]["reached"], (name, stage["steady"])
+    ver = stages[-1]
+    assert ver["cells_across_gap"] == 128
+    assert ver["run"]["sequence"]["steps"] == sum(stage["run"]["step_count"] for stage in stages)
     assert max(ver["max_rel_error"].values()) < 0.01, ver["max_rel_error"]
     tau = np.asarray(ver["wall_shear_stress_Pa"]["run"]) / np.asarray(ver["wall_shear_stress_Pa"]["reference"])
     assert np.max(np.abs(tau - 1.0)) < 0.01, ver["wall_shear_stress_Pa"]

@@ -28,7 +28,8 @@ def run(
     across the gap), couette_dense_3d.toml (64³, from couette_dense's result, in minutes),
     couette_dense055.toml → couette_dense055_3d.toml (the same at φ 0.55), couette_dense_seq32.toml
     → _seq64 → _seq128 (φ 0.55, grid sequencing to 128 cells), chute_2d.toml; time.steady_tol stops a
-    sheared run at its steady state; initial.from_run starts from an earlier run mapped onto the grid.
+    sheared run at its steady state; initial.from_run starts from an earlier run mapped onto the grid
+    (from_run = "earlier.toml": that config is run first, or resumed, or reused if complete).
 
     Ctrl-C stops after the current chunk with a checkpoint that matches the files written
     (exit code 130); `--resume` continues bit for bit.
@@ -37,12 +38,9 @@ def run(
 
     with STOP:  # from here on Ctrl-C is a flag, also during imports and the first compilation
         try:
-            from ..solver.config import load_config
-            from ..solver.run import Simulation
+            from ..solver.chain import run_chain
 
-            cfg = load_config(case)
-            sim = Simulation(cfg, output_dir)
-            ds = sim.run(resume=resume, progress=progress, overwrite=overwrite)
+            sim, ds = run_chain(case, output_dir, resume, progress, overwrite)
         except Interrupted as exc:
             tail = f"\nResume with: ktgf run {case} --resume {exc.checkpoint}" if exc.checkpoint else ""
             typer.echo(f"{exc}{tail}", err=True)

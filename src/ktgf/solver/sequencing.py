@@ -53,6 +53,9 @@ def checkpoint_path(path: str | Path) -> Path:
             raise InputError(f"field initial.from_run = {str(path)!r}: the folder holds no {CHECKPOINT_NAME} "
                              "(valid: the output folder of a finished ktgf run, or its checkpoint file)")
         return p
+    if p.suffix == ".toml":
+        raise InputError(f"field initial.from_run = {str(path)!r} is a run configuration: run the chain with "
+                         "ktgf run (or ktgf.solver.chain.run_chain), which runs it first")
     if p.suffix == ".nc":
         raise InputError(f"field initial.from_run = {str(path)!r}: a netCDF time series holds no fields; valid: "
                          f"the run's output folder or its {CHECKPOINT_NAME}")
