@@ -56,7 +56,7 @@ class InitialSection(_Section):
     branch: int = Field(0, ge=0, le=4, description="eigenmode by decreasing growth rate: HCS 0-2, shear 0-4")
     shear_rate: float | None = Field(None, gt=0.0, description="chute: initial u = shear_rate * height above the base [1/s]")
     from_run: str | None = Field(None, min_length=1, description="start from this earlier run (its output folder or "
-                                 "checkpoint.npz) mapped onto this grid (ktgf.solver.sequencing)")
+                                 "checkpoint.npz, or its TOML config: run first) mapped onto this grid")
 
     @model_validator(mode="after")
     def _temperature(self) -> InitialSection:
@@ -340,9 +340,6 @@ def check_case(cfg: Config, source: str = "config") -> None:
         if getattr(cfg.numerics, key) == "implicit" and cfg.time.scheme == "ssprk3":
             raise InputError(f"{source}: field numerics.{key} = 'implicit' needs time.scheme = 'imex' or 'auto' "
                              "(got 'ssprk3', an explicit scheme)")
-    if cfg.numerics.acoustics == "implicit" and shear is not None:
-        raise InputError(f"{source}: field numerics.acoustics = 'implicit' is not available with a 'lees-edwards' "
-                         f"boundary (boundaries.{shear}); valid: 'explicit'")
     for axis, need in ((shear, LEES_EDWARDS), (wall, WALL)):
         if axis is not None and case.boundary != need:
             raise InputError(f"{source}: field boundaries.{axis}.kind = {need!r} needs case.kind = "

@@ -61,7 +61,7 @@ import numpy as np
 from jax.scipy.sparse.linalg import bicgstab, cg
 
 from ..closures.coefficients import Reduced
-from .acoustics import MIN_SWEEPS, AcousticStage, mass_energy_divergence, pressure, pressure_divergence
+from .acoustics import MIN_SWEEPS, AcousticStage, implicit_fluxes, pressure, pressure_divergence
 from .fluxes import (face_coefficients, face_divergence, face_jump, face_mean, has_walls, pad_fields, pad_viscous,
                      stress, viscous_flux)
 from .boundaries import lees_edwards_faces, wall_terms
@@ -293,6 +293,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     implicit_sink = sink
     friction_sink = 1.5 * rho * theta * r.zeta_f if is_frictional(r) else 0.0
     rho_hat = rho
+    galilean = acoustic is not None and grid.boundaries is not None and grid.boundaries.shear_axis is not None
     if acoustic is not None:
         sweeps = max(sweeps, MIN_SWEEPS)
         p_ref, d_ref = pressure(rho, theta, r, phys), [0.0] * grid.ndim  # Û holds no compression
@@ -340,6 +341,8 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
 
         def A(v: tuple, affine: bool = False) -> tuple:
             d = div_tau(v, affine)
+            if galilean:  # the flow momentum of the implicit mass flux across a Lees-Edwards boundary
+                d = [x + g for x, g in zip(d, implicit_fluxes(rho, v, None, grid, t, affine=False)[1])]
             return tuple(rho * v[j] - adt * d[j] for j in range(3))
 
         eta_m, lam_m = jnp.mean(transport[0]), jnp.mean(transport[1]) + lam_ac_m
@@ -354,7 +357,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         m_base = m_hat
         if acoustic is not None:  # the pressure of the iterate: m̂ − aΔt∇(p_k + λ_ac∇·u_k)
             m_base = tuple(m + adt * d for m, d in zip(m_hat, pressure_divergence(
-                [p + la * d for p, la, d in zip(p_ref_f, lam_ac_f, d_ref)], grid) + [0.0] * (3 - grid.ndim)))
+                [p + la * d for p, la, d in zip(p_ref_f, lam_ac_f, d_ref)], grid, t) + [0.0] * (3 - grid.ndim)))
         b = tuple(m - a for m, a in zip(m_base, A(u, True)))  # solve for the correction to the current u
         # Absolute floors from the scale of the state (thermal momentum ρ√θ, energy Ê), not of
         # the correction: in a nearly uniform gas the correction itself is round-off.
@@ -369,10 +372,10 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         if acoustic is not None:  # the face pressure of the solution, and mass and energy from its fluxes
             Pu = pad_fields(u, grid, t, velocity=0, walls=walls)
             div_f = [stress(Pu, 0.0, 1.0, a, grid)[a] for a in range(grid.ndim)]
-            m_base = tuple(m + adt * d for m, d in zip(m_hat, pressure_divergence(
-                [p + la * (d0 - d) for p, la, d0, d in zip(p_ref_f, lam_ac_f, d_ref, div_f)], grid)
-                + [0.0] * (3 - grid.ndim)))
-            d_rho, d_E = mass_energy_divergence(rho, u, acoustic.enthalpy, grid, t, walls)
+            d_rho, d_m, d_E = implicit_fluxes(rho, u, acoustic.enthalpy, grid, t, walls)
+            m_base = tuple(m + adt * (d + g) for m, d, g in zip(m_hat, pressure_divergence(
+                [p + la * (d0 - d) for p, la, d0, d in zip(p_ref_f, lam_ac_f, d_ref, div_f)], grid, t)
+                + [0.0] * (3 - grid.ndim), d_m))
             rho, E_base, d_ref = rho_hat + adt * d_rho, E_hat + adt * d_E, div_f
         else:
             E_base = E_hat
