@@ -192,8 +192,6 @@ def rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> Any:
     return tuple(explicit_rhs(U, grid, phys, num, viscous=True, t=t))
 
 
-
-
 def divu_bound(maxima: Any, grid: Grid) -> Any:
     """A bound of the central ∇·u on a periodic grid from the maxima of :data:`LIMIT_TERMS`:
     |∇·u| ≤ Σ_a (max u_a − min u_a)/(2Δx_a), with −min u_a = max(−u_a).
@@ -246,13 +244,8 @@ def kernel_step_limits(maxima: Any, grid: Grid, num: Numerics) -> Any:
     return limits_of_maxima(maxima, grid, num, divu_bound(maxima, grid))
 
 
-def stable_dt(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None) -> Any:
-    """Largest step of the scheme: the minimum of its limits (the IMEX scheme has no diffusive ones)."""
-    return dt_of_limits(step_limits(U, grid, phys, num, r), num)
-
-
 def dt_of_limits(lim: Any, num: Numerics) -> Any:
-    """The step of the scheme from the limits of :func:`step_limits`."""
+    """The step of the scheme from the limits of :func:`step_limits` (the IMEX scheme has no diffusive ones)."""
     dt = jnp.minimum(lim[0], lim[3])
     if num.scheme == "ssprk3":
         dt = jnp.minimum(dt, jnp.minimum(lim[1], lim[2]))
@@ -444,8 +437,6 @@ def binding_limit(lim: Any, scheme: str) -> str:
 
 #: An implicit solve whose final relative residual exceeds this multiple of its tolerance fails.
 RESIDUAL_FAIL = 10.0
-
-
 
 
 def status_of_maxima(maxima: Any, phys: Physics) -> Any:
