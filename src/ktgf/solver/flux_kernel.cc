@@ -6,11 +6,11 @@
 // recomputes the face states in each of the five flux components (docs/solver.md, Speed).
 //
 // Entry points (they share the face sweep):
-// * KtgfFluxDivergence: the cell fields (enum Field, each (n0, n1, n2), C order) and float64 (dx, dy, dz,
-//   rho_s) -> -div F of the five conservative fields and the central div u.
+// * KtgfFluxDivergence: float64 (dx, dy, dz, rho_s), then the cell fields (enum Field, each (n0, n1, n2),
+//   C order) -> -div F of the five conservative fields and the central div u.
 // * KtgfSsprkStage: one SSP-RK3 stage U' = a U0 + (1 - a)(Uk + dt L), L = -div F + s0 + s1 div u (the
-//   cooling rate is linear in div u, model.md §1); inputs the cell fields at Uk, then U0, Uk, s0, s1 and
-//   float64 (dx, dy, dz, rho_s, a, dt).
+//   cooling rate is linear in div u, model.md §1); inputs float64 (dx, dy, dz, rho_s, a, dt), then the cell
+//   fields at Uk, U0, Uk, s0, s1.
 // * KtgfSsprkStageCells: the same stage with the cell fields and source computed from Uk by a cell program
 //   (ktgf.solver.cell_program, registered by key with KtgfRegisterCells) plane by plane as the sweep goes
 //   (sweep_fused), so they never go to memory (1.3x faster per stage at 64^3 than writing them first).
@@ -527,33 +527,44 @@ ffi::Error grid_shape(const ffi::AnyBuffer& field, long* n) {
   return ffi::Error::Success();
 }
 
-// Pads the cell fields into `work` and sweeps them with the output `o` (Rhs or Stage).
+// Checks that the first `count` RemainingArgs are cell fields of one precision and shape; their type in `type`.
+ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& type) {
+  if (state.size() < count) return ffi::Error::InvalidArgument("flux kernel: too few fields");
+  auto first = state.get<ffi::AnyBuffer>(0);
+  if (!first.has_value()) return ffi::Error::InvalidArgument("flux kernel: no fields");
+  type = first->element_type();
+  for (size_t i = 0; i < count; ++i) {
+    auto b = state.get<ffi::AnyBuffer>(i);
+    if (!b.has_value() || b->element_type() != type || b->element_count() != first->element_count())
+      return ffi::Error::InvalidArgument("flux kernel: the fields must be cell fields of one precision");
+  }
+  return ffi::Error::Success();
+}
+
+// Pads the cell fields (the first NFIELD of `in`) into `work` and sweeps them with the output `o` (Rhs or Stage).
 template <class Out>
-ffi::Error run(const ffi::AnyBuffer* in, const double* params, Real* work, const Out& o) {
+ffi::Error run(ffi::RemainingArgs in, const double* params, Real* work, const Out& o) {
   long n[3];
-  if (auto err = grid_shape(in[0], n); err.failure()) return err;
+  if (auto err = grid_shape(*in.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
   const int nfield = BUILT_VISCOUS ? NFIELD : GG + 1;
   std::vector<const Real*> fields(NFIELD, nullptr);
-  for (int f = 0; f < nfield; ++f) fields[f] = in[f].typed_data<Real>();
+  for (int f = 0; f < nfield; ++f) fields[f] = in.get<ffi::AnyBuffer>(f)->typed_data<Real>();
   pad<Real>(fields.data(), nfield, n, work);
   sweep_padded(n, params, work, o);
   return ffi::Error::Success();
 }
 
 #if KTGF_KIND != KTGF_STAGE
-ffi::Error flux_divergence(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer uy, ffi::AnyBuffer uz,
-                           ffi::AnyBuffer theta, ffi::AnyBuffer pstar, ffi::AnyBuffer g, ffi::AnyBuffer eta,
-                           ffi::AnyBuffer lam, ffi::AnyBuffer kap, ffi::AnyBuffer omega,
-                           ffi::Buffer<ffi::F64> params, int32_t limiter,
-                           int32_t riemann, int32_t viscous, ffi::Result<ffi::AnyBuffer> d0,
-                           ffi::Result<ffi::AnyBuffer> d1, ffi::Result<ffi::AnyBuffer> d2,
-                           ffi::Result<ffi::AnyBuffer> d3, ffi::Result<ffi::AnyBuffer> d4,
-                           ffi::Result<ffi::AnyBuffer> divu, ffi::Result<ffi::AnyBuffer> work) {
-  const ffi::AnyBuffer in[NFIELD] = {rho, ux, uy, uz, theta, pstar, g, eta, lam, kap, omega};
+ffi::Error flux_divergence(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int32_t limiter, int32_t riemann,
+                           int32_t viscous, ffi::Result<ffi::AnyBuffer> d0, ffi::Result<ffi::AnyBuffer> d1,
+                           ffi::Result<ffi::AnyBuffer> d2, ffi::Result<ffi::AnyBuffer> d3,
+                           ffi::Result<ffi::AnyBuffer> d4, ffi::Result<ffi::AnyBuffer> divu,
+                           ffi::Result<ffi::AnyBuffer> work) {
   if (params.element_count() != 4) return ffi::Error::InvalidArgument("flux kernel: params = (dx, dy, dz, rho_s)");
-  if (auto err = check_variant("KtgfFluxDivergence", rho.element_type(), limiter, riemann, viscous != 0);
-      err.failure())
-    return err;
+  if (in.size() != NFIELD) return ffi::Error::InvalidArgument("flux kernel: fields = the 11 cell fields");
+  ffi::DataType type;
+  if (auto err = same_fields(in, NFIELD, type); err.failure()) return err;
+  if (auto err = check_variant("KtgfFluxDivergence", type, limiter, riemann, viscous != 0); err.failure()) return err;
   const Rhs<Real> o{{d0->typed_data<Real>(), d1->typed_data<Real>(), d2->typed_data<Real>(), d3->typed_data<Real>(),
                      d4->typed_data<Real>()},
                     divu->typed_data<Real>()};
@@ -783,33 +794,28 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
   return fits;
 }
 
-ffi::Error ssprk_stage(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer uy, ffi::AnyBuffer uz,
-                       ffi::AnyBuffer theta, ffi::AnyBuffer pstar, ffi::AnyBuffer g, ffi::AnyBuffer eta,
-                       ffi::AnyBuffer lam, ffi::AnyBuffer kap, ffi::AnyBuffer omega, ffi::Buffer<ffi::F64> params,
-                       ffi::RemainingArgs state, int32_t limiter, int32_t riemann, ffi::Result<ffi::AnyBuffer> u0,
-                       ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2, ffi::Result<ffi::AnyBuffer> u3,
-                       ffi::Result<ffi::AnyBuffer> u4, ffi::Result<ffi::AnyBuffer> work) {
-  const ffi::AnyBuffer in[NFIELD] = {rho, ux, uy, uz, theta, pstar, g, eta, lam, kap, omega};
+ffi::Error ssprk_stage(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int32_t limiter, int32_t riemann,
+                       ffi::Result<ffi::AnyBuffer> u0, ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2,
+                       ffi::Result<ffi::AnyBuffer> u3, ffi::Result<ffi::AnyBuffer> u4,
+                       ffi::Result<ffi::AnyBuffer> work) {
   void* const out[5] = {u0->untyped_data(), u1->untyped_data(), u2->untyped_data(), u3->untyped_data(),
                         u4->untyped_data()};
   if (params.element_count() != 6)
     return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
-  if (state.size() != 12) return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5, s0, s1)");
-  for (size_t i = 0; i < state.size(); ++i) {
-    auto b = state.get<ffi::AnyBuffer>(i);
-    if (!b.has_value() || b->element_type() != rho.element_type() || b->element_count() != rho.element_count())
-      return ffi::Error::InvalidArgument("stage kernel: U0, Uk, s0, s1 must be cell fields of the state precision");
-  }
-  if (auto err = check_variant("KtgfSsprkStage", rho.element_type(), limiter, riemann, true); err.failure()) return err;
+  if (in.size() != NFIELD + 12)
+    return ffi::Error::InvalidArgument("stage kernel: fields = (the 11 cell fields, U0 x5, Uk x5, s0, s1)");
+  ffi::DataType type;
+  if (auto err = same_fields(in, NFIELD + 12, type); err.failure()) return err;
+  if (auto err = check_variant("KtgfSsprkStage", type, limiter, riemann, true); err.failure()) return err;
   Stage<Real> o;
   for (int v = 0; v < 5; ++v) {
-    o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<Real>();
-    o.Uk[v] = state.get<ffi::AnyBuffer>(5 + v)->typed_data<Real>();
+    o.U0[v] = in.get<ffi::AnyBuffer>(NFIELD + v)->typed_data<Real>();
+    o.Uk[v] = in.get<ffi::AnyBuffer>(NFIELD + 5 + v)->typed_data<Real>();
     o.U[v] = static_cast<Real*>(out[v]);
   }
   const double* p = params.typed_data();
-  o.s0 = state.get<ffi::AnyBuffer>(10)->typed_data<Real>();
-  o.s1 = state.get<ffi::AnyBuffer>(11)->typed_data<Real>();
+  o.s0 = in.get<ffi::AnyBuffer>(NFIELD + 10)->typed_data<Real>();
+  o.s1 = in.get<ffi::AnyBuffer>(NFIELD + 11)->typed_data<Real>();
   o.a = Real(p[4]);
   o.b = Real(1) - o.a;  // as the JAX path: 1 - a in the state precision
   o.dt = Real(p[5]);
@@ -826,20 +832,6 @@ ffi::Error find_program(int64_t program, ffi::DataType type, CellProgram& p) {
   const int bits = type == ffi::F64 ? 64 : type == ffi::F32 ? 32 : 0;
   if (p.fn == nullptr) return ffi::Error::InvalidArgument("stage kernel: cell program not registered");
   if (p.bits != bits) return ffi::Error::InvalidArgument("stage kernel: cell program of another precision");
-  return ffi::Error::Success();
-}
-
-// Checks that the first `count` RemainingArgs are cell fields of one precision; their type in `type`.
-ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& type) {
-  if (state.size() < count) return ffi::Error::InvalidArgument("stage kernel: too few state fields");
-  auto first = state.get<ffi::AnyBuffer>(0);
-  if (!first.has_value()) return ffi::Error::InvalidArgument("stage kernel: no state");
-  type = first->element_type();
-  for (size_t i = 0; i < count; ++i) {
-    auto b = state.get<ffi::AnyBuffer>(i);
-    if (!b.has_value() || b->element_type() != type || b->element_count() != first->element_count())
-      return ffi::Error::InvalidArgument("stage kernel: the state must be cell fields of one precision");
-  }
   return ffi::Error::Success();
 }
 
@@ -915,29 +907,13 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
 }
 #endif  // KTGF_KIND
 
-// The eleven cell-field arguments the first two entry points begin with, in the order of enum Field, and the
-// float64 parameters after them.
-template <class Binding>
-auto cell_field_args(Binding b) {
-  return std::move(b).template Arg<ffi::AnyBuffer>()  // rho
-      .template Arg<ffi::AnyBuffer>()          // u_x
-      .template Arg<ffi::AnyBuffer>()          // u_y
-      .template Arg<ffi::AnyBuffer>()          // u_z
-      .template Arg<ffi::AnyBuffer>()          // theta
-      .template Arg<ffi::AnyBuffer>()          // p*
-      .template Arg<ffi::AnyBuffer>()          // g
-      .template Arg<ffi::AnyBuffer>()          // eta
-      .template Arg<ffi::AnyBuffer>()          // lambda_b
-      .template Arg<ffi::AnyBuffer>()          // kappa
-      .template Arg<ffi::AnyBuffer>()          // omega
-      .template Arg<ffi::Buffer<ffi::F64>>();  // (dx, dy, dz, rho_s[, a, dt])
-}
-
 }  // namespace
 
 #if KTGF_KIND != KTGF_STAGE
 XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfFluxDivergence, flux_divergence,
-                              cell_field_args(ffi::Ffi::Bind())
+                              ffi::Ffi::Bind()
+                                  .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s)
+                                  .RemainingArgs()               // the cell fields (enum Field)
                                   .Attr<int32_t>("limiter")
                                   .Attr<int32_t>("riemann")
                                   .Attr<int32_t>("viscous")
@@ -951,8 +927,9 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfFluxDivergence, flux_divergence,
 
 #else  // the stage kind
 XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStage, ssprk_stage,
-                              cell_field_args(ffi::Ffi::Bind())  // at Uk
-                                  .RemainingArgs()               // U0 (5), Uk (5), s0, s1
+                              ffi::Ffi::Bind()
+                                  .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s, a, dt)
+                                  .RemainingArgs()               // the cell fields at Uk, U0 (5), Uk (5), s0, s1
                                   .Attr<int32_t>("limiter")
                                   .Attr<int32_t>("riemann")
                                   .Ret<ffi::AnyBuffer>()  // U' density

@@ -203,7 +203,7 @@ def flux_divergence(W: Any, eos: Any, transport: Any, grid: Any, rho_s: Any, lim
     kind = "rhs" if viscous else "euler"
     call = jax.ffi.ffi_call(_target(TARGET, W[0].dtype, limiter, riemann, kind), (field,) * 6 + (work,))
     params = jnp.stack([jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)])
-    out = call(*fields, params, **_schemes(limiter, riemann), viscous=np.int32(viscous))
+    out = call(params, *fields, **_schemes(limiter, riemann), viscous=np.int32(viscous))
     return list(out[:5]), out[5]
 
 
@@ -222,9 +222,9 @@ def ssprk_stage(U0: Any, Uk: Any, W: Any, eos: Any, transport: Any, source: tupl
     # U' is written over Uk (each cell reads its own Uk only, after the fluxes): no new buffers, and
     # none of the loop-carry copies XLA inserts when a stage's output cannot take its input's place.
     call = jax.ffi.ffi_call(_target(STAGE_TARGET, dtype, limiter, riemann, "stage"), (field,) * 5 + (work,),
-                            input_output_aliases={len(fields) + 6 + v: v for v in range(5)})
+                            input_output_aliases={1 + len(fields) + 5 + v: v for v in range(5)})
     params = _stage_params(a, dt, grid, rho_s, dtype)
-    return tuple(call(*fields, params, *state, **_schemes(limiter, riemann))[:5])
+    return tuple(call(params, *fields, *state, **_schemes(limiter, riemann))[:5])
 
 
 def _register(program: Any, limiter: str, riemann: str, grid: Any) -> None:
