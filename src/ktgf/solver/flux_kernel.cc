@@ -25,6 +25,7 @@
 // -DKTGF_LIMITER and -DKTGF_RIEMANN (indices of stencil.LIMITERS, RIEMANN_SOLVERS) and -DKTGF_KIND (below);
 // its handlers refuse (InvalidArgument) a call for another variant.
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -794,12 +795,26 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
   return fits;
 }
 
+// A stage's output (Stage) with params (dx, dy, dz, rho_s, a, dt), U0 and Uk the fields from in[u0], in[uk].
+Stage<Real> stage_output(const double* p, ffi::RemainingArgs in, size_t u0, size_t uk,
+                         std::array<ffi::Result<ffi::AnyBuffer>, 5> out) {
+  Stage<Real> o;
+  for (int v = 0; v < 5; ++v) {
+    o.U0[v] = in.get<ffi::AnyBuffer>(u0 + v)->typed_data<Real>();
+    o.Uk[v] = in.get<ffi::AnyBuffer>(uk + v)->typed_data<Real>();
+    o.U[v] = out[v]->typed_data<Real>();
+  }
+  o.s0 = o.s1 = nullptr;
+  o.a = Real(p[4]);
+  o.b = Real(1) - o.a;  // as the JAX path: 1 - a in the state precision
+  o.dt = Real(p[5]);
+  return o;
+}
+
 ffi::Error ssprk_stage(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int32_t limiter, int32_t riemann,
                        ffi::Result<ffi::AnyBuffer> u0, ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2,
                        ffi::Result<ffi::AnyBuffer> u3, ffi::Result<ffi::AnyBuffer> u4,
                        ffi::Result<ffi::AnyBuffer> work) {
-  void* const out[5] = {u0->untyped_data(), u1->untyped_data(), u2->untyped_data(), u3->untyped_data(),
-                        u4->untyped_data()};
   if (params.element_count() != 6)
     return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
   if (in.size() != NFIELD + 12)
@@ -807,18 +822,10 @@ ffi::Error ssprk_stage(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int3
   ffi::DataType type;
   if (auto err = same_fields(in, NFIELD + 12, type); err.failure()) return err;
   if (auto err = check_variant("KtgfSsprkStage", type, limiter, riemann, true); err.failure()) return err;
-  Stage<Real> o;
-  for (int v = 0; v < 5; ++v) {
-    o.U0[v] = in.get<ffi::AnyBuffer>(NFIELD + v)->typed_data<Real>();
-    o.Uk[v] = in.get<ffi::AnyBuffer>(NFIELD + 5 + v)->typed_data<Real>();
-    o.U[v] = static_cast<Real*>(out[v]);
-  }
   const double* p = params.typed_data();
+  Stage<Real> o = stage_output(p, in, NFIELD, NFIELD + 5, {u0, u1, u2, u3, u4});
   o.s0 = in.get<ffi::AnyBuffer>(NFIELD + 10)->typed_data<Real>();
   o.s1 = in.get<ffi::AnyBuffer>(NFIELD + 11)->typed_data<Real>();
-  o.a = Real(p[4]);
-  o.b = Real(1) - o.a;  // as the JAX path: 1 - a in the state precision
-  o.dt = Real(p[5]);
   return run(in, p, work->typed_data<Real>(), o);
 }
 
@@ -886,18 +893,7 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
   if (ring->element_type() != type || long(ring->element_count()) < ring_elements(n))
     return ffi::Error::InvalidArgument("stage kernel: the ring workspace is smaller than KtgfRingElements");
   const double* par = params.typed_data();
-  Stage<Real> o;
-  Real* const out[5] = {u0->typed_data<Real>(), u1->typed_data<Real>(), u2->typed_data<Real>(),
-                        u3->typed_data<Real>(), u4->typed_data<Real>()};
-  for (int v = 0; v < 5; ++v) {
-    o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<Real>();
-    o.Uk[v] = state.get<ffi::AnyBuffer>(mode == RATE ? v : 5 + v)->typed_data<Real>();
-    o.U[v] = out[v];
-  }
-  o.s0 = o.s1 = nullptr;  // from the ring
-  o.a = Real(par[4]);
-  o.b = Real(1) - o.a;  // as the JAX path: 1 - a in the state precision
-  o.dt = Real(par[5]);
+  Stage<Real> o = stage_output(par, state, 0, mode == RATE ? 0 : 5, {u0, u1, u2, u3, u4});  // s0, s1: the ring's
   o.mode = mode;
   if (!sweep_fused<Real, KTGF_LIMITER, KTGF_RIEMANN>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(),
                                                      consts(n, par), o, ring->typed_data<Real>(),
