@@ -410,6 +410,16 @@ def config_value(d: Any, dotted: str) -> Any:
     return d
 
 
+def changed_fields(a: Any, b: Any, prefix: str = "") -> list[str]:
+    """Dotted names of the leaves that differ between two configuration dicts (sorted)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        out = []
+        for key in sorted(set(a) | set(b)):
+            out += changed_fields(a.get(key), b.get(key), f"{prefix}{key}.")
+        return out
+    return [] if a == b else [prefix.rstrip(".") or "config"]
+
+
 def box_lengths(cfg: Config) -> tuple[float, ...]:
     """Box sides [m] from ``grid.length``, ``grid.length_d`` or ``relative_to``·``factor``."""
     g, d, ndim = cfg.grid, cfg.particles.diameter, len(cfg.grid.cells)
