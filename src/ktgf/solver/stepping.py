@@ -402,12 +402,10 @@ def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
     return ssprk3_step(U, dt, grid, phys, num, t, r0), jnp.zeros((), U[0].dtype)
 
 
-#: CPU time of one IMEX step over one SSP-RK3 step, measured (RET at φ = 0.5 with Δx = ℓ, 32³:
-#: 108 ms against 36 ms with BiCGSTAB; 143–165 against 35–37 ms with the earlier GMRES).
+#: CPU time of one IMEX step over one SSP-RK3 step, measured (RET at φ = 0.5 with Δx = ℓ, 32³: 108 against 36 ms).
 IMEX_COST = 3.0
-#: The same where SSP-RK3 runs as the fused loop of cell-program kernel calls (:func:`start_program`: CPU, one
-#: device, a 3D periodic grid), measured at stop 27 (RET, φ = 0.5, Δx = ℓ, float64, steady state, ms of CPU per
-#: step): 7.6 against 0.8 at 16³, 50.5 against 5.9 at 32³, 430.8 against 46.9 at 64³ (9.5, 8.6, 9.2×).
+#: The same where SSP-RK3 runs as the fused loop of cell-program kernel calls (:func:`start_program`), measured
+#: likewise in float64 at the steady state: 9.5, 8.6, 9.2× at 16³, 32³, 64³ (430.8 against 46.9 ms at 64³).
 IMEX_COST_FUSED = 9.0
 
 
