@@ -464,9 +464,7 @@ void sweep(const T* const* P, const Consts<T>& k, const Out& o) {
 #if !defined(KTGF_REAL) || !defined(KTGF_LIMITER) || !defined(KTGF_RIEMANN) || !defined(KTGF_KIND)
 #error "build with -DKTGF_REAL=double|float -DKTGF_LIMITER=0..3 -DKTGF_RIEMANN=0..1 -DKTGF_KIND=0..2 (flux_kernel.py)"
 #endif
-#if KTGF_KIND != KTGF_RHS && KTGF_KIND != KTGF_EULER && KTGF_KIND != KTGF_STAGE
-#error "KTGF_KIND must be KTGF_RHS, KTGF_EULER or KTGF_STAGE"
-#endif
+static_assert(KTGF_KIND == KTGF_RHS || KTGF_KIND == KTGF_EULER || KTGF_KIND == KTGF_STAGE, "KTGF_KIND: 0..2");
 using Real = KTGF_REAL;
 static_assert(std::is_same<Real, double>::value || std::is_same<Real, float>::value, "KTGF_REAL: double or float");
 static_assert(KTGF_LIMITER >= MINMOD && KTGF_LIMITER <= NONE, "KTGF_LIMITER: an index of fluxes.LIMITERS");
