@@ -1,14 +1,10 @@
 """The cell closures of the fused SSP-RK3 stage as compiled C++, generated from the Python physics.
 
-Why: a stage of the fused kernel (:func:`.flux_kernel.ssprk_stage`) needed an XLA pass first, to
-evaluate the closures at every cell and write 13 fields (primitive fields, (p*, g), (η, λ_b, κ, ω),
-the energy source (s0, s1)), which the kernel then read back and padded: ≈ 15 ns a cell of XLA and
-≈ 4 ns of padding per stage, a third of the stage (docs/solver.md at cef4049, Speed).  Here the same function —
-:func:`.stepping.kernel_stage_inputs` of the model's :meth:`.Physics.reduced`, nothing rewritten — is
-traced once with scalar inputs, and its jaxpr (elementwise arithmetic only) is printed as a C++ loop
-over a row of cells.  The kernel calls it row by row as its sweep goes (each thread keeps the few planes
-the stencil reaches), so a stage reads the five conservative fields and never writes the coefficients
-to memory, with no XLA closure pass at all.
+:func:`.cell_terms.kernel_stage_inputs` of the model's :meth:`.Physics.reduced` — nothing rewritten — is
+traced once with scalar inputs, and its jaxpr (elementwise arithmetic only) is printed as a C++ loop over a
+row of cells, which :func:`.flux_kernel.ssprk_stage_cells` calls as its sweep goes: a stage reads the five
+conservative fields and writes none of the 13 cell fields to memory (an XLA pass writing them, read back and
+padded by the kernel, was a third of the stage).
 
 Physics stays in one place: the generated code is the jaxpr of the Python closures, operation for
 operation in the same precision (each jaxpr variable keeps its dtype; ``integer_pow`` is expanded as

@@ -14,7 +14,7 @@ import math
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, ValidationInfo, field_validator, model_validator
 
 from ..closures import get_model
 from ..couette.config import WallsConfig
@@ -120,18 +120,12 @@ class NumericsSection(_Section):
     sink: Literal["explicit", "implicit"] = Field(
         "explicit", description="IMEX: collisional sink explicit (step <= cfl_source/zeta0) or implicit (no such limit)")
 
-    @field_validator("limiter")
+    @field_validator("limiter", "riemann")
     @classmethod
-    def _lim(cls, v: str) -> str:
-        if v not in LIMITERS:
-            raise ValueError(f"limiter {v!r} is not valid: choose one of {', '.join(LIMITERS)}")
-        return v
-
-    @field_validator("riemann")
-    @classmethod
-    def _riem(cls, v: str) -> str:
-        if v not in RIEMANN_SOLVERS:
-            raise ValueError(f"riemann {v!r} is not valid: choose one of {', '.join(RIEMANN_SOLVERS)}")
+    def _scheme(cls, v: str, info: ValidationInfo) -> str:
+        valid = LIMITERS if info.field_name == "limiter" else RIEMANN_SOLVERS
+        if v not in valid:
+            raise ValueError(f"{info.field_name} {v!r} is not valid: choose one of {', '.join(valid)}")
         return v
 
 
@@ -411,6 +405,16 @@ def config_value(d: Any, dotted: str) -> Any:
     for key in dotted.split("."):
         d = d.get(key) if isinstance(d, dict) else None
     return d
+
+
+def changed_fields(a: Any, b: Any, prefix: str = "") -> list[str]:
+    """Dotted names of the leaves that differ between two configuration dicts (sorted)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        out = []
+        for key in sorted(set(a) | set(b)):
+            out += changed_fields(a.get(key), b.get(key), f"{prefix}{key}.")
+        return out
+    return [] if a == b else [prefix.rstrip(".") or "config"]
 
 
 def box_lengths(cfg: Config) -> tuple[float, ...]:

@@ -90,8 +90,7 @@ def _velocity_pad(W: Any, transport: Any, grid: Grid, phys: Physics, t: Any) -> 
 def stress_tensor(U: Any, t: Any, grid: Grid, phys: Physics) -> Any:
     """Box average of P = pI − τ [Pa], as (xx, yy, zz, xy, xz, yz) (module docstring)."""
     W = primitive_fields(tuple(U))
-    rho, u, theta = W[0], W[1:4], W[4]
-
+    rho, theta = W[0], W[4]
     r = cell_coefficients(W, grid, phys, t)  # with a frictional stress: p_f and μ_f too
     p = phys.pressure(rho, theta, r)
     transport = phys.transport(rho, theta, r)

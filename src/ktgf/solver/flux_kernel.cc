@@ -1,51 +1,31 @@
 // CPU fast path of ktgf.solver.fluxes.flux_divergence on a fully periodic 3D grid (numerics only).
 //
-// Same formulas, in the same operation order, as the JAX functions of fluxes.py (reconstruct,
-// riemann_flux, stress, heat_flux, stress_work, face_divergence, cell_divergence) except that the
-// face divergence multiplies by 1/dx where the JAX path divides by dx (one rounding apart): the
-// JAX path is the reference, this kernel is checked against it to round-off
-// (tests/solver/test_solver_flux_kernel.py).
-// Why a kernel: XLA recomputes every face state and wave speed inside each of the five flux
-// components of an axis (docs/solver.md, Speed); here each face is computed once, from cells
-// that sit in cache, and its flux goes to the two cells it separates.
+// Same formulas, in the same operation order, as the JAX functions of fluxes.py, except that the face
+// divergence multiplies by 1/dx where JAX divides (one rounding apart); the JAX path is the reference
+// (tests/solver/test_solver_flux_kernel.py).  Each face is computed once, from cells in cache, where XLA
+// recomputes the face states in each of the five flux components (docs/solver.md, Speed).
 //
-// The entry points share the face sweep:
-// * KtgfFluxDivergence: inputs the cell fields (rho, u_x, u_y, u_z, theta, p*, g, eta, lambda_b,
-//   kappa, omega), each of shape (n0, n1, n2), C order, and float64 (dx, dy, dz, material density);
-//   outputs -div F of the five conservative fields and the central div u.
-// * KtgfSsprkStage: one whole SSP-RK3 stage (stepping.ssprk3_step), U' = a U0 + (1 - a)(Uk + dt L)
-//   with L = -div F plus the energy source s0 + s1 div u; inputs the same cell fields at Uk, then
-//   U0 and Uk (5 conservative fields each), s0, s1, and float64 (dx, dy, dz, rho_s, a, dt).  The
-//   source is linear in div u by construction (the cooling rate zeta0 + zeta_U div u, model.md §1);
-//   its two coefficient fields come from the Python physics, so no closure is written here.
-// * KtgfSsprkStageCells: the same stage with the cell fields and the source computed here, from Uk, by a
-//   cell program (ktgf.solver.cell_program: C++ generated from the jaxpr of the Python closures, in its
-//   own library, registered by key with KtgfRegisterCells); inputs float64 (dx, dy, dz, rho_s, a, dt),
-//   the program's float64 parameters, U0 and Uk; attribute `program` the key.  The closures are
-//   evaluated plane by plane as the sweep goes (sweep_fused), into a small ring of planes per thread, so
-//   the cell fields never go to memory (measured 1.3x faster per stage at 64^3 than a padding pass that
-//   wrote them all, then a sweep that read them back; bit-identical output).  Attribute `mode`: the
-//   stage update; or (a step's first stage, before its dt is known) the rate L = -div F + source, written
-//   with the maxima of the step-limit and state-check terms of a step-start program, from which XLA
-//   computes dt; or the second stage from that rate, with Uk = U0 + dt L0 computed as it is read.
-// * KtgfCellLimits: the maxima over the cells of the step-limit terms of a step-start cell program (the
-//   closures and the terms) alone: the check of a chunk's last state.
-// KtgfFluxDivergence and KtgfSsprkStage output a workspace holding their input fields with two periodic
-// ghost cells per side, KtgfSsprkStageCells its ring (outputs, so that XLA owns and reuses the memory).
-// The padded fields are swept in blocks of ROW_BLOCK rows along the second axis so that the five planes
-// of a block that a stencil reaches stay in the core's L2 cache (measured 1.3x faster at 64^3 than whole
-// planes); each cell's MUSCL slope along an axis is kept for the second face it serves (measured 1.1x
-// faster single-threaded at 64^3, bit-identical output).  Reading the unpadded fields with periodic index
-// arithmetic instead of the padded copy was tried and measured 1.9x slower.
+// Entry points (they share the face sweep):
+// * KtgfFluxDivergence: float64 (dx, dy, dz, rho_s), then the cell fields (enum Field, each (n0, n1, n2),
+//   C order) -> -div F of the five conservative fields and the central div u.
+// * KtgfSsprkStage: one SSP-RK3 stage U' = a U0 + (1 - a)(Uk + dt L), L = -div F + s0 + s1 div u (the
+//   cooling rate is linear in div u, model.md §1); inputs float64 (dx, dy, dz, rho_s, a, dt), then the cell
+//   fields at Uk, U0, Uk, s0, s1.
+// * KtgfSsprkStageCells: the same stage with the cell fields and source computed from Uk by a cell program
+//   (ktgf.solver.cell_program, registered by key with KtgfRegisterCells) plane by plane as the sweep goes
+//   (sweep_fused), so they never go to memory (1.3x faster per stage at 64^3 than writing them first).
+//   `mode` (StageMode): the update; the rate L with the maxima of a step-start program's limit terms;
+//   or the second stage from that rate.
+// * KtgfCellLimits: those maxima alone (the check of a chunk's last state).
+// The padded fields (two periodic ghost cells per side) are swept in blocks of ROW_BLOCK rows so that the
+// five planes a stencil reaches stay in L2 (1.3x faster at 64^3 than whole planes); each cell's MUSCL
+// slope along an axis is kept for its second face.
 //
-// Build: one library per variant (flux_kernel.py, Variant), selected by macros: the precision
-// (-DKTGF_REAL=double|float), the limiter and the Riemann solver (-DKTGF_LIMITER, -DKTGF_RIEMANN: indices of
-// fluxes.LIMITERS and fluxes.RIEMANN_SOLVERS), the kind (-DKTGF_KIND): KTGF_RHS and KTGF_EULER hold
-// KtgfFluxDivergence with and without the viscous fluxes, KTGF_STAGE the four stage entries and
-// KtgfRegisterCells (its own registry of cell programs).  Each library instantiates the sweep once, so a build
-// takes seconds, not the minutes of all variants at once; its handlers refuse (InvalidArgument) a call that asks
-// for another precision, limiter, Riemann solver or viscous flag than the library's.
+// Build: one library per variant (flux_kernel.py, Variant), selected by -DKTGF_REAL=double|float,
+// -DKTGF_LIMITER and -DKTGF_RIEMANN (indices of stencil.LIMITERS, RIEMANN_SOLVERS) and -DKTGF_KIND (below);
+// its handlers refuse (InvalidArgument) a call for another variant.
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -102,16 +82,8 @@ struct Consts {
   T omega_factor[3];  // (1/dx_a)/rho_s
 };
 
-// Cells per row of the grid of k, and the row stride of its padded fields and planes (GHOST cells per side).
-template <class T>
-KTGF_INLINE long row_cells(const Consts<T>& k) { return k.n[2]; }
-template <class T>
-KTGF_INLINE long row_stride(const Consts<T>& k) { return k.stride[1]; }
-
-// Planes: the sweeps read the cell fields plane by plane, through a table of three planes around the row's
-// plane i: P[(d0 + 1) * NFIELD + f] is field f of plane i + d0 (d0 = -1, 0, 1), a padded plane with row stride
-// s1, so that the planes can sit in one padded array (sweep) or in a ring of planes (sweep_fused).
-// The value of field f at the cell (i + d0, j + d1, q + d2), the cell (i, j, q) at offset c of its plane.
+// Field f at the cell (i + d0, j + d1, q + d2) of the cell (i, j, q) at offset c of its plane, through a table of
+// planes: P[(d0 + 1) * NFIELD + f] is field f of plane i + d0, padded with row stride s1 (sweep or sweep_fused).
 template <class T>
 struct Stencil {
   const T* const* P;
@@ -124,7 +96,7 @@ struct Stencil {
 template <class T, int A, int LIM>
 KTGF_INLINE void row_slopes(const T* const* P, long c0, const Consts<T>& k, T* out, long ld, long from, long to) {
   constexpr int e0 = A == 0, e1 = A == 1, e2 = A == 2;
-  const long s1 = row_stride(k);
+  const long s1 = k.stride[1];
   #pragma GCC unroll 8
   for (int f = 0; f < 7; ++f) {
     T* o = out + f * ld;
@@ -232,9 +204,8 @@ struct Rhs {
   T* dU[5];
   T* divu;
 };
-// What a stage writes (Stage::mode): U' = a U0 + b (Uk + dt L); L itself (a step's first stage, whose dt is
-// not known yet: the step size comes from the limit terms this stage reduces); or U' with Uk = U0 + dt L0 (the
-// second stage, from the first one's L0: Uk is the first stage's U' = 0 U0 + 1 (U0 + dt L0), computed again).
+// What a stage writes (Stage::mode): U' = a U0 + b (Uk + dt L); L (a step's first stage, before dt is known);
+// or U' with Uk = U0 + dt L0 (the second stage, from the first one's rate L0).
 enum StageMode { UPDATE = 0, RATE = 1, FROM_RATE = 2 };
 template <class T>
 struct Stage {
@@ -252,7 +223,7 @@ struct Stage {
 template <class T, int A, int RIE, bool VISC>
 KTGF_INLINE void row_faces(const T* const* P, long c0, const Consts<T>& k, const T* hl, const T* hr, long lh, T* out,
                            long ld, long from = 0) {
-  const long n2 = row_cells(k), s1 = row_stride(k);
+  const long n2 = k.n[2], s1 = k.stride[1];
 #pragma omp simd
   for (long q = from; q < n2; ++q)
     face_flux<T, A, RIE, VISC>(Stencil<T>{P, c0 + q, s1}, hl + q, hr + q, lh, k, out + q, ld);
@@ -261,7 +232,7 @@ KTGF_INLINE void row_faces(const T* const* P, long c0, const Consts<T>& k, const
 // Central div u of the row's cells.
 template <class T>
 KTGF_INLINE void row_divu(const T* const* P, long c0, const Consts<T>& k, T* dv) {
-  const long n2 = row_cells(k), s1 = row_stride(k);
+  const long n2 = k.n[2], s1 = k.stride[1];
 #pragma omp simd
   for (long q = 0; q < n2; ++q) {
     const Stencil<T> X{P, c0 + q, s1};
@@ -305,7 +276,7 @@ template <class T>
 KTGF_INLINE void write_row(const Rhs<T>& o, const T* const* P, long c0, long out, const Consts<T>& k,
                            const T* const* lo, const T* const* hi, const T* z, long zld, T* /*scratch*/,
                            const T* /*s0*/, const T* /*s1*/) {
-  const long n2 = row_cells(k);
+  const long n2 = k.n[2];
   for (int v = 0; v < 5; ++v) {
     T* d = o.dU[v] + out;
     const T* zv = z + v * zld;
@@ -319,7 +290,7 @@ KTGF_INLINE void write_row(const Rhs<T>& o, const T* const* P, long c0, long out
 template <class T, int MODE, bool SRC>
 KTGF_INLINE void stage_row(const Stage<T>& o, int v, long out, const Consts<T>& k, const T* lo, const T* hi,
                            const T* ylo, const T* yhi, const T* zv, const T* divu, const T* s0, const T* s1) {
-  const long n2 = row_cells(k);
+  const long n2 = k.n[2];
   const T* u0 = o.U0[v] + out;
   const T* uk = o.Uk[v] + out;
   T* d = o.U[v] + out;
@@ -365,14 +336,12 @@ KTGF_INLINE void source_rows(const Stage<T>& o, long out, const T** s) {
 
 constexpr long ROW_BLOCK = 16;
 
-// The per-thread buffers of a sweep over rows of n2 cells with B rows in flight: the lower x faces and
-// the x half slopes of B rows (kept from the previous plane), the y ones of one row (kept from the
-// previous row), the z ones of a row, and the row's div u.
+// The per-thread buffers of a sweep over rows of n2 cells with B rows in flight: the faces and half slopes
+// along x of B rows on the plane being swept (xlo, hx) and the next (xhi, hxn), which trade places after each
+// plane; along y of a row and the next (ylo/hya, yhi/hyb), which trade after each row; along z of a row; div u.
 template <class T>
 struct RowBuffers {
   long B, n2;
-  // x: the faces and half slopes of B rows on the plane being swept (lo, hx) and on the next one (hi, hxn),
-  // which trade places after each plane; y: those of a row, which trade places after each row.
   std::vector<T> xlo, xhi, ylo, yhi, zf, divu, hx, hxn, hya, hyb, hz;
   RowBuffers(long B_, long n2_)
       : B(B_), n2(n2_), xlo(5 * B_ * n2_), xhi(5 * B_ * n2_), ylo(5 * n2_), yhi(5 * n2_), zf(5 * (n2_ + 1)),
@@ -384,7 +353,7 @@ struct RowBuffers {
 template <class T, int LIM, int RIE, bool VISC, class Row>
 KTGF_INLINE void start_block(const T* const* Pm, const T* const* P0, long nb, Row row, const Consts<T>& k,
                              RowBuffers<T>& r) {
-  const long n2 = row_cells(k);
+  const long n2 = k.n[2];
   for (long b = 0; b < nb; ++b) {
     row_slopes<T, 0, LIM>(Pm, row(b), k, r.hxn.data() + b * 7 * n2, n2, 0, n2);
     row_slopes<T, 0, LIM>(P0, row(b), k, r.hx.data() + b * 7 * n2, n2, 0, n2);
@@ -399,7 +368,7 @@ KTGF_INLINE void start_block(const T* const* Pm, const T* const* P0, long nb, Ro
 template <class T, int LIM, int RIE, bool VISC, class Out, class Row, class OutRow, class Src>
 KTGF_INLINE void sweep_rows(const T* const* P0, const T* const* P1, long nb, Row row, OutRow out, Src src,
                             const Consts<T>& k, const Out& o, RowBuffers<T>& r) {
-  const long n2 = row_cells(k), B = r.B;
+  const long n2 = k.n[2], B = r.B;
   T* hy = r.hya.data();
   T* hyn = r.hyb.data();
   T* ylo = r.ylo.data();
@@ -452,14 +421,11 @@ KTGF_INLINE void plane_table(const T* const* P, int nfield, long s0, long p, con
 }
 
 // Sweep of padded fields (all planes in memory, `P` the NFIELD fields, or GG + 1 without the transport).
-// Each thread owns a block of planes i and sweeps them row block by row block, rows (i, j) in
-// order, keeping the fluxes of the lower x faces (a plane block) and y faces (a row) from the
-// previous plane/row, so every face is computed once (plus one x plane and one y row per block),
-// and likewise the half slopes of the cells below (x: a plane block, y: a row), so every cell's
-// slope along each axis is computed once.
+// Each thread owns a block of planes and sweeps them row block by row block, keeping the lower x and y faces
+// and half slopes from the previous plane and row, so each is computed once (plus one plane and row per block).
 template <class T, int LIM, int RIE, bool VISC, class Out>
 void sweep(const T* const* P, const Consts<T>& k, const Out& o) {
-  const long n0 = k.n[0], n1 = k.n[1], n2 = row_cells(k), s0 = k.stride[0], s1 = row_stride(k);
+  const long n0 = k.n[0], n1 = k.n[1], n2 = k.n[2], s0 = k.stride[0], s1 = k.stride[1];
   const int nfield = VISC ? NFIELD : GG + 1;
 #pragma omp parallel
   {
@@ -491,18 +457,14 @@ void sweep(const T* const* P, const Consts<T>& k, const Out& o) {
   }
 }
 
-// The variant this library is built for, from the -D macros of flux_kernel.py (one library per variant, built
-// when first needed): it instantiates `sweep` once, which is most of what a build costs (7-15 s here; the
-// 64 instantiations of the library of all variants took 6 minutes).
+// The kind of library (flux_kernel.py, KINDS); each instantiates `sweep` once, most of a build's 7-15 s.
 #define KTGF_RHS 0    // KtgfFluxDivergence with the viscous fluxes
 #define KTGF_EULER 1  // KtgfFluxDivergence without them
 #define KTGF_STAGE 2  // KtgfSsprkStage, KtgfSsprkStageCells, KtgfCellLimits, KtgfRegisterCells, KtgfRingElements
 #if !defined(KTGF_REAL) || !defined(KTGF_LIMITER) || !defined(KTGF_RIEMANN) || !defined(KTGF_KIND)
 #error "build with -DKTGF_REAL=double|float -DKTGF_LIMITER=0..3 -DKTGF_RIEMANN=0..1 -DKTGF_KIND=0..2 (flux_kernel.py)"
 #endif
-#if KTGF_KIND != KTGF_RHS && KTGF_KIND != KTGF_EULER && KTGF_KIND != KTGF_STAGE
-#error "KTGF_KIND must be KTGF_RHS, KTGF_EULER or KTGF_STAGE"
-#endif
+static_assert(KTGF_KIND == KTGF_RHS || KTGF_KIND == KTGF_EULER || KTGF_KIND == KTGF_STAGE, "KTGF_KIND: 0..2");
 using Real = KTGF_REAL;
 static_assert(std::is_same<Real, double>::value || std::is_same<Real, float>::value, "KTGF_REAL: double or float");
 static_assert(KTGF_LIMITER >= MINMOD && KTGF_LIMITER <= NONE, "KTGF_LIMITER: an index of fluxes.LIMITERS");
@@ -519,8 +481,7 @@ std::string variant_name(ffi::DataType type, int limiter, int riemann, bool visc
   return std::string(precision) + " " + lim + "/" + rie + (viscous ? " viscous" : " inviscid");
 }
 
-// Success if a call of `entry` asks for the variant this library computes, else the error that says both: a
-// library never computes another variant than the one it was built for.
+// Success if a call of `entry` asks for the variant this library computes, else the error that says both.
 ffi::Error check_variant(const char* entry, ffi::DataType type, int limiter, int riemann, bool viscous) {
   if (type == BUILT_TYPE && limiter == KTGF_LIMITER && riemann == KTGF_RIEMANN && viscous == BUILT_VISCOUS)
     return ffi::Error::Success();
@@ -555,37 +516,54 @@ void sweep_padded(const long* n, const double* params, const Real* work, const O
   sweep<Real, KTGF_LIMITER, KTGF_RIEMANN, BUILT_VISCOUS>(P.data(), k, o);
 }
 
-// Pads the cell fields into `work` and sweeps them with the output `o` (Rhs or Stage).
-template <class Out>
-ffi::Error run(const ffi::AnyBuffer* in, const double* params, Real* work, const Out& o) {
-  auto dims = in[0].dimensions();
+// The grid shape of a 3D cell field, or an error.
+ffi::Error grid_shape(const ffi::AnyBuffer& field, long* n) {
+  auto dims = field.dimensions();
   if (dims.size() != 3) return ffi::Error::InvalidArgument("flux kernel: fields must be 3D");
-  long n[3];
   for (int a = 0; a < 3; ++a) n[a] = long(dims[a]);
   if (n[0] < GHOST || n[1] < GHOST || n[2] < GHOST)
     return ffi::Error::InvalidArgument("flux kernel: at least 2 cells per axis");
+  return ffi::Error::Success();
+}
+
+// Checks that the first `count` RemainingArgs are cell fields of one precision and shape; their type in `type`.
+ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& type) {
+  if (state.size() < count) return ffi::Error::InvalidArgument("flux kernel: too few fields");
+  auto first = state.get<ffi::AnyBuffer>(0);
+  if (!first.has_value()) return ffi::Error::InvalidArgument("flux kernel: no fields");
+  type = first->element_type();
+  for (size_t i = 0; i < count; ++i) {
+    auto b = state.get<ffi::AnyBuffer>(i);
+    if (!b.has_value() || b->element_type() != type || b->element_count() != first->element_count())
+      return ffi::Error::InvalidArgument("flux kernel: the fields must be cell fields of one precision");
+  }
+  return ffi::Error::Success();
+}
+
+// Pads the cell fields (the first NFIELD of `in`) into `work` and sweeps them with the output `o` (Rhs or Stage).
+template <class Out>
+ffi::Error run(ffi::RemainingArgs in, const double* params, Real* work, const Out& o) {
+  long n[3];
+  if (auto err = grid_shape(*in.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
   const int nfield = BUILT_VISCOUS ? NFIELD : GG + 1;
   std::vector<const Real*> fields(NFIELD, nullptr);
-  for (int f = 0; f < nfield; ++f) fields[f] = in[f].typed_data<Real>();
+  for (int f = 0; f < nfield; ++f) fields[f] = in.get<ffi::AnyBuffer>(f)->typed_data<Real>();
   pad<Real>(fields.data(), nfield, n, work);
   sweep_padded(n, params, work, o);
   return ffi::Error::Success();
 }
 
 #if KTGF_KIND != KTGF_STAGE
-ffi::Error flux_divergence(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer uy, ffi::AnyBuffer uz,
-                           ffi::AnyBuffer theta, ffi::AnyBuffer pstar, ffi::AnyBuffer g, ffi::AnyBuffer eta,
-                           ffi::AnyBuffer lam, ffi::AnyBuffer kap, ffi::AnyBuffer omega,
-                           ffi::Buffer<ffi::F64> params, int32_t limiter,
-                           int32_t riemann, int32_t viscous, ffi::Result<ffi::AnyBuffer> d0,
-                           ffi::Result<ffi::AnyBuffer> d1, ffi::Result<ffi::AnyBuffer> d2,
-                           ffi::Result<ffi::AnyBuffer> d3, ffi::Result<ffi::AnyBuffer> d4,
-                           ffi::Result<ffi::AnyBuffer> divu, ffi::Result<ffi::AnyBuffer> work) {
-  const ffi::AnyBuffer in[NFIELD] = {rho, ux, uy, uz, theta, pstar, g, eta, lam, kap, omega};
+ffi::Error flux_divergence(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int32_t limiter, int32_t riemann,
+                           int32_t viscous, ffi::Result<ffi::AnyBuffer> d0, ffi::Result<ffi::AnyBuffer> d1,
+                           ffi::Result<ffi::AnyBuffer> d2, ffi::Result<ffi::AnyBuffer> d3,
+                           ffi::Result<ffi::AnyBuffer> d4, ffi::Result<ffi::AnyBuffer> divu,
+                           ffi::Result<ffi::AnyBuffer> work) {
   if (params.element_count() != 4) return ffi::Error::InvalidArgument("flux kernel: params = (dx, dy, dz, rho_s)");
-  if (auto err = check_variant("KtgfFluxDivergence", rho.element_type(), limiter, riemann, viscous != 0);
-      err.failure())
-    return err;
+  if (in.size() != NFIELD) return ffi::Error::InvalidArgument("flux kernel: fields = the 11 cell fields");
+  ffi::DataType type;
+  if (auto err = same_fields(in, NFIELD, type); err.failure()) return err;
+  if (auto err = check_variant("KtgfFluxDivergence", type, limiter, riemann, viscous != 0); err.failure()) return err;
   const Rhs<Real> o{{d0->typed_data<Real>(), d1->typed_data<Real>(), d2->typed_data<Real>(), d3->typed_data<Real>(),
                      d4->typed_data<Real>()},
                     divu->typed_data<Real>()};
@@ -626,9 +604,8 @@ KTGF_INLINE void row_maxima(T* const* t, long n, int nlim, T* local) {
   }
 }
 
-// The maxima over the cells of the `nlim` limit terms of a step-start cell program fn on the state U (its
-// cell fields and source go to a row scratch and are dropped): the step limits' closures and reductions in
-// one pass that writes nothing per cell.  A NaN term wins, as in jnp.max.
+// The maxima over the cells of the `nlim` limit terms of a step-start cell program fn on the state U, in one
+// pass that writes nothing per cell (the cell fields go to a row scratch).  A NaN term wins, as in jnp.max.
 template <class T>
 void cell_limits(CellsFn<T> fn, const double* leaf, const T* const* U, const long* n, int nlim, T* maxima) {
   for (int k = 0; k < nlim; ++k) maxima[k] = -std::numeric_limits<T>::infinity();
@@ -694,10 +671,8 @@ inline void spin_hint() {
 #endif
 }
 
-// Waits until the neighbours of thread t (of nt; the threads whose ghost rows are t's rows) have computed the
-// cell fields of plane p.  A spin, not an OpenMP barrier: the kernel's threads are all running, the wait is
-// short (they do the same work), and a sleeping wait under OMP_WAIT_POLICY=PASSIVE costs a wake-up each
-// time (measured: 18 % of a 64^3 step idle with a barrier per plane).
+// Waits until the neighbours of thread t (of nt; whose ghost rows are t's rows) have computed the cell fields of
+// plane p.  A spin: the wait is short, and a barrier per plane left 18 % of a 64^3 step idle (PASSIVE wake-ups).
 inline void wait_for(const Progress* progress, int t, int nt, long p) {
   for (int d : {-1, 1}) {
     const int u = (t + d + nt) % nt;
@@ -708,24 +683,19 @@ inline void wait_for(const Progress* progress, int t, int nt, long p) {
   }
 }
 
-// One SSP-RK3 stage whose cell fields the cell program fn (parameters leaf) computes from Uk as the sweep
-// goes, so that they never go to memory: thread t owns rows [jlo, jhi) of every plane and keeps planes
-// i - 1 .. i + 2 of its rows and GHOST rows per side in its ring (a slice of `ring` of `capacity` elements);
-// before it sweeps plane i it computes plane i + 2 into the slot of plane i - 2.  The closures are evaluated
-// once per cell, plus the ghost rows (2 GHOST / (n1 / threads) more) and the first planes.  U' may be written
-// over Uk: a thread reads Uk of plane p for the closures (at step p - 2) and the update (step p) before it
-// writes U' of plane p, and it writes plane p only once its neighbours, whose ghost rows are its rows, have
-// computed plane p (wait_for; only then: a stage that writes elsewhere runs its threads unsynchronised); planes
-// 0 and 1, needed again at the end, are kept in their own slots.  U' may instead be written over U0, which is
-// read only at the cell being written (except by FROM_RATE's closures, which then wait too).  o.mode
-// (StageMode) says what is written; FROM_RATE rows of Uk are computed from U0 and L0 as they are read.
-// nlim > 0 (a step-start program fn): the maxima of its nlim limit terms over the cells also go to `maxima`,
-// each thread reducing the rows it evaluates (its ghost rows too: a maximum taken twice is the same).
+// One SSP-RK3 stage whose cell fields the cell program fn (parameters leaf) computes from Uk as the sweep goes:
+// thread t owns rows [jlo, jhi) of every plane and keeps planes i - 1 .. i + 2 of them, with GHOST rows per
+// side, in its ring (a slice of `ring_all`); before it sweeps plane i it computes plane i + 2 into the slot of
+// plane i - 2 (planes 0 and 1, needed again at the end, keep their own slots).  U' may be written over Uk: a
+// thread reads Uk of plane p before it writes U' of plane p, and then only once its neighbours have computed
+// plane p (wait_for); or over U0, read only at the cell being written (but by FROM_RATE's closures, which wait
+// too).  FROM_RATE rows of Uk are computed from U0 and L0 as they are read.  nlim > 0: the maxima of the
+// program's nlim limit terms also go to `maxima` (ghost rows too: a maximum taken twice is the same).
 // Returns false (nothing computed) if the threads' rings do not fit in `capacity`.
 template <class T, int LIM, int RIE>
 bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const Stage<T>& o, T* ring_all,
                  long capacity, int nlim = 0, T* maxima = nullptr) {
-  const long n0 = kg.n[0], n1 = kg.n[1], n2 = row_cells(kg), m2 = row_stride(kg);
+  const long n0 = kg.n[0], n1 = kg.n[1], n2 = kg.n[2], m2 = kg.stride[1];
   bool fits = true;
   for (int q = 0; q < nlim; ++q) maxima[q] = -std::numeric_limits<T>::infinity();
   const int threads = fused_threads(kg.n);
@@ -823,47 +793,38 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
   return fits;
 }
 
-ffi::Error ssprk_stage(ffi::AnyBuffer rho, ffi::AnyBuffer ux, ffi::AnyBuffer uy, ffi::AnyBuffer uz,
-                       ffi::AnyBuffer theta, ffi::AnyBuffer pstar, ffi::AnyBuffer g, ffi::AnyBuffer eta,
-                       ffi::AnyBuffer lam, ffi::AnyBuffer kap, ffi::AnyBuffer omega, ffi::Buffer<ffi::F64> params,
-                       ffi::RemainingArgs state, int32_t limiter, int32_t riemann, ffi::Result<ffi::AnyBuffer> u0,
-                       ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2, ffi::Result<ffi::AnyBuffer> u3,
-                       ffi::Result<ffi::AnyBuffer> u4, ffi::Result<ffi::AnyBuffer> work) {
-  const ffi::AnyBuffer in[NFIELD] = {rho, ux, uy, uz, theta, pstar, g, eta, lam, kap, omega};
-  void* const out[5] = {u0->untyped_data(), u1->untyped_data(), u2->untyped_data(), u3->untyped_data(),
-                        u4->untyped_data()};
-  if (params.element_count() != 6)
-    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
-  if (state.size() != 12) return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5, s0, s1)");
-  for (size_t i = 0; i < state.size(); ++i) {
-    auto b = state.get<ffi::AnyBuffer>(i);
-    if (!b.has_value() || b->element_type() != rho.element_type() || b->element_count() != rho.element_count())
-      return ffi::Error::InvalidArgument("stage kernel: U0, Uk, s0, s1 must be cell fields of the state precision");
-  }
-  if (auto err = check_variant("KtgfSsprkStage", rho.element_type(), limiter, riemann, true); err.failure()) return err;
+// A stage's output (Stage) with params (dx, dy, dz, rho_s, a, dt), U0 and Uk the fields from in[u0], in[uk].
+Stage<Real> stage_output(const double* p, ffi::RemainingArgs in, size_t u0, size_t uk,
+                         std::array<ffi::Result<ffi::AnyBuffer>, 5> out) {
   Stage<Real> o;
   for (int v = 0; v < 5; ++v) {
-    o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<Real>();
-    o.Uk[v] = state.get<ffi::AnyBuffer>(5 + v)->typed_data<Real>();
-    o.U[v] = static_cast<Real*>(out[v]);
+    o.U0[v] = in.get<ffi::AnyBuffer>(u0 + v)->typed_data<Real>();
+    o.Uk[v] = in.get<ffi::AnyBuffer>(uk + v)->typed_data<Real>();
+    o.U[v] = out[v]->typed_data<Real>();
   }
-  const double* p = params.typed_data();
-  o.s0 = state.get<ffi::AnyBuffer>(10)->typed_data<Real>();
-  o.s1 = state.get<ffi::AnyBuffer>(11)->typed_data<Real>();
+  o.s0 = o.s1 = nullptr;
   o.a = Real(p[4]);
   o.b = Real(1) - o.a;  // as the JAX path: 1 - a in the state precision
   o.dt = Real(p[5]);
-  return run(in, p, work->typed_data<Real>(), o);
+  return o;
 }
 
-// The grid shape of a 3D cell field, or an error.
-ffi::Error grid_shape(const ffi::AnyBuffer& field, long* n) {
-  auto dims = field.dimensions();
-  if (dims.size() != 3) return ffi::Error::InvalidArgument("stage kernel: fields must be 3D");
-  for (int a = 0; a < 3; ++a) n[a] = long(dims[a]);
-  if (n[0] < GHOST || n[1] < GHOST || n[2] < GHOST)
-    return ffi::Error::InvalidArgument("stage kernel: at least 2 cells per axis");
-  return ffi::Error::Success();
+ffi::Error ssprk_stage(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int32_t limiter, int32_t riemann,
+                       ffi::Result<ffi::AnyBuffer> u0, ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2,
+                       ffi::Result<ffi::AnyBuffer> u3, ffi::Result<ffi::AnyBuffer> u4,
+                       ffi::Result<ffi::AnyBuffer> work) {
+  if (params.element_count() != 6)
+    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
+  if (in.size() != NFIELD + 12)
+    return ffi::Error::InvalidArgument("stage kernel: fields = (the 11 cell fields, U0 x5, Uk x5, s0, s1)");
+  ffi::DataType type;
+  if (auto err = same_fields(in, NFIELD + 12, type); err.failure()) return err;
+  if (auto err = check_variant("KtgfSsprkStage", type, limiter, riemann, true); err.failure()) return err;
+  const double* p = params.typed_data();
+  Stage<Real> o = stage_output(p, in, NFIELD, NFIELD + 5, {u0, u1, u2, u3, u4});
+  o.s0 = in.get<ffi::AnyBuffer>(NFIELD + 10)->typed_data<Real>();
+  o.s1 = in.get<ffi::AnyBuffer>(NFIELD + 11)->typed_data<Real>();
+  return run(in, p, work->typed_data<Real>(), o);
 }
 
 // The cell program registered under `program`, checked against the precision of `type`.
@@ -879,24 +840,8 @@ ffi::Error find_program(int64_t program, ffi::DataType type, CellProgram& p) {
   return ffi::Error::Success();
 }
 
-// Checks that the first `count` RemainingArgs are cell fields of one precision; their type in `type`.
-ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& type) {
-  if (state.size() < count) return ffi::Error::InvalidArgument("stage kernel: too few state fields");
-  auto first = state.get<ffi::AnyBuffer>(0);
-  if (!first.has_value()) return ffi::Error::InvalidArgument("stage kernel: no state");
-  type = first->element_type();
-  for (size_t i = 0; i < count; ++i) {
-    auto b = state.get<ffi::AnyBuffer>(i);
-    if (!b.has_value() || b->element_type() != type || b->element_count() != first->element_count())
-      return ffi::Error::InvalidArgument("stage kernel: the state must be cell fields of one precision");
-  }
-  return ffi::Error::Success();
-}
-
-// KtgfCellLimits: the maxima over the cells of the terms (as many as `maxima` holds) of a step-start cell
-// program at Uk (the step limits' and the state check's) in a pass that writes nothing per cell: the check of a
-// call's last state (the first stage of each step reduces the same terms as it sweeps).  It does not depend on
-// the limiter or the Riemann solver; Python calls the one of the stage library of the step.
+// KtgfCellLimits: the maxima of the terms (as many as `maxima` holds) of a step-start cell program at Uk
+// (cell_limits).  It does not depend on the limiter or the Riemann solver of its library.
 ffi::Error cell_limits_entry(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state, int64_t program,
                              ffi::Result<ffi::AnyBuffer> maxima) {
   if (state.size() != 5) return ffi::Error::InvalidArgument("cell limits kernel: state = Uk x5");
@@ -916,11 +861,8 @@ ffi::Error cell_limits_entry(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs stat
   return ffi::Error::Success();
 }
 
-// KtgfSsprkStageCells: one SSP-RK3 stage whose cell fields the cell program computes as the sweep goes
-// (sweep_fused); `ring` its per-thread planes (ring_elements).  `mode` (StageMode): UPDATE, state (U0, Uk);
-// RATE, state U0, writes L(U0) and the maxima of the program's limit terms (a step-start program; as many as
-// `maxima` holds, which is empty in the other modes);
-// FROM_RATE, state (U0, L0).  U' may alias Uk (L0) or U0 (see sweep_fused).
+// KtgfSsprkStageCells (sweep_fused; `ring` its per-thread planes, ring_elements).  `mode` (StageMode): UPDATE,
+// state (U0, Uk); RATE, state U0, writes L(U0) and the maxima (empty in the other modes); FROM_RATE, (U0, L0).
 ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state,
                              int32_t limiter, int32_t riemann, int64_t program, int32_t mode,
                              ffi::Result<ffi::AnyBuffer> u0, ffi::Result<ffi::AnyBuffer> u1,
@@ -949,18 +891,7 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
   if (ring->element_type() != type || long(ring->element_count()) < ring_elements(n))
     return ffi::Error::InvalidArgument("stage kernel: the ring workspace is smaller than KtgfRingElements");
   const double* par = params.typed_data();
-  Stage<Real> o;
-  Real* const out[5] = {u0->typed_data<Real>(), u1->typed_data<Real>(), u2->typed_data<Real>(),
-                        u3->typed_data<Real>(), u4->typed_data<Real>()};
-  for (int v = 0; v < 5; ++v) {
-    o.U0[v] = state.get<ffi::AnyBuffer>(v)->typed_data<Real>();
-    o.Uk[v] = state.get<ffi::AnyBuffer>(mode == RATE ? v : 5 + v)->typed_data<Real>();
-    o.U[v] = out[v];
-  }
-  o.s0 = o.s1 = nullptr;  // from the ring
-  o.a = Real(par[4]);
-  o.b = Real(1) - o.a;  // as the JAX path: 1 - a in the state precision
-  o.dt = Real(par[5]);
+  Stage<Real> o = stage_output(par, state, 0, mode == RATE ? 0 : 5, {u0, u1, u2, u3, u4});  // s0, s1: the ring's
   o.mode = mode;
   if (!sweep_fused<Real, KTGF_LIMITER, KTGF_RIEMANN>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(),
                                                      consts(n, par), o, ring->typed_data<Real>(),
@@ -970,29 +901,13 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
 }
 #endif  // KTGF_KIND
 
-// The eleven cell-field arguments the first two entry points begin with, in the order of enum Field, and the
-// float64 parameters after them.
-template <class Binding>
-auto cell_field_args(Binding b) {
-  return std::move(b).template Arg<ffi::AnyBuffer>()  // rho
-      .template Arg<ffi::AnyBuffer>()          // u_x
-      .template Arg<ffi::AnyBuffer>()          // u_y
-      .template Arg<ffi::AnyBuffer>()          // u_z
-      .template Arg<ffi::AnyBuffer>()          // theta
-      .template Arg<ffi::AnyBuffer>()          // p*
-      .template Arg<ffi::AnyBuffer>()          // g
-      .template Arg<ffi::AnyBuffer>()          // eta
-      .template Arg<ffi::AnyBuffer>()          // lambda_b
-      .template Arg<ffi::AnyBuffer>()          // kappa
-      .template Arg<ffi::AnyBuffer>()          // omega
-      .template Arg<ffi::Buffer<ffi::F64>>();  // (dx, dy, dz, rho_s[, a, dt])
-}
-
 }  // namespace
 
 #if KTGF_KIND != KTGF_STAGE
 XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfFluxDivergence, flux_divergence,
-                              cell_field_args(ffi::Ffi::Bind())
+                              ffi::Ffi::Bind()
+                                  .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s)
+                                  .RemainingArgs()               // the cell fields (enum Field)
                                   .Attr<int32_t>("limiter")
                                   .Attr<int32_t>("riemann")
                                   .Attr<int32_t>("viscous")
@@ -1006,8 +921,9 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfFluxDivergence, flux_divergence,
 
 #else  // the stage kind
 XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStage, ssprk_stage,
-                              cell_field_args(ffi::Ffi::Bind())  // at Uk
-                                  .RemainingArgs()               // U0 (5), Uk (5), s0, s1
+                              ffi::Ffi::Bind()
+                                  .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s, a, dt)
+                                  .RemainingArgs()               // the cell fields at Uk, U0 (5), Uk (5), s0, s1
                                   .Attr<int32_t>("limiter")
                                   .Attr<int32_t>("riemann")
                                   .Ret<ffi::AnyBuffer>()  // U' density

@@ -1,36 +1,24 @@
 """CPU fast path of :func:`.fluxes.flux_divergence` and of a whole SSP-RK3 stage: XLA FFI custom calls (``flux_kernel.cc``).
 
-The kernel does the numerics of :mod:`.fluxes` only (MUSCL reconstruction with the configured
-limiter, HLL/Rusanov, central viscous stress and heat flux, face divergence, ∇·u) from the same
-cell fields the JAX path gets; every closure stays in Python (the cell programs of
-:func:`ssprk_stage_cells` are generated from it).  It computes each face once
-instead of once per flux component (docs/solver.md, Speed) and agrees with the JAX path to
-round-off (tests/solver/test_solver_flux_kernel.py).  :func:`ssprk_stage` also applies the energy
-source and the stage update of :func:`.stepping.ssprk3_step` in the same sweep, so a stage of
-the explicit scheme is one closure pass (XLA) and one kernel call; :func:`ssprk_stage_cells` also
-evaluates the closures, by a generated cell program (:mod:`.cell_program`), plane by plane as its sweep
-goes (so the cell fields never go to memory), and a stage is one call.  A step's first stage, whose Δt is not
-known yet, is :func:`rate_cells`: it writes the rate L(U) and reduces the maxima of the step-limit and
-state-check terms of the closures it evaluates anyway, from which the step size is computed; the second stage
-reads U + Δt L.  :func:`cell_limits` is that reduction alone (the closures and the maxima, in one pass that
-writes nothing per cell).
+The kernel does the numerics of :mod:`.fluxes` only (MUSCL reconstruction, HLL/Rusanov, central viscous
+stress and heat flux, face divergence, ∇·u), computing each face once instead of once per flux component
+(docs/solver.md, Speed); it agrees with the JAX path to round-off (tests/solver/test_solver_flux_kernel.py).
+Every closure stays in Python.  :func:`ssprk_stage` also applies the energy source and the stage update of
+:func:`.stepping.ssprk3_step`; :func:`ssprk_stage_cells` also evaluates the closures, by a cell program
+generated from them (:mod:`.cell_program`), plane by plane as it sweeps, so a stage is one call.  A step's
+first stage, before Δt is known, is :func:`rate_cells`: the rate L(U) and the maxima of the step-limit and
+state-check terms; :func:`cell_limits` is that reduction alone.
 
-It is used where it applies — CPU backend, one device, a 3D fully periodic grid, float32 or
-float64 — and when it is switched on: :data:`.fluxes.FLUX_KERNEL` (default from the environment
-variable ``KTGF_FLUX_KERNEL``; ``0`` switches it off).  The JAX path remains the reference and
-the path for GPUs, sharding, walls and Lees–Edwards boundaries.
+It is used where it applies — CPU backend, one device, a 3D fully periodic grid, float32 or float64 — unless
+:data:`.fluxes.FLUX_KERNEL` is off (``KTGF_FLUX_KERNEL=0``).  The JAX path remains the reference and the path
+for GPUs, sharding, walls and Lees–Edwards boundaries.
 
-Build: one shared library per *variant* (:class:`Variant`: precision × limiter × Riemann solver × kind, the
-kind one of :data:`KINDS` — the viscous flux divergence, the inviscid one of the IMEX scheme, or the SSP-RK3
-stage entries),
-compiled when a solver first needs it (:func:`applies`) by :mod:`.cxx` (the C++ compiler ``$CXX`` or the first
-found, ``-O3`` and the flags it accepts: ``-march=native``, OpenMP threads) into ``$KTGF_CACHE_DIR`` (default
-``~/.cache/ktgf``), and kept there; a variant is chosen by ``-D`` macros, so each build
-compiles the face sweep once (7–15 s here; one library of all 64 instantiations took 6 minutes).  Each
-variant registers its FFI targets under the base names (:data:`TARGET`, ...) plus :attr:`Variant.suffix`
-(:func:`target`); its handlers refuse a call that asks for another variant.  Without a compiler (or if a
-build fails, or JAX has no ``jax.ffi``) the JAX path runs and one WARNING on the ``ktgf`` logger says why and
-what it costs (:func:`unavailable`); no further build is tried in that process.
+Build: one shared library per :class:`Variant`, compiled when a solver first needs it (:func:`applies`) by
+:mod:`.cxx` into ``$KTGF_CACHE_DIR`` (default ``~/.cache/ktgf``) and kept there; ``-D`` macros choose the
+variant, so a build compiles the face sweep once (7–15 s here).  A variant's FFI targets are the base names
+(:data:`TARGET`, ...) plus :attr:`Variant.suffix`.  Without a compiler (or if a build fails, or JAX has no
+``jax.ffi``) the JAX path runs and one WARNING on the ``ktgf`` logger says why and what it costs
+(:func:`unavailable`); no further build is tried in that process.
 """
 
 from __future__ import annotations
@@ -81,11 +69,7 @@ _loaded: dict[Any, Any] = {}
 @dataclass(frozen=True)
 class Variant:
     """One build of the kernel: the state precision (``"float64"`` or ``"float32"``), the limiter (one of
-    :data:`.stencil.LIMITERS`), the Riemann solver (:data:`.stencil.RIEMANN_SOLVERS`) and the kind (:data:`KINDS`).
-
-    (Libraries built for one row length, with constant stencil offsets, were removed: in one process, SSP-RK3,
-    RET, they gained 1.025× at 64³ float64, 1.028× float32, 0.99–1.02× at 32³ and lost at 16³; each row length
-    cost a build of 10–15 s.)"""
+    :data:`.stencil.LIMITERS`), the Riemann solver (:data:`.stencil.RIEMANN_SOLVERS`) and the kind (:data:`KINDS`)."""
 
     dtype: str
     limiter: str
@@ -142,10 +126,8 @@ def _library(v: Variant) -> Any:
     RuntimeError or OSError if it cannot be built or loaded."""
     lib = _loaded.get(v)
     if lib is None:
-        # Idle OpenMP threads must sleep, not spin: between calls XLA's own threads need the cores.  But they
-        # spin briefly first (GOMP_SPINCOUNT, 80 us here): a step calls the kernel three times with almost
-        # nothing in between, and waking a sleeping thread for each call cost about 0.2 ms per step (docs/solver.md at
-        # cef4049, "Waking the threads").  Both are read once, when libgomp loads: set before the library is.
+        # Idle OpenMP threads sleep (XLA's threads need the cores between calls), after a short spin: waking them
+        # for each of a step's three calls cost about 0.2 ms per step.  libgomp reads both when it loads.
         os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
         os.environ.setdefault("GOMP_SPINCOUNT", str(SPIN_COUNT))
         lib = ctypes.cdll.LoadLibrary(str(build(v)))
@@ -201,7 +183,6 @@ def _target(base: str, dtype: Any, limiter: str, riemann: str, kind: str) -> str
 
 def _cell_fields(W: Any, eos: Any, transport: Any, grid: Any, viscous: bool) -> tuple[list[Any], Any]:
     """The kernel's 11 cell-field inputs and its workspace (their copies with periodic ghost cells)."""
-
     dtype = W[0].dtype
     fields = [jnp.asarray(f, dtype) for f in (*W, *eos)]
     # Non-viscous calls pass ρ in the unused transport slots (no copy; the kernel ignores them).
@@ -211,7 +192,6 @@ def _cell_fields(W: Any, eos: Any, transport: Any, grid: Any, viscous: bool) -> 
 
 
 def _schemes(limiter: str, riemann: str) -> dict[str, Any]:
-
     return {"limiter": np.int32(LIMITERS.index(limiter)), "riemann": np.int32(RIEMANN_SOLVERS.index(riemann))}
 
 
@@ -223,7 +203,7 @@ def flux_divergence(W: Any, eos: Any, transport: Any, grid: Any, rho_s: Any, lim
     kind = "rhs" if viscous else "euler"
     call = jax.ffi.ffi_call(_target(TARGET, W[0].dtype, limiter, riemann, kind), (field,) * 6 + (work,))
     params = jnp.stack([jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)])
-    out = call(*fields, params, **_schemes(limiter, riemann), viscous=np.int32(viscous))
+    out = call(params, *fields, **_schemes(limiter, riemann), viscous=np.int32(viscous))
     return list(out[:5]), out[5]
 
 
@@ -242,9 +222,9 @@ def ssprk_stage(U0: Any, Uk: Any, W: Any, eos: Any, transport: Any, source: tupl
     # U' is written over Uk (each cell reads its own Uk only, after the fluxes): no new buffers, and
     # none of the loop-carry copies XLA inserts when a stage's output cannot take its input's place.
     call = jax.ffi.ffi_call(_target(STAGE_TARGET, dtype, limiter, riemann, "stage"), (field,) * 5 + (work,),
-                            input_output_aliases={len(fields) + 6 + v: v for v in range(5)})
+                            input_output_aliases={1 + len(fields) + 5 + v: v for v in range(5)})
     params = _stage_params(a, dt, grid, rho_s, dtype)
-    return tuple(call(*fields, params, *state, **_schemes(limiter, riemann))[:5])
+    return tuple(call(params, *fields, *state, **_schemes(limiter, riemann))[:5])
 
 
 def _register(program: Any, limiter: str, riemann: str, grid: Any) -> None:
@@ -262,11 +242,10 @@ def _register(program: Any, limiter: str, riemann: str, grid: Any) -> None:
 
 
 def cell_limits(Uk: Any, program: Any, leaf: Any, grid: Any, limiter: str, riemann: str) -> Any:
-    """The maxima over the cells of the terms (:data:`.stepping.START_TERMS`: step limits, then state status) of
-    the step-start cell program ``program`` (:func:`.cell_program.for_physics` with ``limits``) at the state Uk,
-    in one pass that writes nothing per cell: the check of the last state of an ``advance`` call (each step's
-    first stage, :func:`rate_cells`, reduces the same terms as it sweeps).  ``limiter``, ``riemann``: those of the
-    stages, whose library this call uses (the pass does not depend on them)."""
+    """The maxima over the cells of the terms (step limits, then state status) of the step-start cell program
+    ``program`` (:func:`.cell_program.for_physics` with ``limits``) at the state Uk, in one pass that writes
+    nothing per cell: the check of an ``advance`` call's last state.  ``limiter``, ``riemann``: those of the
+    stages, whose library this call uses."""
     _register(program, limiter, riemann, grid)
     dtype = Uk[0].dtype
     call = jax.ffi.ffi_call(_target(LIMITS_TARGET, dtype, limiter, riemann, "stage"),
@@ -311,17 +290,12 @@ def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any
                       limiter: str, riemann: str, write_over: str = "uk", from_rate: bool = False) -> tuple[Any, ...]:
     """The SSP-RK3 stage of :func:`ssprk_stage` with the cell fields and the energy source computed in
     the kernel from Uk by a cell program (:func:`.cell_program.for_physics`) with parameters ``leaf``
-    (:func:`.cell_program.leaf_values`), plane by plane as the sweep goes (the fused sweep of
-    flux_kernel.cc): no cell field is written to memory.
+    (:func:`.cell_program.leaf_values`), plane by plane as it sweeps: no cell field is written to memory.
 
-    ``write_over``: which input buffers U' is written over, so that the stage needs no new ones: ``"uk"`` (the
-    second stage of a step), ``"u0"`` (the last stage, when the caller no longer needs the step's start state:
-    the kernel reads U0 only at the cell it writes) or ``"new"`` (fresh buffers).  A step's first stage has
-    Uk = U0, which the later stages still read, so it writes new buffers: written in place, XLA would first
-    copy U0 (measured: 7 % of a 64³ step in copies).
-
-    ``from_rate``: ``Uk`` is the rate L0 = L(U0) of :func:`rate_cells`, and the stage's Uk is U0 + Δt L0 (the
-    first stage's U', computed again where it is read).
+    ``write_over``: the input buffers U' is written over: ``"uk"``, ``"u0"`` (when the caller no longer needs
+    the step's start state) or ``"new"`` (a step's first stage, whose Uk = U0 the later stages still read:
+    written in place, XLA would first copy U0).  ``from_rate``: ``Uk`` is the rate L0 = L(U0) of
+    :func:`rate_cells`, and the stage's Uk is U0 + Δt L0.
     """
     dtype = Uk[0].dtype
     state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
@@ -333,9 +307,8 @@ def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any
 
 def rate_cells(U: Any, program: Any, leaf: Any, grid: Any, rho_s: Any, limiter: str, riemann: str) -> tuple:
     """The first stage of a fused SSP-RK3 step before its Δt is known: ``(L, maxima)``, the rate
-    L(U) = −∇·F + S (into new buffers) and the maxima over the cells of the :data:`.stepping.START_TERMS` of
-    the step-start cell program ``program`` (parameters ``leaf``, :func:`.cell_program.leaf_values` with the
-    grid), which the kernel reduces as it sweeps: the closures of U are evaluated once, for both.  The step's
-    second stage takes L as its ``Uk`` (:func:`ssprk_stage_cells` with ``from_rate``)."""
+    L(U) = −∇·F + S (into new buffers) and the maxima over the cells of the terms of the step-start cell
+    program ``program`` (parameters ``leaf``), from one evaluation of the closures.  The step's second stage
+    takes L as its ``Uk`` (:func:`ssprk_stage_cells` with ``from_rate``)."""
     state = [jnp.asarray(f, U[0].dtype) for f in U]
     return _stage_cells(state, program, leaf, 0.0, 0.0, grid, rho_s, limiter, riemann, "rate", None)

@@ -19,14 +19,12 @@ Flux along a of (ρ, ρu, E):  (ρu_a,  ρu u_a + P·e_a,  E u_a + (P·u)_a + q_
 
 from __future__ import annotations
 
-import functools
 import os
 from collections.abc import Sequence
 from typing import Any
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 from .boundaries import lees_edwards_faces
 from .grid import Grid
@@ -52,19 +50,14 @@ def limited_slope(dm: Any, dp: Any, limiter: str) -> Any:
     return jnp.where(prod > 0.0, s, 0.0)
 
 
-#: Materialise shared intermediates (padded fields, face states, wave speeds, transport
-#: coefficients) with ``lax.optimization_barrier`` so XLA does not recompute them inside every
-#: consumer fusion (there are 5 flux components × 2 faces per cell consuming each).
-MATERIALISE = True  # switch for A/B timing of the barriers
-
-
 def materialise(x: Any) -> Any:
-    """``x`` behind an optimisation barrier: XLA computes it once and stores it.
+    """``x`` behind an optimisation barrier: XLA computes it once and stores it, instead of recomputing shared
+    intermediates (padded fields, face states, wave speeds) inside each of their consumer fusions.
 
     Measured (docs/solver.md, Speed): the barriers keep the padded and primitive fields
     stored, but inside the per-axis flux fusion XLA CPU fuses straight through them.
     """
-    return jax.lax.optimization_barrier(x) if MATERIALISE else x
+    return jax.lax.optimization_barrier(x)
 
 
 def pad_fields(W: Sequence[Any], grid: Grid, t: Any = 0.0, velocity: int | None = None,
@@ -94,14 +87,6 @@ def pad_viscous(W: Sequence[Any], transport: Sequence[Any], grid: Grid, phys: Ph
     return pad_fields(W, grid, t, velocity=1, theta=4, walls=walls)
 
 
-#: Periodic padding by ``jnp.pad`` (``"pad"``, the default: XLA emits one concatenation pass per
-#: axis and field), by one gather per field from a precomputed index (``"gather"``), or ``"auto"``
-#: (the gather for float64 fields only).  All copy the same values.  The gather halves the
-#: fusions of a right-hand side (47 → 24) and pads 3.5× faster alone, but whole steps measured in
-#: the same process against ``"pad"`` ranged from 1.25× faster to 0.88× (float32, IMEX) on the
-#: shared machine, so it is not the default (docs/solver.md, Speed).
-PERIODIC_PAD = "pad"
-
 #: Use the C++ kernel (:mod:`.flux_kernel`) for :func:`flux_divergence` where it applies (CPU,
 #: one device, 3D fully periodic grid).  Default on; ``KTGF_FLUX_KERNEL=0`` switches it off.
 FLUX_KERNEL = os.environ.get("KTGF_FLUX_KERNEL", "1").lower() not in ("0", "off", "false", "no")
@@ -115,29 +100,14 @@ STAGE_KERNEL = os.environ.get("KTGF_STAGE_KERNEL", "1").lower() not in ("0", "of
 CELL_PROGRAM = os.environ.get("KTGF_CELL_PROGRAM", "1").lower() not in ("0", "off", "false", "no")
 
 
-@functools.lru_cache(maxsize=16)
-def _wrap_index(shape: tuple[int, ...]) -> np.ndarray:
-    """Flat index into a field of ``shape`` of every cell of its periodically padded copy."""
-    idx = [np.arange(-GHOST, n + GHOST) % n for n in shape]
-    flat = np.ravel_multi_index(np.meshgrid(*idx, indexing="ij"), shape)
-    return flat.astype(np.int32)
-
-
 def pad_periodic(W: Sequence[Any], ndim: int) -> tuple[Any, ...]:
     """Fields with GHOST periodic ghost cells on each side of every grid axis.
 
     Padding once per stage and then reading stencils as static slices keeps the fused loops
-    free of the concatenations that ``jnp.roll`` would put in every one of them.  How the ghost
-    cells are copied (``jnp.pad`` or one gather) is :data:`PERIODIC_PAD`.
+    free of the concatenations that ``jnp.roll`` would put in every one of them.  (A gather from a
+    precomputed index pads 3.5× faster alone, but whole steps ranged from 1.25× faster to 0.88×.)
     """
-    def wrap(f: Any) -> Any:
-        gather = PERIODIC_PAD == "gather" or (PERIODIC_PAD == "auto" and jnp.dtype(f.dtype).itemsize >= 8)
-        if gather and f.ndim == ndim:
-            index = jnp.asarray(_wrap_index(tuple(f.shape)))
-            return f.reshape(-1).at[index].get(mode="promise_in_bounds")
-        return jnp.pad(f, [(GHOST, GHOST)] * ndim, mode="wrap")
-
-    return materialise(tuple(wrap(f) for f in W))
+    return materialise(tuple(jnp.pad(f, [(GHOST, GHOST)] * ndim, mode="wrap") for f in W))
 
 
 def window(P: Any, cells: tuple[int, ...], axis: int, offset: int, extra: int, shift: tuple[int, ...] = ()) -> Any:

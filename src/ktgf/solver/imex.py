@@ -183,6 +183,13 @@ def _axpy(x: Any, a: Any, y: Any) -> Any:
     return jax.tree_util.tree_map(lambda u, v: u + a.astype(u.dtype) * v, x, y)
 
 
+def _until(b: Any, tol: Any, atol: Any, maxiter: int) -> tuple[Any, Any]:
+    """The loop condition of a solve of ``b`` with float64 norms (iterate while ‖r‖ > max(tol‖b‖, atol) and
+    fewer than ``maxiter`` iterations; the carry holds r second and the count last), and that bound squared."""
+    stop2 = jnp.maximum(tol * _norm(b, jnp.float64), atol) ** 2
+    return lambda c: (_dot(c[1], c[1], jnp.float64) > stop2) & (c[-1] < maxiter), stop2
+
+
 def _bicgstab64(A: Any, b: Any, tol: Any, atol: Any, maxiter: int, M: Any) -> Any:
     """Right-preconditioned BiCGSTAB (van der Vorst 1992) with float32 vectors and float64 inner products.
 
@@ -190,13 +197,9 @@ def _bicgstab64(A: Any, b: Any, tol: Any, atol: Any, maxiter: int, M: Any) -> An
     ‖r‖ ≤ max(tol‖b‖, atol)); only the scalars (inner products, norms, α, ω) are float64.
     """
     f8 = jnp.float64
-    stop2 = jnp.maximum(tol * _norm(b, f8), atol) ** 2
+    cond, stop2 = _until(b, tol, atol, maxiter)
     zero = jax.tree_util.tree_map(jnp.zeros_like, b)
     one = jnp.ones((), f8)
-
-    def cond(c: tuple) -> Any:
-        _, r, *_, k = c
-        return (_dot(r, r, f8) > stop2) & (k < maxiter)
 
     def body(c: tuple) -> tuple:
         x, r, rhat, p, v, rho_old, alpha, omega, k = c
@@ -222,12 +225,8 @@ def _bicgstab64(A: Any, b: Any, tol: Any, atol: Any, maxiter: int, M: Any) -> An
 def _cg64(A: Any, b: Any, tol: Any, atol: Any, maxiter: int, M: Any) -> Any:
     """Preconditioned CG with float32 vectors and float64 inner products (else as ``jax.scipy``'s ``cg``)."""
     f8 = jnp.float64
-    stop2 = jnp.maximum(tol * _norm(b, f8), atol) ** 2
+    cond, _ = _until(b, tol, atol, maxiter)
     z = M(b)
-
-    def cond(c: tuple) -> Any:
-        _, r, *_, k = c
-        return (_dot(r, r, f8) > stop2) & (k < maxiter)
 
     def body(c: tuple) -> tuple:
         x, r, p, gamma, k = c

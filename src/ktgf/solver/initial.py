@@ -49,6 +49,14 @@ def t_of_tau(tau: Any, phys: Physics, phi0: float, theta0: float) -> Any:
     return t0 * np.expm1(np.asarray(tau) / (nu0(phi0, theta0, phys.diameter) * t0))
 
 
+def _plane_wave(grid: Grid, mode: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """The wavevector k = 2πn/L of integer ``mode`` and e^{ik·x} at the cell centres."""
+    if len(mode) != grid.ndim or not any(mode):
+        raise InputError(f"mode {tuple(mode)} must have {grid.ndim} integer entries, not all zero")
+    k, x = grid.wavevector(tuple(mode)), grid.mesh()
+    return k, np.exp(1j * sum(k[a] * x[a] for a in range(grid.ndim)))
+
+
 def _direction(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     khat = k / np.linalg.norm(k)
     ref = np.array([0.0, 0.0, 1.0]) if abs(khat[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
@@ -66,13 +74,9 @@ def single_mode(
     eigenvector (ρ_k, θ_k, w) used (transverse: (0, 0, 1) for w⊥).  ``branch`` picks the
     longitudinal eigenvalue by decreasing real part.
     """
-    if len(mode) != grid.ndim or not any(mode):
-        raise InputError(f"mode {tuple(mode)} must have {grid.ndim} integer entries, not all zero")
-    k = grid.wavevector(tuple(mode))
+    k, phase = _plane_wave(grid, mode)
     kstar = float(np.linalg.norm(k)) * mean_free_path(phi0, phys.diameter)
     khat, perp = _direction(k)
-    x = grid.mesh()
-    phase = np.exp(1j * sum(k[a] * x[a] for a in range(grid.ndim)))
     r = phys.model.reduced(phi0, phys.restitution, hcs=phys.hcs)
     rho, u, theta = uniform_fields(grid, phys, phi0, theta0)
     w_scale = math.sqrt(2.0 * theta0)
@@ -120,10 +124,8 @@ def shear_mode(
     by :func:`ktgf.solver.flows.add_base_flow`.  Returns the conservative state and the modes
     (σ of the seeded one: ``growth_rates[branch]``).
     """
-    if len(mode) != grid.ndim or not any(mode):
-        raise InputError(f"mode {tuple(mode)} must have {grid.ndim} integer entries, not all zero")
+    k, wave = _plane_wave(grid, mode)
     f, a, v = shear_axes(grid)
-    k = grid.wavevector(tuple(mode))
     if k[f] != 0.0:
         raise InputError(f"mode {tuple(mode)} varies along the flow direction (axis {'xyz'[f]}): a uniform-shear "
                          "normal mode needs k_flow = 0")
@@ -133,8 +135,6 @@ def shear_mode(
     modes = shear_modes(phys.model, phi0, float(phys.restitution), rate, ky=k[a], kz=k[v],
                         d=float(phys.diameter), rho_s=float(phys.material_density))
     vec = modes.vectors[:, branch]
-    x = grid.mesh()
-    wave = np.exp(1j * sum(k[b] * x[b] for b in range(grid.ndim)))
     rho, u, theta = uniform_fields(grid, phys, phi0, modes.base.theta)
     rho = rho + phys.material_density * amplitude * np.real(vec[0] * wave)
     for j, comp in enumerate((f, a, v)):

@@ -36,7 +36,7 @@ from ..closures import get_model
 from ..closures.coefficients import mean_free_path
 from ..errors import DivergenceError, InputError, KtgfError
 from ..io import write_netcdf
-from .config import Config, box_lengths, config_value, initial_temperature
+from .config import Config, box_lengths, changed_fields, config_value, initial_temperature
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
 from .cases import get_case
 from .flows import CASE_UNITS, PROFILES, VERIFICATION_FILE, describe
@@ -94,16 +94,6 @@ def check_memory(cells: tuple[int, ...], precision: str, available: int | None =
             + (" or numerics.precision = 'float32'" if precision == "float64" else "")
         )
     return need
-
-
-def _diff(a: Any, b: Any, prefix: str = "") -> list[str]:
-    """Dotted names of the leaves that differ between two JSON-like dicts."""
-    if isinstance(a, dict) and isinstance(b, dict):
-        out = []
-        for key in sorted(set(a) | set(b)):
-            out += _diff(a.get(key), b.get(key), f"{prefix}{key}.")
-        return out
-    return [] if a == b else [prefix.rstrip(".") or "config"]
 
 
 def _x64(enabled: bool) -> Any:
@@ -444,7 +434,7 @@ class Simulation:
         except ValueError:
             raise InputError(f"{name}: field config is not JSON") from None
         new = self.cfg.model_dump(mode="json")
-        changed = [f for f in _diff(old, new) if f not in RESUMABLE_CHANGES]
+        changed = [f for f in changed_fields(old, new) if f not in RESUMABLE_CHANGES]
         if changed:
             f = changed[0]
             raise InputError(
@@ -480,7 +470,7 @@ class Simulation:
         times = rows["time"]
         if k and (np.any(np.diff(times) <= 0) or times[-1] > t or times[0] != 0.0):
             raise InputError(f"{name}: field history.time is not increasing from 0 to at most t = {t:g} s")
-        if {"time.end", "time.outputs"} & set(_diff(old, new)):
+        if {"time.end", "time.outputs"} & set(changed_fields(old, new)):
             # another output schedule: continue with its outputs after the last one recorded
             after = self.output_times[(self.output_times >= t) & (self.output_times > (times[-1] if k else -1.0))]
             k = n_out - len(after)

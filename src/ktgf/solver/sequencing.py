@@ -112,28 +112,19 @@ def mean_temperature(U: np.ndarray) -> float:
     return float(np.sum(rho * theta) / np.sum(rho))
 
 
-def _leaves(d: Any, prefix: str = "") -> dict[str, Any]:
-    if isinstance(d, dict):
-        out: dict[str, Any] = {}
-        for k, v in d.items():
-            out.update(_leaves(v, f"{prefix}{k}."))
-        return out
-    return {prefix.rstrip("."): d}
-
-
 def check_compatible(old: Any, new: Any, old_lengths: tuple[float, ...], new_lengths: tuple[float, ...],
                      source: str) -> None:
     """Refuse (one line naming the field) an earlier run that is not the same flow on a mappable box."""
-    from .config import config_value
+    from .config import changed_fields, config_value
 
     a, b = old.model_dump(mode="json"), new.model_dump(mode="json")
     where = f"(initial.from_run = {source!r})"
-    for name in SAME_FIELDS:
-        sa, sb = _leaves(config_value(a, name), name + "."), _leaves(config_value(b, name), name + ".")
-        for key in sorted(set(sa) | set(sb)):
-            if sa.get(key) != sb.get(key):
-                raise InputError(f"field {key} = {sb.get(key)!r} differs from the earlier run's {sa.get(key)!r} "
-                                 f"{where}: a run maps only onto the same flow")
+    changed = [f for name in SAME_FIELDS
+               for f in changed_fields(config_value(a, name), config_value(b, name), name + ".")]
+    if changed:
+        key = changed[0]
+        raise InputError(f"field {key} = {config_value(b, key)!r} differs from the earlier run's "
+                         f"{config_value(a, key)!r} {where}: a run maps only onto the same flow")
     n_old, n_new = len(old.grid.cells), len(new.grid.cells)
     if n_old != n_new:
         raise InputError(f"field grid.cells has {n_new} axes, the earlier run {n_old} {where}: valid the same dimension")

@@ -2,7 +2,7 @@
 
 The sink is integrated explicitly, together with the convective fluxes.  Each SSP-RK3 stage is
 a convex combination of forward-Euler steps, and a forward-Euler step of dθ/dt = −ζθ keeps θ
-positive whenever ζΔt < 1; :func:`~ktgf.solver.stepping.stable_dt` limits Δt by
+positive whenever ζΔt < 1; :func:`~ktgf.solver.stepping.step_limits` limits Δt by
 ``cfl_source/max|ζ|`` (< 1), so the sink alone can never make θ non-positive.  (The explicit
 part of the IMEX scheme is not SSP; the same limit applies.)
 """

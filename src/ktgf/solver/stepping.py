@@ -192,8 +192,6 @@ def rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> Any:
     return tuple(explicit_rhs(U, grid, phys, num, viscous=True, t=t))
 
 
-
-
 def divu_bound(maxima: Any, grid: Grid) -> Any:
     """A bound of the central ∇·u on a periodic grid from the maxima of :data:`LIMIT_TERMS`:
     |∇·u| ≤ Σ_a (max u_a − min u_a)/(2Δx_a), with −min u_a = max(−u_a).
@@ -246,13 +244,8 @@ def kernel_step_limits(maxima: Any, grid: Grid, num: Numerics) -> Any:
     return limits_of_maxima(maxima, grid, num, divu_bound(maxima, grid))
 
 
-def stable_dt(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None) -> Any:
-    """Largest step of the scheme: the minimum of its limits (the IMEX scheme has no diffusive ones)."""
-    return dt_of_limits(step_limits(U, grid, phys, num, r), num)
-
-
 def dt_of_limits(lim: Any, num: Numerics) -> Any:
-    """The step of the scheme from the limits of :func:`step_limits`."""
+    """The step of the scheme from the limits of :func:`step_limits` (the IMEX scheme has no diffusive ones)."""
     dt = jnp.minimum(lim[0], lim[3])
     if num.scheme == "ssprk3":
         dt = jnp.minimum(dt, jnp.minimum(lim[1], lim[2]))
@@ -409,12 +402,10 @@ def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
     return ssprk3_step(U, dt, grid, phys, num, t, r0), jnp.zeros((), U[0].dtype)
 
 
-#: CPU time of one IMEX step over one SSP-RK3 step, measured (RET at φ = 0.5 with Δx = ℓ, 32³:
-#: 108 ms against 36 ms with BiCGSTAB; 143–165 against 35–37 ms with the earlier GMRES).
+#: CPU time of one IMEX step over one SSP-RK3 step, measured (RET at φ = 0.5 with Δx = ℓ, 32³: 108 against 36 ms).
 IMEX_COST = 3.0
-#: The same where SSP-RK3 runs as the fused loop of cell-program kernel calls (:func:`start_program`: CPU, one
-#: device, a 3D periodic grid), measured at stop 27 (RET, φ = 0.5, Δx = ℓ, float64, steady state, ms of CPU per
-#: step): 7.6 against 0.8 at 16³, 50.5 against 5.9 at 32³, 430.8 against 46.9 at 64³ (9.5, 8.6, 9.2×).
+#: The same where SSP-RK3 runs as the fused loop of cell-program kernel calls (:func:`start_program`), measured
+#: likewise in float64 at the steady state: 9.5, 8.6, 9.2× at 16³, 32³, 64³ (430.8 against 46.9 ms at 64³).
 IMEX_COST_FUSED = 9.0
 
 
@@ -444,8 +435,6 @@ def binding_limit(lim: Any, scheme: str) -> str:
 
 #: An implicit solve whose final relative residual exceeds this multiple of its tolerance fails.
 RESIDUAL_FAIL = 10.0
-
-
 
 
 def status_of_maxima(maxima: Any, phys: Physics) -> Any:
