@@ -19,10 +19,10 @@ from typing import Any
 import xarray as xr
 
 from ..errors import InputError, KtgfError
-from .config import Config, load_config
+from .config import Config, changed_fields, load_config
 from .interrupt import Interrupted
 from .io import load_checkpoint
-from .run import CHECKPOINT, Simulation, _diff
+from .run import CHECKPOINT, Simulation
 
 
 def earlier_config(path: str | Path, cfg: Config) -> Path | None:
@@ -38,7 +38,7 @@ def _stage_state(sim: Simulation) -> str:
     output folder of an earlier stage holds of that stage's run."""
     ckpt = sim.directory / CHECKPOINT
     try:
-        if _diff(json.loads(load_checkpoint(ckpt)["config"]), sim.cfg.model_dump(mode="json")):
+        if changed_fields(json.loads(load_checkpoint(ckpt)["config"]), sim.cfg.model_dump(mode="json")):
             return "new"  # another run: Simulation.run refuses its folder (or clears it with overwrite)
     except (OSError, KtgfError, ValueError, KeyError):
         return "new"
