@@ -27,10 +27,10 @@ def plane_deviation(U: np.ndarray, rho_s: float) -> dict[str, float]:
 
 
 def main() -> None:
-    from ktgf.solver.config import load_config
+    from ktgf.solver.chain import stage_config
     from ktgf.solver.run import Simulation
 
-    cfg = load_config(sys.argv[1])
+    cfg = stage_config(sys.argv[1])  # a chain's earlier stage: its output folder, as configured
     with tempfile.TemporaryDirectory() as scratch:
         start = np.asarray(Simulation(cfg, scratch).initial_state())
     end = np.load(sys.argv[2])["U"]

@@ -13,6 +13,7 @@ whole cost (steps, wall and CPU time of every stage) is in the last stage's ``ve
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +32,22 @@ def earlier_config(path: str | Path, cfg: Config) -> Path | None:
     if source is None or not source.endswith(".toml"):
         return None
     return Path(path).parent / source
+
+
+def stage_config(path: str | Path, folder_of: Callable[[Path], Path] | None = None) -> Config:
+    """The configuration in ``path`` with a ``from_run`` that names a configuration replaced by that stage's
+    output folder: ``folder_of(earlier config)`` (:func:`run_chain` runs it there), by default its
+    ``output.directory`` as configured (the chain already run)."""
+    cfg = load_config(path)
+    earlier = earlier_config(path, cfg)
+    if earlier is None:
+        return cfg
+    if not earlier.is_file():
+        raise InputError(f"field initial.from_run = {cfg.initial.from_run!r}: no run configuration "
+                         f"{str(earlier)!r} (valid: a TOML file, relative to the folder of the config naming "
+                         "it, or an earlier run's output folder or checkpoint)")
+    folder = folder_of(earlier) if folder_of is not None else Path(load_config(earlier).output.directory)
+    return cfg.model_copy(update={"initial": cfg.initial.model_copy(update={"from_run": str(folder)})})
 
 
 def _stage_state(sim: Simulation) -> str:
@@ -57,16 +74,8 @@ def run_chain(path: str | Path, output_dir: str | Path | None = None, resume: st
     :meth:`~.run.Simulation.run` for this last stage (``overwrite`` also clears an earlier stage's folder that
     holds another run).  Ctrl-C in an earlier stage raises :class:`~.interrupt.Interrupted` with no checkpoint
     to resume by hand: running the chain again continues that stage."""
-    cfg = load_config(path)
-    earlier = earlier_config(path, cfg)
-    if earlier is not None:
-        if not earlier.is_file():
-            raise InputError(f"field initial.from_run = {cfg.initial.from_run!r}: no run configuration "
-                             f"{str(earlier)!r} (valid: a TOML file, relative to the folder of the config naming "
-                             "it, or an earlier run's output folder or checkpoint)")
-        folder = run_chain(earlier, progress=progress, overwrite=overwrite, last=False)[0].directory
-        initial = cfg.initial.model_copy(update={"from_run": str(folder)})
-        cfg = cfg.model_copy(update={"initial": initial})
+    cfg = stage_config(path, lambda earlier: run_chain(earlier, progress=progress, overwrite=overwrite,
+                                                         last=False)[0].directory)
     sim = Simulation(cfg, output_dir)
     state = "new" if last else _stage_state(sim)
     if state == "complete":
