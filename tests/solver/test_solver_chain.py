@@ -8,6 +8,7 @@ modification times (a complete earlier stage is not run again).
 from __future__ import annotations
 
 import json
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -57,7 +58,7 @@ def by_hand(tmp_path_factory: pytest.TempPathFactory) -> np.ndarray:
 
 
 def test_ktgf_run_of_the_last_config_runs_the_chain_and_reuses_a_complete_stage(
-        by_hand: np.ndarray, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+        by_hand: np.ndarray, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture) -> None:
     last = _write_chain(tmp_path)
     monkeypatch.chdir(tmp_path)
     res = CliRunner().invoke(app, ["run", str(last), "--no-progress"])
@@ -67,7 +68,9 @@ def test_ktgf_run_of_the_last_config_runs_the_chain_and_reuses_a_complete_stage(
     first = json.loads((tmp_path / "a_run" / "verification.json").read_text())
     assert ver["run"]["sequence"]["steps"] == first["run"]["step_count"] + ver["run"]["step_count"]
     stamp = (tmp_path / "a_run" / "checkpoint.npz").stat().st_mtime_ns
-    sim, _ = run_chain(last, progress=False, overwrite=True)  # again: only the last stage runs
+    with caplog.at_level(logging.INFO, logger="ktgf"):
+        sim, _ = run_chain(last, progress=False, overwrite=True)  # again: only the last stage runs
+    assert "chain: reusing the complete run of" in caplog.text and "a.toml" in caplog.text
     assert (tmp_path / "a_run" / "checkpoint.npz").stat().st_mtime_ns == stamp
     assert np.array_equal(np.asarray(sim.state), by_hand)
 

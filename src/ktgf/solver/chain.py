@@ -13,6 +13,7 @@ whole cost (steps, wall and CPU time of every stage) is in the last stage's ``ve
 from __future__ import annotations
 
 import json
+import logging
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -24,6 +25,8 @@ from .config import Config, changed_fields, load_config
 from .interrupt import Interrupted
 from .io import load_checkpoint
 from .run import CHECKPOINT, Simulation
+
+log = logging.getLogger(__name__)
 
 
 def earlier_config(path: str | Path, cfg: Config) -> Path | None:
@@ -78,6 +81,9 @@ def run_chain(path: str | Path, output_dir: str | Path | None = None, resume: st
                                                          last=False)[0].directory)
     sim = Simulation(cfg, output_dir)
     state = "new" if last else _stage_state(sim)
+    if not last:  # one line per earlier stage (INFO on the ktgf logger: the CLI shows it)
+        log.info("chain: %s %s in %s", {"complete": "reusing the complete run of", "interrupted": "resuming",
+                                           "new": "running"}[state], path, sim.directory)
     if state == "complete":
         return sim, None
     try:
