@@ -142,8 +142,7 @@ def viscous_divergence(W: tuple, transport: tuple, grid: Grid, phys: Physics, t:
     Pk = pad_fields(transport, grid, t)
     out: list[Any] = [0.0] * 5
     for a in range(grid.ndim):
-        F = viscous_flux(P, Pk, a, grid, phys.material_density)
-        F = lees_edwards_faces(F, grid, a, t)
+        F = lees_edwards_faces(viscous_flux(P, Pk, a, grid, phys.material_density), grid, a, t)
         dF = face_divergence(jnp.stack([jnp.broadcast_to(f, F[1].shape) for f in F[1:]]), grid, a)
         out = [out[0]] + [o + dF[i] for i, o in enumerate(out[1:])]
     out[0] = jnp.zeros_like(W[0])

@@ -92,13 +92,11 @@ _CHECKPOINT_KEYS = ("format", "hash", "U", "t", "steps", "output_index", "histor
 
 def _content_hash(U: np.ndarray, t: float, steps: int, output_index: int, history: str, config: str) -> str:
     """SHA-256 of everything a checkpoint holds (state bytes, shape, dtype, counters, history, config)."""
-    h = hashlib.sha256()
     head = {"format": CHECKPOINT_FORMAT, "shape": list(U.shape), "dtype": U.dtype.str, "t": float(t).hex(),
             "steps": int(steps), "output_index": int(output_index)}
-    h.update(json.dumps(head, sort_keys=True).encode())
-    h.update(np.ascontiguousarray(U).tobytes())
-    h.update(history.encode())
-    h.update(config.encode())
+    h = hashlib.sha256(json.dumps(head, sort_keys=True).encode())
+    for part in (np.ascontiguousarray(U).tobytes(), history.encode(), config.encode()):
+        h.update(part)
     return h.hexdigest()
 
 

@@ -300,7 +300,7 @@ class Simulation:
                         fault_hook("chunk", chunks)
                     self._poll()
                     self._record(U, t, history)
-                    if self._steady(history):  # the last output: its fields and checkpoint are written
+                    if self.steady_summary(history)["reached"]:  # the last output: its files are written
                         self.output_times = self.output_times[:k + 1]
                         n_out = k + 1
                     if write_files:
@@ -351,12 +351,6 @@ class Simulation:
                 with atomic_path(self.directory / VERIFICATION_FILE) as tmp:
                     tmp.write_text(json.dumps(self.verification, indent=2) + "\n")
         return ds
-
-    def _steady(self, history: dict[str, list]) -> bool:
-        """True when ``time.steady_tol`` is set and the last output is steady (:meth:`~.cases.Case.steady_change`)."""
-        tol = self.cfg.time.steady_tol
-        change = self.case.steady_change(history) if tol is not None else None
-        return change is not None and change < tol
 
     def steady_summary(self, history: dict[str, list]) -> dict[str, Any]:
         """The steady-state stop: tolerance, whether it was met, the last change and the time [s]."""
