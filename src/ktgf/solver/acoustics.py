@@ -91,19 +91,12 @@ def _wall_faces(F: list[Any], grid: Grid, a: int) -> list[Any]:
     if not (has_walls(grid) and a in grid.boundaries.wall_axes):
         return F
     n = grid.cells[a]
-    out = []
-    for f in F:
-        if jnp.ndim(f) == 0:
-            out.append(f)
-            continue
+
+    def zero_ends(f: Any) -> Any:
         zero = jnp.zeros_like(jax.lax.slice_in_dim(f, 0, 1, axis=a))
-        out.append(jnp.concatenate([zero, jax.lax.slice_in_dim(f, 1, n, axis=a), zero], axis=a))
-    return out
+        return jnp.concatenate([zero, jax.lax.slice_in_dim(f, 1, n, axis=a), zero], axis=a)
 
-
-def mass_flux(Prho: Any, Pu: tuple, grid: Grid, a: int) -> Any:
-    """ρ̄ū at the faces along ``a`` (padded ρ and velocities; wall ghosts give ū = 0 at a wall)."""
-    return face_mean(Prho, grid.cells, a) * face_mean(Pu[a], grid.cells, a)
+    return [f if jnp.ndim(f) == 0 else zero_ends(f) for f in F]
 
 
 def advective_divergence(W: tuple, eos: tuple, h0: Any, grid: Grid, limiter: str, t: Any = 0.0) -> tuple[list, Any]:
@@ -149,7 +142,7 @@ def implicit_fluxes(rho: Any, u: tuple, h0: Any, grid: Grid, t: Any = 0.0,
     sheared = grid.boundaries is not None and grid.boundaries.shear_axis is not None
     d_rho, d_m, d_E = 0.0, [0.0, 0.0, 0.0], 0.0
     for a in range(grid.ndim):
-        m = mass_flux(P[0], P[1:4], grid, a)
+        m = face_mean(P[0], grid.cells, a) * face_mean(P[1 + a], grid.cells, a)  # ρ̄ū (walls: ū = 0 by the ghosts)
         zero = jnp.zeros(m.shape, m.dtype) if sheared else 0.0  # an array, so the Galilean change can fill it
         F = lees_edwards_faces(_wall_faces([m, zero, zero, zero, face_mean(H, grid.cells, a) * m if H is not None
                                             else zero], grid, a), grid, a, t)

@@ -139,16 +139,15 @@ class Boundaries:
                 if side.velocity[a] != 0.0:
                     raise InputError(f"wall velocity {side.velocity} on axis {AXES[a]} has a normal component: "
                                      "walls move tangentially")
+
     def tree_flatten(self) -> tuple[tuple, tuple]:
         return (self.shear_rate,), (self.kinds, self.flow, self.walls)
 
     @classmethod
     def tree_unflatten(cls, aux: tuple, leaves: tuple) -> Boundaries:
         obj = object.__new__(cls)
-        object.__setattr__(obj, "kinds", aux[0])
-        object.__setattr__(obj, "flow", aux[1])
-        object.__setattr__(obj, "walls", aux[2])
-        object.__setattr__(obj, "shear_rate", leaves[0])
+        for name, v in zip(("kinds", "flow", "walls", "shear_rate"), (*aux, *leaves)):
+            object.__setattr__(obj, name, v)
         return obj
 
     @property
@@ -266,8 +265,7 @@ def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any],
         n, h = grid.cells[a], grid.spacing[a]
         for side, ws in enumerate(bc.walls[a]):
             wall = ws.wall
-            c0, c1 = (_side(x, a, n, side, 0) for x in (rho, theta)), (_side(x, a, n, side, 1) for x in (rho, theta))
-            (r0, t0), (r1, t1) = c0, c1
+            (r0, t0), (r1, t1) = [[_side(x, a, n, side, g) for x in (rho, theta)] for g in (0, 1)]
             phi_w = jnp.clip((1.5 * r0 - 0.5 * r1) / rho_s, 0.5 * r0 / rho_s, 2.0 * r0 / rho_s)
             theta_w = jnp.clip(1.5 * t0 - 0.5 * t1, 0.5 * t0, 2.0 * t0)
             chi = phys.model.chi(phi_w)
@@ -276,11 +274,9 @@ def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any],
                 c = rho_s * jj_friction(wall, phi_w, chi, theta_w)
                 ratio_t, weight = (beta - c) / (beta + c), 2.0 * c / (beta + c)
             elif wall.momentum == "prescribed":
-                ratio_t, weight = -jnp.ones_like(beta), 2.0 * jnp.ones_like(beta)
-                c = None
+                ratio_t, weight, c = -jnp.ones_like(beta), 2.0 * jnp.ones_like(beta), None
             else:
-                ratio_t, weight = jnp.ones_like(beta), jnp.zeros_like(beta)
-                c = jnp.zeros_like(beta)
+                ratio_t, weight, c = jnp.ones_like(beta), jnp.zeros_like(beta), jnp.zeros_like(beta)
             ratio = tuple(-jnp.ones_like(beta) if j == a else ratio_t for j in range(3))
             offset = tuple(jnp.zeros_like(beta) if j == a else weight * ws.velocity[j] for j in range(3))
             uc = [_side(x, a, n, side, 0) for x in u]

@@ -251,8 +251,7 @@ def parse_config(data: dict[str, Any], source: str = "config") -> Config:
 
 def load_config(path: str | Path) -> Config:
     """Read and validate a TOML run configuration."""
-    data = read_toml(path)
-    return parse_config(data, str(path))
+    return parse_config(read_toml(path), str(path))
 
 
 def _check_friction(cfg: Config, model: Any, source: str) -> None:
@@ -284,17 +283,13 @@ def check_physics(cfg: Config, source: str = "config") -> None:
     phi0 = cfg.initial.solid_fraction
     stop = cfg.numerics.phi_stop if cfg.numerics.phi_stop is not None else 0.99 * model.phi_max
     if phi0 >= model.phi_max:
-        raise InputError(
-            f"{source}: field initial.solid_fraction = {phi0:g} is out of range: valid 0 < phi < {model.phi_max:g} "
-            f"(packing limit of model {model.name!r})"
-        )
+        raise InputError(f"{source}: field initial.solid_fraction = {phi0:g} is out of range: valid 0 < phi < "
+                         f"{model.phi_max:g} (packing limit of model {model.name!r})")
     if phi0 >= stop:
         raise InputError(f"{source}: field initial.solid_fraction = {phi0:g} is at or above numerics.phi_stop = {stop:g}")
     mode, cells = cfg.initial.mode, cfg.grid.cells
     if cfg.initial.perturbation in ("mode", "shear-mode") and (mode is None or len(mode) != len(cells) or not any(mode)):
-        raise InputError(
-            f"{source}: field initial.mode = {mode} must have {len(cells)} integers, not all 0"
-        )
+        raise InputError(f"{source}: field initial.mode = {mode} must have {len(cells)} integers, not all 0")
     if mode is not None and any(abs(n) > c // 2 for n, c in zip(mode, cells)):
         raise InputError(f"{source}: field initial.mode = {mode} is out of range: valid |mode[a]| <= cells[a]/2 = "
                          f"{[c // 2 for c in cells]} (the grid resolves no shorter wave)")
@@ -307,11 +302,9 @@ def check_physics(cfg: Config, source: str = "config") -> None:
         kp, kl = critical_wavenumbers(model.reduced(phi0, cfg.model.restitution, hcs=True))
         k = kp if cfg.grid.relative_to == "transverse" else kl
         if not float(k) > 0:
-            raise InputError(
-                f"{source}: field grid.relative_to = {cfg.grid.relative_to!r}: model {model.name!r} at "
-                f"phi = {phi0:g}, e = {cfg.model.restitution:g} has no {cfg.grid.relative_to} instability "
-                "(infinite critical size); give grid.length instead"
-            )
+            raise InputError(f"{source}: field grid.relative_to = {cfg.grid.relative_to!r}: model {model.name!r} at "
+                             f"phi = {phi0:g}, e = {cfg.model.restitution:g} has no {cfg.grid.relative_to} instability "
+                             "(infinite critical size); give grid.length instead")
 
 
 def check_case(cfg: Config, source: str = "config") -> None:

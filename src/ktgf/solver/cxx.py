@@ -228,11 +228,6 @@ def shared_library(name: str, source: str | Path, flags: Sequence[str], what: st
     threads
         Build with OpenMP threads where the compiler takes them (else serial, said once at WARNING).
 
-    Returns
-    -------
-    Path
-        The library in the cache folder.
-
     Raises
     ------
     RuntimeError

@@ -36,9 +36,7 @@ def velocity_split(u: Any, grid: Grid) -> tuple[Any, Any]:
     """Fourier transforms (û∥, û⊥) of the compressive and solenoidal parts of u (Helmholtz split)."""
     axes = tuple(range(1, grid.ndim + 1))
     uh = jnp.fft.fftn(u, axes=axes)
-    ks = jnp.meshgrid(
-        *(2.0 * np.pi * jnp.fft.fftfreq(n, d=h) for n, h in zip(grid.cells, grid.spacing)), indexing="ij"
-    )
+    ks = jnp.meshgrid(*(2.0 * np.pi * jnp.fft.fftfreq(n, d=h) for n, h in zip(grid.cells, grid.spacing)), indexing="ij")
     k = ks + [jnp.zeros(grid.cells)] * (3 - grid.ndim)
     k2 = sum(ki * ki for ki in k)
     kdotu = sum(k[j] * uh[j] for j in range(3))

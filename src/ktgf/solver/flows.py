@@ -52,12 +52,9 @@ def boundaries(cfg: Any) -> Boundaries:
     if wall is not None:
         f = AXES.index(wall.flow)
         lower, upper = wall.walls.build_pair()
-        sides = []
-        for w, sign in ((lower, -1.0), (upper, 1.0)):
-            v = [0.0, 0.0, 0.0]
-            v[f] = sign * 0.5 * float(wall.wall_speed)
-            sides.append(WallSide(w, tuple(v)))
-        return Boundaries(kinds, flow=f, walls=tuple(tuple(sides) if s.kind == WALL else None for s in sections))
+        sides = tuple(WallSide(w, tuple(sign * 0.5 * float(wall.wall_speed) if j == f else 0.0 for j in range(3)))
+                      for w, sign in ((lower, -1.0), (upper, 1.0)))
+        return Boundaries(kinds, flow=f, walls=tuple(sides if s.kind == WALL else None for s in sections))
     return Boundaries(kinds)
 
 
@@ -79,13 +76,6 @@ def add_base_flow(U: Any, grid: Grid, base_shear: float | None = None) -> Any:
     return conservative(jnp.asarray(W[0]), jnp.asarray(np.stack(W[1:4])), jnp.asarray(W[4]))
 
 
-def _velocity_pad(W: Any, transport: Any, grid: Grid, phys: Physics, t: Any) -> tuple:
-    """Velocities padded as the viscous fluxes see them (with walls: their ghost cells)."""
-    if has_walls(grid):
-        return pad_viscous(W, transport, grid, phys, t)[1:4]
-    return pad_fields(W[1:4], grid, t, velocity=0)
-
-
 @jax.jit
 def stress_tensor(U: Any, t: Any, grid: Grid, phys: Physics) -> Any:
     """Box average of P = pI − τ [Pa], as (xx, yy, zz, xy, xz, yz) (module docstring)."""
@@ -95,7 +85,8 @@ def stress_tensor(U: Any, t: Any, grid: Grid, phys: Physics) -> Any:
     p = phys.pressure(rho, theta, r)
     transport = phys.transport(rho, theta, r)
     eta, lam, _, _ = transport
-    Pu = _velocity_pad(W, transport, grid, phys, t)
+    # the velocities padded as the viscous fluxes see them (with walls: their ghost cells)
+    Pu = pad_viscous(W, transport, grid, phys, t)[1:4] if has_walls(grid) else pad_fields(W[1:4], grid, t, velocity=0)
     g = velocity_gradients(Pu, grid)
     divu = cell_divergence(Pu, grid)
     out = []
@@ -118,7 +109,6 @@ def wall_case_diagnostics(U: Any, t: float, grid: Grid, phys: Physics) -> dict[s
 def wall_diagnostics(U: Any, grid: Grid, phys: Physics) -> Any:
     """Mean over each wall of the shear stress η∂u_f/∂x_a [Pa] (lower, upper) and the slip u_f − U_w [m/s]."""
     W = primitive_fields(tuple(U))
-
     r = cell_coefficients(W, grid, phys)
     transport = phys.transport(W[0], W[4], r)
     terms = wall_terms(W[0], W[1:4], W[4], transport, grid, phys)

@@ -115,15 +115,8 @@ def window(P: Any, cells: tuple[int, ...], axis: int, offset: int, extra: int, s
 
     ``shift`` optionally moves the block by ±1 along other axes (tangential stencils).
     """
-    start, stop = [], []
-    for b, n in enumerate(cells):
-        d = shift[b] if shift else 0
-        if b == axis:
-            start.append(GHOST + offset)
-            stop.append(GHOST + offset + n + extra)
-        else:
-            start.append(GHOST + d)
-            stop.append(GHOST + d + n)
+    start = [GHOST + (offset if b == axis else shift[b] if shift else 0) for b in range(len(cells))]
+    stop = [s + n + (extra if b == axis else 0) for b, (s, n) in enumerate(zip(start, cells))]
     return jax.lax.slice(P, start, stop)
 
 
@@ -233,9 +226,8 @@ def stress(Pu: Sequence[Any], eta: Any, lam: Any, axis: int, grid: Grid) -> list
         if b != a:
             for j in range(3):
                 g = _central(Pu[j], grid, a, b)
-                tangential[b, j] = 0.5 * (
-                    jax.lax.slice_in_dim(g, 0, n + 1, axis=a) + jax.lax.slice_in_dim(g, 1, n + 2, axis=a)
-                )
+                tangential[b, j] = 0.5 * (jax.lax.slice_in_dim(g, 0, n + 1, axis=a)
+                                          + jax.lax.slice_in_dim(g, 1, n + 2, axis=a))
     tangential = materialise(tangential)
 
     def grad(b: int, j: int) -> Any:  # ∂u_j/∂x_b at the face
@@ -316,7 +308,5 @@ def flux_divergence(W: Sequence[Any], coefficients: tuple[tuple[Any, ...], tuple
 
 def cell_divergence(Pu: Sequence[Any], grid: Grid) -> Any:
     """Central ∇·u at the cells (padded velocities)."""
-    return sum(
-        (window(Pu[b], grid.cells, b, 1, 0) - window(Pu[b], grid.cells, b, -1, 0)) * (0.5 / grid.spacing[b])
-        for b in range(grid.ndim)
-    )
+    return sum((window(Pu[b], grid.cells, b, 1, 0) - window(Pu[b], grid.cells, b, -1, 0)) * (0.5 / grid.spacing[b])
+               for b in range(grid.ndim))

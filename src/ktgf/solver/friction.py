@@ -60,7 +60,6 @@ def needs_rate(phys: Physics) -> bool:
 def strain_invariants(u: Any, grid: Grid, t: Any = 0.0) -> tuple[Any, Any]:
     """(S:S, ∇·u) at the cells, S the deviatoric strain rate, by central differences of the padded u
     (Lees–Edwards images at time t; extrapolated ghosts at walls)."""
-
     g = velocity_gradients(pad_fields(tuple(u), grid, t, velocity=0), grid)
     divu = g[0][0] + g[1][1] + g[2][2]
     dd = sum(0.25 * (g[b][j] + g[j][b]) ** 2 for b in range(3) for j in range(3))
@@ -70,9 +69,8 @@ def strain_invariants(u: Any, grid: Grid, t: Any = 0.0) -> tuple[Any, Any]:
 def cell_coefficients(W: Any, grid: Grid, phys: Physics, t: Any = 0.0) -> Any:
     """The closures at the cells of the primitive state W = (ρ, u, θ) at time t (once per stage).
 
-    A plain :meth:`Physics.reduced` (bit for bit the former coefficients) unless the model needs the
-    velocity gradient: a dissipation correction in a sheared case, or a frictional stress
-    (then a :class:`FrictionalReduced`).
+    A plain :meth:`Physics.reduced` unless the model needs the velocity gradient: a dissipation
+    correction in a sheared case, or a frictional stress (then a :class:`FrictionalReduced`).
     """
     if not needs_rate(phys):
         return phys.reduced(W[0])
@@ -80,9 +78,7 @@ def cell_coefficients(W: Any, grid: Grid, phys: Physics, t: Any = 0.0) -> Any:
     ss, _ = strain_invariants(W[1:4], grid, t)
     ss = jnp.maximum(ss, 0.0)  # round-off
     model = phys.model
-    shear = None
-    if model.dissipation.key != "none" and not phys.hcs:
-        shear = phys.diameter * jnp.sqrt(2.0 * ss / theta)
+    shear = phys.diameter * jnp.sqrt(2.0 * ss / theta) if model.dissipation.key != "none" and not phys.hcs else None
     r = phys.reduced(rho, shear)
     if not model.friction.has_stress:
         return r

@@ -67,9 +67,8 @@ class Grid:
     @classmethod
     def tree_unflatten(cls, cells: tuple[int, ...], children: tuple) -> Grid:
         obj = object.__new__(cls)  # no validation: leaves may be tracers
-        object.__setattr__(obj, "cells", cells)
-        object.__setattr__(obj, "lengths", tuple(children[0]))
-        object.__setattr__(obj, "boundaries", children[1])
+        for name, v in zip(("cells", "lengths", "boundaries"), (cells, tuple(children[0]), children[1])):
+            object.__setattr__(obj, name, v)
         return obj
 
     @property

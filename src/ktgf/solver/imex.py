@@ -142,8 +142,7 @@ def viscous_divergence(W: tuple, transport: tuple, grid: Grid, phys: Physics, t:
     Pk = pad_fields(transport, grid, t)
     out: list[Any] = [0.0] * 5
     for a in range(grid.ndim):
-        F = viscous_flux(P, Pk, a, grid, phys.material_density)
-        F = lees_edwards_faces(F, grid, a, t)
+        F = lees_edwards_faces(viscous_flux(P, Pk, a, grid, phys.material_density), grid, a, t)
         dF = face_divergence(jnp.stack([jnp.broadcast_to(f, F[1].shape) for f in F[1:]]), grid, a)
         out = [out[0]] + [o + dF[i] for i, o in enumerate(out[1:])]
     out[0] = jnp.zeros_like(W[0])
@@ -289,7 +288,6 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     # A frictional stress's work 2μ_f S:S (docs/friction.md §7) is removed here, in the implicit part with
     # the frictional heating it cancels, frozen with μ_f at the stage start (as a rate ∝ θ, or explicitly,
     # the stage-start θ biased the steady θ by O(ζΔt), 4-7 % measured; explicitly a stiff one overshot).
-    implicit_sink = sink
     friction_sink = 1.5 * rho * theta * r.zeta_f if is_frictional(r) else 0.0
     rho_hat = rho
     galilean = acoustic is not None and grid.boundaries is not None and grid.boundaries.shear_axis is not None
@@ -297,7 +295,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         sweeps = max(sweeps, MIN_SWEEPS)
         p_ref, d_ref = pressure(rho, theta, r, phys), [0.0] * grid.ndim  # Û holds no compression
     fI = viscous_divergence(Wh, phys.transport(rho, theta, r), grid, phys, t)
-    fI[4] = fI[4] - friction_sink - (collisional_sink(rho, theta, r, phys)[0] if implicit_sink else 0.0)
+    fI[4] = fI[4] - friction_sink - (collisional_sink(rho, theta, r, phys)[0] if sink else 0.0)
     heat = fI[4] - sum(x * f for x, f in zip(u, fI[1:4]))
     theta = jnp.clip(theta + adt * heat / (1.5 * rho), 0.5 * theta, 2.0 * theta)
 
@@ -367,7 +365,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         sb = _unit(b, acc)
         du, _ = solve_m(A, tuple(x / sb for x in b), tol=tol, atol=atol_m / sb, maxiter=RESTART * maxiter, M=M)
         u = tuple(x + sb * dx for x, dx in zip(u, du))
-        rho_op = rho
+        rho_op, E_base = rho, E_hat
         if acoustic is not None:  # the face pressure of the solution, and mass and energy from its fluxes
             Pu = pad_fields(u, grid, t, velocity=0, walls=walls)
             div_f = [stress(Pu, 0.0, 1.0, a, grid)[a] for a in range(grid.ndim)]
@@ -376,8 +374,6 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
                 [p + la * (d0 - d) for p, la, d0, d in zip(p_ref_f, lam_ac_f, d_ref, div_f)], grid, t)
                 + [0.0] * (3 - grid.ndim), d_m))
             rho, E_base, d_ref = rho_hat + adt * d_rho, E_hat + adt * d_E, div_f
-        else:
-            E_base = E_hat
         if walls is not None:  # the wall heat terms need the slip of the new u (at the operator's ρ)
             walls = wall_terms(rho_op, u, theta, transport, grid, phys)
 
@@ -389,12 +385,12 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
             return 1.5 * rho * th - adt * div
 
         # The collisional sink linearised about θ_k: S_k + S'_k (θ − θ_k) (module docstring).
-        s_k, ds_k = collisional_sink(rho, theta, r, phys) if implicit_sink else (0.0, 0.0)
+        s_k, ds_k = collisional_sink(rho, theta, r, phys) if sink else (0.0, 0.0)
         s_const = s_k - ds_k * theta
         mass = 1.5 * rho + adt * ds_k
 
         def B_sink(th: Any) -> Any:
-            return B(th) + adt * ds_k * th if implicit_sink else B(th)
+            return B(th) + adt * ds_k * th if sink else B(th)
 
         # Right-hand side: Ê − ρ̂|u|²/2 + aΔt∇·(τ·u + ω∇φ), i.e. the stage equation with κ = 0.
         fI0 = viscous_divergence((rho, *u, jnp.zeros_like(theta)), transport, grid, phys, t, walls)
@@ -412,7 +408,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
 
         # The conservative stage state and the residual of its two linear problems.
         fI = viscous_divergence((rho, *u, theta), transport, grid, phys, t, walls)
-        fI[4] = fI[4] - friction_sink - (s_const + ds_k * theta if implicit_sink else 0.0)
+        fI[4] = fI[4] - friction_sink - (s_const + ds_k * theta if sink else 0.0)
         U = (rho, *(m + adt * f for m, f in zip(m_base, fI[1:4])), E_base + adt * fI[4])
         res_m = _norm(tuple(rho_op * x - m for x, m in zip(u, U[1:4])), acc)
         res_E = _norm(U[4] - rho * (0.5 * sum(x * x for x in u) + 1.5 * theta), acc)

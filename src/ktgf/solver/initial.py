@@ -143,8 +143,9 @@ def shear_mode(
     return conservative(jnp.asarray(rho), jnp.asarray(u), jnp.asarray(theta)), modes
 
 
-def _random_modes(grid: Grid, seed: int, max_mode: int) -> np.ndarray:
-    """Four seeded random fields (three velocity components and δρ) of the Fourier modes |n_a| ≤ ``max_mode``."""
+def _random_modes(grid: Grid, seed: int, max_mode: int, amplitude: float, theta: float) -> tuple:
+    """Seeded random fields of the Fourier modes |n_a| ≤ ``max_mode``: a velocity of rms ``amplitude``·√θ per
+    component and δρ/ρ of rms ``amplitude``."""
     rng = np.random.default_rng(seed)
     x = grid.mesh()
     ranges = [range(-max_mode, max_mode + 1)] * grid.ndim
@@ -156,7 +157,8 @@ def _random_modes(grid: Grid, seed: int, max_mode: int) -> np.ndarray:
         arg = sum(k[a] * x[a] for a in range(grid.ndim))
         amp = rng.normal(size=4) + 1j * rng.normal(size=4)
         f += np.real(amp.reshape((4,) + (1,) * grid.ndim) * np.exp(1j * arg)[None])
-    return f
+    return (f[:3] * (amplitude * math.sqrt(theta) / np.sqrt(np.mean(f[:3] ** 2))),
+            f[3] * (amplitude / np.sqrt(np.mean(f[3] ** 2))))
 
 
 def random_velocity(
@@ -168,9 +170,7 @@ def random_velocity(
     component, δφ/φ0 has rms ``amplitude``; both are the same physical fields on every grid
     that resolves those modes.
     """
-    f = _random_modes(grid, seed, max_mode)
-    u = f[:3] * (amplitude * math.sqrt(theta0) / np.sqrt(np.mean(f[:3] ** 2)))
-    drho = f[3] * (amplitude / np.sqrt(np.mean(f[3] ** 2)))
+    u, drho = _random_modes(grid, seed, max_mode, amplitude, theta0)
     rho, _, theta = uniform_fields(grid, phys, phi0, theta0)
     rho = rho * (1.0 + drho)
     # Zero total momentum: the box frame is the centre-of-mass frame (no uniform drift).
@@ -192,10 +192,7 @@ def perturb(U: np.ndarray, grid: Grid, amplitude: float, seed: int, max_mode: in
     u = m / rho
     theta = (U[4] / rho - 0.5 * np.sum(u * u, axis=0)) / 1.5
     axes = tuple(range(1, grid.ndim + 1))
-    f = _random_modes(grid, seed, max_mode)
-    theta_bar = float(np.sum(rho * theta) / np.sum(rho))
-    du = f[:3] * (amplitude * math.sqrt(theta_bar) / np.sqrt(np.mean(f[:3] ** 2)))
-    drho = f[3] * (amplitude / np.sqrt(np.mean(f[3] ** 2)))
+    du, drho = _random_modes(grid, seed, max_mode, amplitude, float(np.sum(rho * theta) / np.sum(rho)))
     drho -= np.sum(rho * drho) / np.sum(rho)
     new_rho = rho * (1.0 + drho)
     new_u = u + du

@@ -40,24 +40,16 @@ def write_vti(path: str | Path, grid: Grid, fields: dict[str, np.ndarray], time:
         vtype = _VTK_TYPES.get(f.dtype, "Float64")
         f = f.astype(np.float64 if vtype == "Float64" else np.float32, copy=False)
         if f.shape == tuple(grid.cells):
-            data = f.reshape(cells).transpose(2, 1, 0)  # VTK: x fastest
-            ncomp = 1
+            data, ncomp = f.reshape(cells).transpose(2, 1, 0), 1  # VTK: x fastest
         elif f.shape == (3, *grid.cells):
-            data = np.moveaxis(f.reshape((3, *cells)), 0, -1).transpose(2, 1, 0, 3)
-            ncomp = 3
+            data, ncomp = np.moveaxis(f.reshape((3, *cells)), 0, -1).transpose(2, 1, 0, 3), 3
         else:
             raise InputError(f"field {name!r} has shape {f.shape}; expected {grid.cells} or (3, *{grid.cells})")
-        arrays.append(
-            f'        <DataArray type="{vtype}" Name="{name}" NumberOfComponents="{ncomp}" format="binary">\n'
-            f"          {_b64(data)}\n        </DataArray>"
-        )
-    field_data = ""
-    if time is not None:
-        t = np.array([time], dtype=np.float64)
-        field_data = (
-            '    <FieldData>\n      <DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" format="binary">'
-            f"{_b64(t)}</DataArray>\n    </FieldData>\n"
-        )
+        arrays.append(f'        <DataArray type="{vtype}" Name="{name}" NumberOfComponents="{ncomp}" format="binary">\n'
+                      f"          {_b64(data)}\n        </DataArray>")
+    field_data = "" if time is None else (
+        '    <FieldData>\n      <DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" format="binary">'
+        f"{_b64(np.array([time], dtype=np.float64))}</DataArray>\n    </FieldData>\n")
     xml = (
         '<?xml version="1.0"?>\n'
         '<VTKFile type="ImageData" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n'
@@ -100,13 +92,11 @@ _CHECKPOINT_KEYS = ("format", "hash", "U", "t", "steps", "output_index", "histor
 
 def _content_hash(U: np.ndarray, t: float, steps: int, output_index: int, history: str, config: str) -> str:
     """SHA-256 of everything a checkpoint holds (state bytes, shape, dtype, counters, history, config)."""
-    h = hashlib.sha256()
     head = {"format": CHECKPOINT_FORMAT, "shape": list(U.shape), "dtype": U.dtype.str, "t": float(t).hex(),
             "steps": int(steps), "output_index": int(output_index)}
-    h.update(json.dumps(head, sort_keys=True).encode())
-    h.update(np.ascontiguousarray(U).tobytes())
-    h.update(history.encode())
-    h.update(config.encode())
+    h = hashlib.sha256(json.dumps(head, sort_keys=True).encode())
+    for part in (np.ascontiguousarray(U).tobytes(), history.encode(), config.encode()):
+        h.update(part)
     return h.hexdigest()
 
 

@@ -18,6 +18,7 @@ from any checkpoint reproduces the uninterrupted run bit for bit.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import json
@@ -187,10 +188,8 @@ class Simulation:
             return None
         devices = jax.devices()
         if len(devices) < ndev:
-            raise InputError(
-                f"field parallel.devices = {ndev}: only {len(devices)} JAX device(s) available "
-                "(on CPU set XLA_FLAGS=--xla_force_host_platform_device_count=N before starting Python)"
-            )
+            raise InputError(f"field parallel.devices = {ndev}: only {len(devices)} JAX device(s) available "
+                             "(on CPU set XLA_FLAGS=--xla_force_host_platform_device_count=N before starting Python)")
         if self.grid.cells[0] % ndev:
             raise InputError(f"field parallel.devices = {ndev} must divide grid.cells[0] = {self.grid.cells[0]}")
         mesh = jax.sharding.Mesh(np.array(devices[:ndev]), ("x",))
@@ -243,11 +242,7 @@ class Simulation:
         it to simulate Ctrl-C).  ``resume`` is a checkpoint of the same config (harmless
         changes allowed: see :data:`RESUMABLE_CHANGES`).  With ``write_files`` the output folder
         is locked for the run; a fresh run refuses a folder holding another run's files unless
-        ``overwrite`` (which deletes them).
-
-        SIGINT/SIGTERM stop the run between compiled chunks: the checkpoint then written
-        matches the outputs on disk, and :class:`~ktgf.solver.interrupt.Interrupted` (a
-        KeyboardInterrupt) is raised.
+        ``overwrite`` (which deletes them).  SIGINT/SIGTERM: see the module docstring.
         """
         from .outdir import RunLock
 
@@ -256,14 +251,8 @@ class Simulation:
         with STOP:
             if STOP.requested:
                 raise Interrupted("interrupted before the run started; nothing written", exit_code=STOP.exit_code)
-            lock = RunLock(self.directory) if write_files else None
-            if lock is not None:
-                lock.acquire()
-            try:
+            with RunLock(self.directory) if write_files else contextlib.nullcontext():
                 return self._run(resume, progress, on_chunk, write_files, overwrite)
-            finally:
-                if lock is not None:
-                    lock.release()
 
     def _run(self, resume: str | Path | None, progress: bool, on_chunk: Callable[[dict[str, Any]], None] | None,
              write_files: bool, overwrite: bool) -> Any:
@@ -277,17 +266,14 @@ class Simulation:
             U, t, steps, k = self.initial_state(), 0.0, 0, 0
             status = int(state_status(tuple(U), self.phys))
             if status:
-                raise InputError(
-                    f"initial state: {STATUS_MESSAGES[status]} (phi_stop = {self.phys.phi_stop:g}); "
-                    "reduce initial.amplitude or raise numerics.phi_stop"
-                )
+                raise InputError(f"initial state: {STATUS_MESSAGES[status]} (phi_stop = {self.phys.phi_stop:g}); "
+                                 "reduce initial.amplitude or raise numerics.phi_stop")
             history = {name: [] for name in self.history_keys}
         self.history = history
         ckpt = self.directory / CHECKPOINT
         bar = _Progress(progress, self.output_times[-1], self.t_haff, self.phys, self.phi0, self.theta0,
                         case=self.case.name, shear_rate=shear_rate(self.grid))
         chunks = 0
-        first_chunk = True
         try:
             with bar:
                 while k < n_out:
@@ -301,22 +287,20 @@ class Simulation:
                             U, t, target, self.cfg.time.max_steps_per_call, self.grid, self.phys, self.num
                         )
                         n, status = int(n), int(status)
-                        if status != 0:
-                            U, t, steps = U_new, float(t_new), steps + n
-                            self._fail(U, t, float(dt), steps, status, k, history, ckpt, write_files)
                         U, t, steps = U_new, float(t_new), steps + n
+                        if status != 0:
+                            self._fail(U, t, float(dt), steps, status, k, history, ckpt, write_files)
                         chunks += 1
                         wall = _time.perf_counter() - wall
-                        if not first_chunk:  # the first call includes the compilation
+                        if chunks > 1:  # the first call includes the compilation
                             self.wall_stepping, self.steps_timed = self.wall_stepping + wall, self.steps_timed + n
-                        first_chunk = False
                         bar.update(t, n, wall)
                         if on_chunk is not None:
                             on_chunk({"t": t, "steps": steps, "output_index": k})
                         fault_hook("chunk", chunks)
                     self._poll()
                     self._record(U, t, history)
-                    if self._steady(history):  # the last output: its fields and checkpoint are written
+                    if self.steady_summary(history)["reached"]:  # the last output: its files are written
                         self.output_times = self.output_times[:k + 1]
                         n_out = k + 1
                     if write_files:
@@ -367,12 +351,6 @@ class Simulation:
                 with atomic_path(self.directory / VERIFICATION_FILE) as tmp:
                     tmp.write_text(json.dumps(self.verification, indent=2) + "\n")
         return ds
-
-    def _steady(self, history: dict[str, list]) -> bool:
-        """True when ``time.steady_tol`` is set and the last output is steady (:meth:`~.cases.Case.steady_change`)."""
-        tol = self.cfg.time.steady_tol
-        change = self.case.steady_change(history) if tol is not None else None
-        return change is not None and change < tol
 
     def steady_summary(self, history: dict[str, list]) -> dict[str, Any]:
         """The steady-state stop: tolerance, whether it was met, the last change and the time [s]."""
@@ -553,13 +531,12 @@ class Simulation:
         from ..io import run_metadata
 
         t = np.asarray(history["time"], dtype=float)
-        theta_haff = self.theta0 / (1.0 + t / self.t_haff) ** 2
         data = {name: ("time", np.asarray(history[name], dtype=float)) for name in SCALARS}
         data.update({name: (("time", "axis"), np.asarray(history[name], dtype=float).reshape(len(t), -1))
                      for name in PER_AXIS})
         cooling = self.case.hcs
         if cooling:
-            data["theta_haff"] = ("time", theta_haff)
+            data["theta_haff"] = ("time", self.theta0 / (1.0 + t / self.t_haff) ** 2)
         coords = {"time": t, "axis": list("xyz"[: self.grid.ndim])}
         for name in self.case.columns:
             values = np.asarray(history[name], dtype=float)

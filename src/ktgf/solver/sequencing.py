@@ -146,13 +146,11 @@ def _slopes(f: np.ndarray, axis: int, periodic: bool, limiter: str = "minmod") -
     d = np.diff(f, axis=axis)
     n = f.shape[axis]
     if periodic:
-        wrap = np.take(f, [0], axis=axis) - np.take(f, [n - 1], axis=axis)
-        left = np.concatenate([wrap, d], axis=axis)    # f_i − f_{i−1}
-        right = np.concatenate([d, wrap], axis=axis)   # f_{i+1} − f_i
+        first = last = np.take(f, [0], axis=axis) - np.take(f, [n - 1], axis=axis)  # across the wrap
     else:
         first, last = np.take(d, [0], axis=axis), np.take(d, [n - 2], axis=axis)
-        left = np.concatenate([first, d], axis=axis)
-        right = np.concatenate([d, last], axis=axis)
+    left = np.concatenate([first, d], axis=axis)    # f_i − f_{i−1}
+    right = np.concatenate([d, last], axis=axis)   # f_{i+1} − f_i
     if limiter == "central":
         return 0.5 * (left + right)
     return np.where(left * right > 0.0, np.sign(left) * np.minimum(np.abs(left), np.abs(right)), 0.0)

@@ -2,19 +2,8 @@
 
 ``advance`` runs whole steps inside one compiled ``lax.while_loop`` until a target time, a
 step budget, or the first step that leaves the physical state space — that step is not
-accepted, so the returned state is the last good one and ``status`` says what went wrong:
-
-====== =======================================
-status meaning
-====== =======================================
-0      fine
-1      NaN or infinity in a field
-2      θ ≤ 0 somewhere
-3      φ ≥ phi_stop (approaching packing) somewhere
-4      ρ ≤ 0 somewhere
-5      the stable time step collapsed (Δt ≤ 0 or NaN)
-6      an implicit stage solve did not converge (IMEX)
-====== =======================================
+accepted, so the returned state is the last good one and ``status`` says what went wrong
+(a key of :data:`STATUS_MESSAGES`, 0: fine).
 
 Schemes (``Numerics.scheme``):
 
@@ -138,20 +127,15 @@ class Numerics:
     def __post_init__(self) -> None:
         from ..errors import InputError
 
-        if self.limiter not in LIMITERS:
-            raise InputError(f"limiter {self.limiter!r} is not valid: choose one of {LIMITERS}")
-        if self.riemann not in RIEMANN_SOLVERS:
-            raise InputError(f"riemann solver {self.riemann!r} is not valid: choose one of {RIEMANN_SOLVERS}")
-        if self.scheme not in SCHEMES:
-            raise InputError(f"time scheme {self.scheme!r} is not valid: choose one of {SCHEMES}")
-        if self.acoustics not in ACOUSTICS:
-            raise InputError(f"acoustics {self.acoustics!r} is not valid: choose one of {ACOUSTICS}")
-        if self.acoustics == "implicit" and self.scheme != "imex":
-            raise InputError(f"acoustics 'implicit' needs the imex scheme (got scheme {self.scheme!r})")
-        if self.sink not in SINKS:
-            raise InputError(f"sink {self.sink!r} is not valid: choose one of {SINKS}")
-        if self.sink == "implicit" and self.scheme != "imex":
-            raise InputError(f"sink 'implicit' needs the imex scheme (got scheme {self.scheme!r})")
+        options = {"limiter": (self.limiter, LIMITERS), "riemann solver": (self.riemann, RIEMANN_SOLVERS),
+                   "time scheme": (self.scheme, SCHEMES), "acoustics": (self.acoustics, ACOUSTICS),
+                   "sink": (self.sink, SINKS)}
+        for what, (value, valid) in options.items():
+            if value not in valid:
+                raise InputError(f"{what} {value!r} is not valid: choose one of {valid}")
+        for what in ("acoustics", "sink"):
+            if getattr(self, what) == "implicit" and self.scheme != "imex":
+                raise InputError(f"{what} 'implicit' needs the imex scheme (got scheme {self.scheme!r})")
 
 
 def explicit_coefficients(r: Any, num: Numerics) -> Any:
