@@ -25,9 +25,9 @@ def run(
 
     Examples: examples/hcs_3d.toml (cooling box), uniform_shear.toml, uniform_shear_dense.toml (64³,
     φ 0.55), frictional_shear.toml (μ 0.5), couette_2d.toml, couette_dense.toml (φ 0.5, 64 cells
-    across the gap), couette_dense_3d.toml (64³, from couette_dense's result, in minutes),
-    couette_dense055.toml → couette_dense055_3d.toml (the same at φ 0.55), couette_dense_seq32.toml
-    → _seq64 → _seq128 (φ 0.55, grid sequencing to 128 cells), chute_2d.toml; time.steady_tol stops a
+    across the gap), couette_dense_3d.toml (64³ from couette_dense's result; runs couette_dense first),
+    couette_dense055.toml → couette_dense055_3d.toml (the same at φ 0.55: ≈ 9 min from a uniform start),
+    couette_dense_seq32.toml → _seq64 → _seq128 (φ 0.55, grid sequencing to 128 cells), chute_2d.toml; time.steady_tol stops a
     sheared run at its steady state; initial.from_run starts from an earlier run mapped onto the grid
     (from_run = "earlier.toml": that config is run first, or resumed, or reused if complete).
 
