@@ -100,3 +100,9 @@ def test_a_missing_earlier_config_and_a_config_source_outside_a_chain_are_refuse
     assert "\n" not in str(exc.value)
     with pytest.raises(InputError, match="is a run configuration: run the chain with ktgf run"):
         Simulation(load_config(last))
+    # a chain that returns to itself, found before anything runs
+    (tmp_path / "a.toml").write_text(last.read_text().replace('from_run = "a.toml"', 'from_run = "b.toml"'))
+    (tmp_path / "b.toml").write_text(last.read_text())
+    with pytest.raises(InputError, match="the chain returns to") as exc:
+        run_chain(last, progress=False)
+    assert "\n" not in str(exc.value) and not (tmp_path / "a_run").exists()
