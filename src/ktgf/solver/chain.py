@@ -70,20 +70,20 @@ def _stage_state(sim: Simulation) -> str:
 
 
 def run_chain(path: str | Path, output_dir: str | Path | None = None, resume: str | Path | None = None,
-              progress: bool = True, overwrite: bool = False, last: bool = True,
-              after: tuple[Path, ...] = ()) -> tuple[Simulation, Any]:
+              progress: bool = True, overwrite: bool = False, after: tuple[Path, ...] = ()) -> tuple[Simulation, Any]:
     """Run the configuration in ``path`` after the chain of earlier configurations it starts from (module
     docstring); returns its :class:`~.run.Simulation` and the Dataset of :meth:`~.run.Simulation.run` (None for
     an earlier stage found complete).  ``output_dir``, ``resume`` and ``overwrite`` are those of
     :meth:`~.run.Simulation.run` for this last stage (``overwrite`` also clears an earlier stage's folder that
     holds another run).  Ctrl-C in an earlier stage raises :class:`~.interrupt.Interrupted` with no checkpoint
-    to resume by hand: running the chain again continues that stage."""
-    here = Path(path).resolve()
-    if here in after:  # ``after``: the stages that start from this one, last first
+    to resume by hand: running the chain again continues that stage.  ``after``: the stages that start from
+    this one, the last first (empty: this is the last stage)."""
+    here, last = Path(path).resolve(), not after
+    if here in after:
         raise InputError(f"field initial.from_run: the chain returns to {str(path)!r} (a stage cannot start from "
                          "itself or a later stage)")
     cfg = stage_config(path, lambda earlier: run_chain(earlier, progress=progress, overwrite=overwrite,
-                                                         last=False, after=(*after, here))[0].directory)
+                                                         after=(*after, here))[0].directory)
     sim = Simulation(cfg, output_dir)
     state = "new" if last else _stage_state(sim)
     if not last:  # one line per earlier stage (INFO on the ktgf logger: the CLI shows it)
