@@ -199,6 +199,53 @@ def test_frictional_couette_keeps_the_1d_solution_within_one_percent() -> None:
     run_from_profile_within_one_percent(sim, ref, phi0)
 
 
+@pytest.mark.analytic
+@pytest.mark.slow
+def test_frictional_walls_keep_the_1d_solution_of_a_dense_cell() -> None:
+    """JJ walls with δ_w = 30° (``frictional`` μ = 0.5, e = 0.7, Schaeffer, φ̄ = 0.57: the wall layer at φ 0.54 has
+    p_f 11 % of p), 128 cells, IMEX, strain 10 from the 1D profile: the wall traction raises the 1D wall stress by
+    17 % over δ_w = 0; the 3D run keeps the 1D profile and stress.  Measured at 64 / 128 / 256 cells: θ 4.4 / 1.6 /
+    0.54 %, wall stress 1.95 / 1.29 / 0.65 %, u 0.09 / 0.44 / 0.29 %, φ 0.13 / 0.05 / 0.03 % (θ second order at
+    most, the stress first: also without wall friction at 128 cells, 1.3 %), so 2 % in θ and stress at 128 cells,
+    1 % in u, φ.  53 s wall idle."""
+    import dataclasses
+
+    from helpers.couette_case import couette_case as _couette
+    from helpers.couette_case import parse as _parse
+
+    from ktgf.couette.geometry import PlanarCell
+    from ktgf.couette.run import Material, run
+    from ktgf.solver.cases.couette import couette_reference
+    from ktgf.solver.run import Simulation
+
+    n, phi0 = 128, 0.57
+    text = _couette([n], 10.0).replace('name = "ret"\nrestitution = 0.9', 'name = "frictional"\nrestitution = 0.7\n'
+                                        'options = { mu = 0.5, stress = "schaeffer" }')
+    text = text.replace("solid_fraction = 0.3", f"solid_fraction = {phi0}").replace(
+        "restitution = 0.9 }", "restitution = 0.9, friction_angle = 30.0 }")
+    sim = Simulation(_parse(text))
+    ref = couette_reference(sim.phys, sim.grid, phi0)
+    smooth = dataclasses.replace(sim.grid.boundaries.walls[0][0].wall, friction_angle=0.0)
+    material = Material(float(sim.phys.diameter), float(sim.phys.material_density), float(sim.phys.restitution))
+    ref0 = run(sim.phys.model, PlanarCell(sim.grid.lengths[0], 1.0), smooth, smooth, phi0, material, n_cells=400,
+               stretch=1.5)
+    tau_ref, tau_smooth = float(ref["wall_shear_stress"].values[1]), float(ref0["wall_shear_stress"].values[1])
+    assert tau_ref > 1.15 * tau_smooth
+    y = sim.grid.centres(0) - 0.5 * sim.grid.lengths[0]
+    u = np.zeros((3, n))
+    u[1] = np.interp(y, ref["y"].values, ref["u"].values)
+    with sim.precision():
+        rho_s = sim.phys.material_density
+        U0 = conservative(jnp.asarray(rho_s * np.interp(y, ref["y"].values, ref["phi"].values)), jnp.asarray(u),
+                          jnp.asarray(np.interp(y, ref["y"].values, ref["theta"].values)))
+        U0 = U0 * (phi0 * rho_s * n / float(U0[0].sum()))
+    sim.initial_state = lambda: sim.place(U0)
+    sim.run(progress=False, write_files=False)
+    err, tau = sim.verification["max_rel_error"], sim.verification["wall_shear_stress_Pa"]["run"]
+    assert err["u"] < 0.01 and err["phi"] < 0.01 and err["theta"] < 0.02, err
+    assert all(abs(t / tau_ref - 1.0) < 0.02 for t in tau), (tau, tau_ref)
+
+
 # --- 5. configs --------------------------------------------------------------------------------------
 
 def _config(case: str, options: str = "", extra: str = "") -> dict:
@@ -258,15 +305,14 @@ def test_what_the_3d_solver_still_refuses_is_one_line_naming_it(case: str, optio
     assert "\n" not in msg and field in msg, msg
 
 
-@pytest.mark.contract
-def test_a_frictional_wall_is_refused_in_3d() -> None:
-    data = tomllib.loads("""
+def _rough_wall_config(options: str, momentum: str = "johnson-jackson") -> dict:
+    return tomllib.loads(f"""
 [case]
 kind = "couette"
 [model]
 name = "frictional"
 restitution = 0.7
-options = { stress = "schaeffer" }
+options = {{ {options} }}
 [initial]
 solid_fraction = 0.4
 temperature = 1e-3
@@ -275,12 +321,73 @@ perturbation = "none"
 cells = [8]
 length_d = 10.0
 [boundaries]
-x = { kind = "wall", flow = "y", wall_speed = 1.0, walls = { type = "johnson-jackson", specularity = 0.1, restitution = 0.9, friction_angle = 20.0 } }
+x = {{ kind = "wall", flow = "y", wall_speed = 1.0, walls = {{ type = "{momentum}", specularity = 0.1, restitution = 0.9, friction_angle = 20.0 }} }}
 [time]
 end = 1.0
 unit = "strain"
 """)
+
+
+@pytest.mark.contract
+@pytest.mark.parametrize("options, momentum", [("", "johnson-jackson"), ('stress = "schaeffer"', "zero-flux")])
+def test_a_frictional_wall_needs_a_frictional_stress_and_a_johnson_jackson_wall(options: str, momentum: str) -> None:
+    """The wall traction p_f tan δ_w acts on the frictional normal stress, as in the 1D Couette solver."""
     with pytest.raises(InputError) as exc:
-        parse_config(data)
+        parse_config(_rough_wall_config(options, momentum))
     msg = str(exc.value)
-    assert "\n" not in msg and "friction_angle" in msg, msg
+    assert "\n" not in msg and "friction_angle = 20" in msg and "model.options.stress" in msg, msg
+    walls = parse_config(_rough_wall_config('stress = "schaeffer"')).boundaries.x.walls.build_pair()
+    assert [w.friction_angle for w in walls] == [20.0, 20.0]
+
+
+@pytest.mark.analytic
+@pytest.mark.parametrize("slip_components", [1, 2])
+def test_the_frictional_wall_ghost_makes_the_wall_stress_the_johnson_jackson_traction(slip_components: int) -> None:
+    """With δ_w > 0 the central viscous flux through each wall face is c u_sl + p_f tan δ_w u_sl/√(|u_sl|² + s²)
+    (s = ε_w U) at the face slip, the collisional part c and the traction from ktgf.couette.walls, the 1D solver's
+    functions; the heat flux keeps D − c|u_sl|² (the frictional work is lost at the wall contacts).  Two slip
+    components: the traction is along the slip vector.  The wall layers are dense (φ ≈ 0.53), so p_f > 0."""
+    from ktgf.couette.walls import Wall, jj_dissipation, jj_friction, jj_frictional_wall_stress
+    from ktgf.solver.boundaries import WallSide, pad, wall_terms
+    from ktgf.solver.run import _x64
+
+    m = get_model("frictional", mu=0.5, stress="schaeffer")
+    phys = Physics(m, E, D, RHO_S, 0.99 * m.phi_max)
+    wall = Wall(specularity=0.3, restitution=0.8, friction_angle=25.0, slip_regularisation=0.005)
+    speed = 0.5
+    walls = (WallSide(wall, (0.0, -speed, 0.0)), WallSide(wall, (0.0, speed, 0.0)))
+    grid = Grid((8,), (8 * D,), Boundaries(("wall",), flow=1, walls=(walls,)))
+    x = grid.centres(0) / (8 * D)
+    phi = 0.53 - 0.04 * x * (1.0 - x)
+    theta = 1e-4 * (1.0 + x)
+    u = np.zeros((3, 8))
+    u[1] = 0.8 * (x - 0.5) + 0.1 * x**3
+    if slip_components == 2:
+        u[2] = 0.3 * np.cos(3.0 * x)
+    with _x64(True):
+        rho = jnp.asarray(RHO_S * phi)
+        transport = phys.transport(rho, jnp.asarray(theta), phys.reduced(rho))
+        T = wall_terms(rho, [jnp.asarray(v) for v in u], jnp.asarray(theta), transport, grid, phys)
+        P = [np.asarray(f) for f in pad((rho, *(jnp.asarray(v) for v in u), jnp.asarray(theta)), grid, 2,
+                                        velocity=1, theta=4, walls=T)]
+        Pk = [np.asarray(f) for f in pad(transport, grid, 2)]
+        p_f = [float(m.friction.frictional_pressure(w, m.phi_max)) for w in (1.5 * phi[0] - 0.5 * phi[1],
+                                                                              1.5 * phi[-1] - 0.5 * phi[-2])]
+    h, s = grid.spacing[0], wall.slip_regularisation * 2.0 * speed
+    for side, (c, g) in enumerate(((2, 1), (-3, -2))):  # (wall cell, ghost) in the padded arrays
+        i = 0 if side == 0 else -1
+        phi_w = 1.5 * phi[i] - 0.5 * phi[i - 1 if side else 1]
+        theta_w = 1.5 * theta[i] - 0.5 * theta[i - 1 if side else 1]
+        chi = float(m.chi(phi_w))
+        c_jj = RHO_S * jj_friction(wall, phi_w, chi, theta_w)
+        slip = np.array([0.5 * (P[1 + j][c] + P[1 + j][g]) - walls[side].velocity[j] for j in (1, 2)])
+        size = float(np.hypot(*slip))
+        assert p_f[side] > 0.0 and size > s
+        eta, kap = (0.5 * (Pk[k][c] + Pk[k][g]) for k in (0, 2))
+        stress = np.array([eta * (P[1 + j][c] - P[1 + j][g]) / h for j in (1, 2)])
+        traction = jj_frictional_wall_stress(wall, p_f[side], size, s) / size * slip
+        np.testing.assert_allclose(stress, c_jj * slip + traction, rtol=1e-10, atol=1e-12 * abs(stress).max())
+        assert np.abs(traction).max() > 0.1 * np.abs(stress).max()  # the traction matters here
+        heat_out = kap * (P[4][c] - P[4][g]) / h
+        np.testing.assert_allclose(heat_out, RHO_S * jj_dissipation(wall, phi_w, chi, theta_w) - c_jj * size**2,
+                                   rtol=1e-10)

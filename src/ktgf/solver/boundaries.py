@@ -54,6 +54,7 @@ are frozen with the transport coefficients (at the sweep's θ), so D is linear i
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -246,14 +247,46 @@ def wall_face(f: Any, axis: int, n: int, side: int) -> Any:
     return 0.5 * (layers[0] + _extrapolated(layers, 1, positive=True)[0])
 
 
-def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any], grid: Any, phys: Any) -> dict:
+def frictional_wall_coefficient(wall: Any, ws: WallSide, pair: Any, phi_w: Any, phys: Any, uc: Sequence[Any],
+                                beta: Any, c: Any, a: int) -> Any:
+    """The frictional part c_f of a Johnson–Jackson wall's shear coefficient, wall stress = (c + c_f) u_sl.
+
+    The frictional wall traction p_f tan δ_w u_sl/√(|u_sl|² + s²) (:func:`ktgf.couette.walls.jj_frictional_wall_stress`,
+    s = ε_w |U_upper − U_lower|, p_f = w p_f at the wall's φ) makes the face condition η_f(u_c − u_f)/(Δ/2) =
+    c u_sl + p_f tan δ_w u_sl/√(|u_sl|² + s²) nonlinear.  The slip u_sl is parallel to v = u_c − U_w (tangential),
+    so its size σ is the root of f(σ) = (β + c)σ + Pσ/√(σ² + s²) − β|v| (β = 2η_f/Δ, P = p_f tan δ_w): f rises
+    and is concave for σ ≥ 0, so Newton from σ = β|v|/(β + c) ≥ root moves below the root once and then rises to it
+    monotonically.  Returns c_f = P/√(σ² + s²) at that root, so the ghost cell of :func:`_wall_ghosts` makes the
+    discrete wall stress exactly the condition's.
+    """
+    model = phys.model
+    P = model.friction.frictional_pressure(phi_w, model.phi_max) * math.tan(math.radians(wall.friction_angle))
+    dU = [pair[1].velocity[j] - pair[0].velocity[j] for j in range(3)]
+    s2 = (wall.slip_regularisation ** 2) * sum(d * d for d in dU)
+    v = jnp.sqrt(sum((uc[j] - ws.velocity[j]) ** 2 for j in range(3) if j != a))
+    target = beta * v
+
+    def newton(_: int, sigma: Any) -> Any:
+        root = jnp.sqrt(sigma * sigma + s2)
+        f = (beta + c) * sigma + P * sigma / root - target
+        return jnp.maximum(sigma - f / (beta + c + P * s2 / root**3), 0.0)
+
+    sigma = jax.lax.fori_loop(0, 40, newton, target / (beta + c))
+    return P / jnp.sqrt(sigma * sigma + s2)
+
+
+def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any], grid: Any, phys: Any,
+               frozen: dict | None = None) -> dict:
     """Ghost-cell coefficients of every wall, from the state (θ: the temperature of the coefficients).
 
     Per (axis, side): ``ratio``, ``offset`` (3 components) with u_ghost = ratio_j u_c + offset_j;
     ``heat`` = (a, g) with θ_ghost = θ_c − Δ(a θ_w − g)/κ_f, θ_w = (3θ_0 − θ_1)/2, a = D/θ_w and
     g = G (κ_f, and η_f in the velocity ghosts, are the wall-face coefficients the fluxes use);
-    ``stress`` = η∂u/∂n = c(u_f − U_w) and ``slip`` = u_f − U_w per component (diagnostics).
-    The coefficients depend on ``theta`` and on u; :func:`pad` applies them.
+    ``stress`` = η∂u/∂n = c(u_f − U_w) and ``slip`` = u_f − U_w per component (diagnostics);
+    ``c_friction``: the frictional part of c (:func:`frictional_wall_coefficient`; walls with δ_w > 0).
+    The coefficients depend on ``theta`` and on u; :func:`pad` applies them.  ``frozen``: earlier terms whose
+    ``c_friction`` is kept (an implicit stage updates the heat terms after its momentum solve and keeps the
+    momentum operator it solved with).
     """
     from ..couette.walls import jj_dissipation, jj_friction
 
@@ -270,16 +303,21 @@ def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any],
             theta_w = jnp.clip(1.5 * t0 - 0.5 * t1, 0.5 * t0, 2.0 * t0)
             chi = phys.model.chi(phi_w)
             beta = 2.0 * wall_face(eta, a, n, side) / h  # the face η of the viscous flux
+            uc = [_side(x, a, n, side, 0) for x in u]
             if wall.momentum == "johnson-jackson":
-                c = rho_s * jj_friction(wall, phi_w, chi, theta_w)
+                c = c_collision = rho_s * jj_friction(wall, phi_w, chi, theta_w)
+                if wall.friction_angle > 0.0:
+                    c_friction = (frozen[a, side]["c_friction"] if frozen is not None else
+                                  frictional_wall_coefficient(wall, ws, bc.walls[a], phi_w, phys, uc, beta, c, a))
+                    c = c + c_friction
                 ratio_t, weight = (beta - c) / (beta + c), 2.0 * c / (beta + c)
             elif wall.momentum == "prescribed":
                 ratio_t, weight, c = -jnp.ones_like(beta), 2.0 * jnp.ones_like(beta), None
             else:
                 ratio_t, weight, c = jnp.ones_like(beta), jnp.zeros_like(beta), jnp.zeros_like(beta)
+                c_collision = c
             ratio = tuple(-jnp.ones_like(beta) if j == a else ratio_t for j in range(3))
             offset = tuple(jnp.zeros_like(beta) if j == a else weight * ws.velocity[j] for j in range(3))
-            uc = [_side(x, a, n, side, 0) for x in u]
             u_face = [0.5 * (uc[j] * (1.0 + ratio[j]) + offset[j]) for j in range(3)]
             slip = tuple(jnp.zeros_like(beta) if j == a else u_face[j] - ws.velocity[j] for j in range(3))
             if c is None:  # no slip: the stress is the viscous one, η(u_c − u_f)/(Δ/2) toward the medium
@@ -288,7 +326,8 @@ def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any],
                 stress = tuple(c * s_ for s_ in slip)
             if wall.energy == "johnson-jackson":
                 d_over_theta = rho_s * jj_dissipation(wall, phi_w, chi, theta_w) / theta_w
-                work = sum(st * sl for st, sl in zip(stress, slip)) if c is not None else jnp.zeros_like(beta)
+                # the slip work of the collisions only: the frictional traction's is dissipated at the wall contacts
+                work = (sum(c_collision * sl * sl for sl in slip) if c is not None else jnp.zeros_like(beta))
                 heat = ("jj", d_over_theta, work)
             elif wall.energy == "prescribed":
                 heat = ("fixed", jnp.full_like(beta, wall.temperature), jnp.zeros_like(beta))
@@ -296,6 +335,8 @@ def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any],
                 heat = ("adiabatic", jnp.zeros_like(beta), jnp.zeros_like(beta))
             out[a, side] = {"ratio": ratio, "offset": offset, "heat": heat[1:], "stress": stress, "slip": slip,
                             "kappa": wall_face(kappa, a, n, side)}
+            if wall.friction_angle > 0.0:
+                out[a, side]["c_friction"] = c_friction
     return out
 
 

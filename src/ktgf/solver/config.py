@@ -269,9 +269,12 @@ def _check_friction(cfg: Config, model: Any, source: str) -> None:
             raise InputError(f"{source}: field model.options.mu: {exc}") from None
     wall = cfg.boundaries.wall_axis()  # check_case: only on a case between walls
     walls = getattr(cfg.boundaries, wall).walls if wall else None
-    if walls is not None and any((w.friction_angle or 0.0) > 0.0 for w in walls.build_pair()):
-        raise InputError(f"{source}: field boundaries.{wall}.walls.friction_angle: the 3D solver's walls have no "
-                         "frictional wall stress (valid: 0; it is in the 1D Couette solver, docs/friction.md §8)")
+    rough = [w for w in (walls.build_pair() if walls is not None else ()) if w.friction_angle > 0.0]
+    if rough and not (model.friction.has_stress and all(w.momentum == "johnson-jackson" for w in rough)):
+        # the JJ frictional wall traction is p_f tan δ_w: it needs a frictional normal stress p_f
+        raise InputError(f"{source}: field boundaries.{wall}.walls.friction_angle = {rough[0].friction_angle:g} acts on "
+                         "the frictional normal stress: valid > 0 only with a johnson-jackson momentum wall and a model "
+                         "with a frictional stress (model.options.stress)")
 
 
 def check_physics(cfg: Config, source: str = "config") -> None:

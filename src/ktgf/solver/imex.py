@@ -323,7 +323,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         c_f = [f[0] / 3.0 + lb for f, lb in zip(faces, lam_f)]
         kap_f = [f[2] for f in faces]
 
-        # Wall coefficients frozen with the transport ones (their momentum part does not depend on u).
+        # Wall coefficients frozen with the transport ones (a frictional wall's momentum part at the sweep's u).
         walls = wall_terms(rho, u, theta, transport, grid, phys) if has_walls(grid) else None
 
         def div_tau(v: tuple, affine: bool = False) -> list[Any]:
@@ -375,7 +375,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
                 + [0.0] * (3 - grid.ndim), d_m))
             rho, E_base, d_ref = rho_hat + adt * d_rho, E_hat + adt * d_E, div_f
         if walls is not None:  # the wall heat terms need the slip of the new u (at the operator's ρ)
-            walls = wall_terms(rho_op, u, theta, transport, grid, phys)
+            walls = wall_terms(rho_op, u, theta, transport, grid, phys, frozen=walls)
 
         def B(th: Any) -> Any:
             Pt = pad_fields((th,), grid, t, affine=False, theta=0, walls=walls)[0]
