@@ -1,4 +1,5 @@
-// CPU fast path of ktgf.solver.fluxes.flux_divergence on a fully periodic 3D grid (numerics only).
+// CPU fast path of ktgf.solver.fluxes.flux_divergence on a 3D grid (numerics only): periodic, or with the
+// ghost cells filled by the caller.
 //
 // Same formulas, in the same operation order, as the JAX functions of fluxes.py, except that the face
 // divergence multiplies by 1/dx where JAX divides (one rounding apart); the JAX path is the reference
@@ -80,6 +81,7 @@ struct Consts {
   T inv_dx[3];        // 1/dx_a (normal derivatives, face divergence)
   T half_inv_dx[3];   // 0.5/dx_a (central derivatives)
   T omega_factor[3];  // (1/dx_a)/rho_s
+  bool wrap2 = true;  // the ghost cells along z are periodic images (false: fields padded by the caller)
 };
 
 // Field f at the cell (i + d0, j + d1, q + d2) of the cell (i, j, q) at offset c of its plane, through a table of
@@ -388,13 +390,18 @@ KTGF_INLINE void sweep_rows(const T* const* P0, const T* const* P1, long nb, Row
     // the face below cell 0): the same inputs, so the same bits, and a whole number of vectors (no scalar tail).
     T* hz = r.hz.data() + 1;
     T* zf = r.zf.data() + 1;
-    row_slopes<T, 2, LIM>(P0, c0, k, hz, n2 + 2, 0, n2);
-    for (int f = 0; f < 7; ++f) {
-      hz[f * (n2 + 2) - 1] = hz[f * (n2 + 2) + n2 - 1];
-      hz[f * (n2 + 2) + n2] = hz[f * (n2 + 2)];
+    if (k.wrap2) {
+      row_slopes<T, 2, LIM>(P0, c0, k, hz, n2 + 2, 0, n2);
+      for (int f = 0; f < 7; ++f) {
+        hz[f * (n2 + 2) - 1] = hz[f * (n2 + 2) + n2 - 1];
+        hz[f * (n2 + 2) + n2] = hz[f * (n2 + 2)];
+      }
+      row_faces<T, 2, RIE, VISC>(P0, c0, k, hz, hz + 1, n2 + 2, zf, n2 + 1, 0);
+      for (int v = 0; v < 5; ++v) zf[v * (n2 + 1) - 1] = zf[v * (n2 + 1) + n2 - 1];
+    } else {  // the ghost cells' slopes and the face below cell 0 from the padded fields themselves
+      row_slopes<T, 2, LIM>(P0, c0, k, hz, n2 + 2, -1, n2 + 1);
+      row_faces<T, 2, RIE, VISC>(P0, c0, k, hz, hz + 1, n2 + 2, zf, n2 + 1, -1);
     }
-    row_faces<T, 2, RIE, VISC>(P0, c0, k, hz, hz + 1, n2 + 2, zf, n2 + 1, 0);
-    for (int v = 0; v < 5; ++v) zf[v * (n2 + 1) - 1] = zf[v * (n2 + 1) + n2 - 1];
     const T* lo[10];
     const T* hi[10];
     for (int v = 0; v < 5; ++v) {
@@ -526,13 +533,13 @@ ffi::Error grid_shape(const ffi::AnyBuffer& field, long* n) {
   return ffi::Error::Success();
 }
 
-// Checks that the first `count` RemainingArgs are cell fields of one precision and shape; their type in `type`.
-ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& type) {
-  if (state.size() < count) return ffi::Error::InvalidArgument("flux kernel: too few fields");
-  auto first = state.get<ffi::AnyBuffer>(0);
+// Checks that the `count` RemainingArgs from `from` on are cell fields of one precision and shape; their type in `type`.
+ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& type, size_t from = 0) {
+  if (state.size() < from + count) return ffi::Error::InvalidArgument("flux kernel: too few fields");
+  auto first = state.get<ffi::AnyBuffer>(from);
   if (!first.has_value()) return ffi::Error::InvalidArgument("flux kernel: no fields");
   type = first->element_type();
-  for (size_t i = 0; i < count; ++i) {
+  for (size_t i = from; i < from + count; ++i) {
     auto b = state.get<ffi::AnyBuffer>(i);
     if (!b.has_value() || b->element_type() != type || b->element_count() != first->element_count())
       return ffi::Error::InvalidArgument("flux kernel: the fields must be cell fields of one precision");
@@ -540,14 +547,26 @@ ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& ty
   return ffi::Error::Success();
 }
 
-// Pads the cell fields (the first NFIELD of `in`) into `work` and sweeps them with the output `o` (Rhs or Stage).
+// Sweeps the cell fields (the first NFIELD of `in`) on the grid of the output field `grid` with the output `o` (Rhs
+// or Stage): fields of the grid's shape are padded periodically into `work` first; fields of the padded shape
+// (GHOST more per side) are swept as they are, their ghost cells filled by the caller (walls, Lees-Edwards).
 template <class Out>
-ffi::Error run(ffi::RemainingArgs in, const double* params, Real* work, const Out& o) {
-  long n[3];
-  if (auto err = grid_shape(*in.get<ffi::AnyBuffer>(0), n); err.failure()) return err;
+ffi::Error run(ffi::RemainingArgs in, const ffi::AnyBuffer& grid, const double* params, Real* work, const Out& o) {
+  long n[3], m[3];
+  if (auto err = grid_shape(grid, n); err.failure()) return err;
+  if (auto err = grid_shape(*in.get<ffi::AnyBuffer>(0), m); err.failure()) return err;
+  const bool padded = m[0] == n[0] + 2 * GHOST && m[1] == n[1] + 2 * GHOST && m[2] == n[2] + 2 * GHOST;
+  if (!padded && (m[0] != n[0] || m[1] != n[1] || m[2] != n[2]))
+    return ffi::Error::InvalidArgument("flux kernel: the cell fields must have the grid's shape or the padded one");
   const int nfield = BUILT_VISCOUS ? NFIELD : GG + 1;
   std::vector<const Real*> fields(NFIELD, nullptr);
   for (int f = 0; f < nfield; ++f) fields[f] = in.get<ffi::AnyBuffer>(f)->typed_data<Real>();
+  if (padded) {
+    Consts<Real> k = consts(n, params);
+    k.wrap2 = false;
+    sweep<Real, KTGF_LIMITER, KTGF_RIEMANN, BUILT_VISCOUS>(fields.data(), k, o);
+    return ffi::Error::Success();
+  }
   pad<Real>(fields.data(), nfield, n, work);
   sweep_padded(n, params, work, o);
   return ffi::Error::Success();
@@ -567,7 +586,7 @@ ffi::Error flux_divergence(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, 
   const Rhs<Real> o{{d0->typed_data<Real>(), d1->typed_data<Real>(), d2->typed_data<Real>(), d3->typed_data<Real>(),
                      d4->typed_data<Real>()},
                     divu->typed_data<Real>()};
-  return run(in, params.typed_data(), work->typed_data<Real>(), o);
+  return run(in, *d0, params.typed_data(), work->typed_data<Real>(), o);
 }
 #else  // the stage kind
 // Cell programs (ktgf.solver.cell_program), by key: f(n, params, in[5], out[NFIELD + 2 + nlim]) over n cells,
@@ -817,14 +836,16 @@ ffi::Error ssprk_stage(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int3
     return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
   if (in.size() != NFIELD + 12)
     return ffi::Error::InvalidArgument("stage kernel: fields = (the 11 cell fields, U0 x5, Uk x5, s0, s1)");
-  ffi::DataType type;
-  if (auto err = same_fields(in, NFIELD + 12, type); err.failure()) return err;
+  ffi::DataType type, state_type;
+  if (auto err = same_fields(in, NFIELD, type); err.failure()) return err;
+  if (auto err = same_fields(in, 12, state_type, NFIELD); err.failure()) return err;
+  if (state_type != type) return ffi::Error::InvalidArgument("stage kernel: the fields must be of one precision");
   if (auto err = check_variant("KtgfSsprkStage", type, limiter, riemann, true); err.failure()) return err;
   const double* p = params.typed_data();
   Stage<Real> o = stage_output(p, in, NFIELD, NFIELD + 5, {u0, u1, u2, u3, u4});
   o.s0 = in.get<ffi::AnyBuffer>(NFIELD + 10)->typed_data<Real>();
   o.s1 = in.get<ffi::AnyBuffer>(NFIELD + 11)->typed_data<Real>();
-  return run(in, p, work->typed_data<Real>(), o);
+  return run(in, *in.get<ffi::AnyBuffer>(NFIELD), p, work->typed_data<Real>(), o);
 }
 
 // The cell program registered under `program`, checked against the precision of `type`.

@@ -9,9 +9,10 @@ generated from them (:mod:`.cell_program`), plane by plane as it sweeps, so a st
 first stage, before Δt is known, is :func:`rate_cells`: the rate L(U) and the maxima of the step-limit and
 state-check terms; :func:`cell_limits` is that reduction alone.
 
-It is used where it applies — CPU backend, one device, a 3D fully periodic grid, float32 or float64 — unless
-:data:`.fluxes.FLUX_KERNEL` is off (``KTGF_FLUX_KERNEL=0``).  The JAX path remains the reference and the path
-for GPUs, sharding, walls and Lees–Edwards boundaries.
+It is used where it applies — CPU backend, one device, a 3D grid, float32 or float64 — unless
+:data:`.fluxes.FLUX_KERNEL` is off (``KTGF_FLUX_KERNEL=0``).  With walls or Lees–Edwards boundaries the caller
+passes the fields padded and corrects the planes next to the boundary (:func:`.fluxes.kernel_fields`); the cell
+programs run on periodic grids only.  The JAX path remains the reference and the path for GPUs and sharding.
 
 Build: one shared library per :class:`Variant`, compiled when a solver first needs it (:func:`applies`) by
 :mod:`.cxx` into ``$KTGF_CACHE_DIR`` (default ``~/.cache/ktgf``) and kept there; ``-D`` macros choose the
@@ -167,9 +168,9 @@ def available() -> bool:
 
 def applies(grid: Any, dtype: Any, kind: str, limiter: str, riemann: str) -> bool:
     """Whether the variant (``dtype``, ``limiter``, ``riemann``, ``kind``) of the kernel can replace the JAX path
-    on ``grid`` (see the module docstring); builds it if needed."""
-    periodic = grid.boundaries is None or grid.boundaries.all_periodic
-    return (grid.ndim == 3 and periodic and jnp.dtype(dtype) in (jnp.float32, jnp.float64)
+    on ``grid`` (see the module docstring; other boundaries than periodic: the caller pads the fields,
+    :func:`.fluxes.kernel_fields`); builds it if needed."""
+    return (grid.ndim == 3 and jnp.dtype(dtype) in (jnp.float32, jnp.float64)
             and jax.default_backend() == "cpu" and jax.device_count() == 1
             and _usable(variant(dtype, limiter, riemann, kind)))
 
@@ -182,11 +183,14 @@ def _target(base: str, dtype: Any, limiter: str, riemann: str, kind: str) -> str
 
 
 def _cell_fields(W: Any, eos: Any, transport: Any, grid: Any, viscous: bool) -> tuple[list[Any], Any]:
-    """The kernel's 11 cell-field inputs and its workspace (their copies with periodic ghost cells)."""
+    """The kernel's 11 cell-field inputs and its workspace (their copies with periodic ghost cells; none if the
+    fields come padded)."""
     dtype = W[0].dtype
     fields = [jnp.asarray(f, dtype) for f in (*W, *eos)]
     # Non-viscous calls pass ρ in the unused transport slots (no copy; the kernel ignores them).
     fields += [jnp.asarray(f, dtype) for f in transport] if viscous else [fields[0]] * 4
+    if tuple(fields[0].shape) != tuple(grid.cells):
+        return fields, jax.ShapeDtypeStruct((1,), dtype)
     nfield = 11 if viscous else 7
     return fields, jax.ShapeDtypeStruct((nfield, *(n + 2 * GHOST for n in grid.cells)), dtype)
 

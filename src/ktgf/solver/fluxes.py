@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from types import SimpleNamespace
 from typing import Any
 
 import jax
@@ -287,8 +288,9 @@ def flux_divergence(W: Sequence[Any], coefficients: tuple[tuple[Any, ...], tuple
         from . import flux_kernel
 
         if flux_kernel.applies(grid, W[0].dtype, "rhs" if viscous else "euler", limiter, riemann):
-            return flux_kernel.flux_divergence(W, eos, transport, grid, phys.material_density, limiter, riemann,
-                                               viscous)
+            *fields, fix = kernel_fields(W, eos, transport, grid, phys, limiter, riemann, viscous, t)
+            dU, divu = flux_kernel.flux_divergence(*fields, grid, phys.material_density, limiter, riemann, viscous)
+            return add_boundary_fluxes(dU, fix, grid), divu
     P = pad_fields((*W, *eos), grid, t, velocity=1)
     Pk = pad_fields(transport, grid, t) if viscous else ()
     Pv = (pad_viscous(W, transport, grid, phys, t) if has_walls(grid) else P[:5]) if viscous else ()
@@ -310,3 +312,76 @@ def cell_divergence(Pu: Sequence[Any], grid: Grid) -> Any:
     """Central ∇·u at the cells (padded velocities)."""
     return sum((window(Pu[b], grid.cells, b, 1, 0) - window(Pu[b], grid.cells, b, -1, 0)) * (0.5 / grid.spacing[b])
                for b in range(grid.ndim))
+
+
+def kernel_fields(W: Sequence[Any], eos: Sequence[Any], transport: Sequence[Any], grid: Grid, phys: Physics,
+                  limiter: str, riemann: str, viscous: bool, t: Any = 0.0) -> tuple:
+    """The cell fields the C++ kernel sweeps (W, eos, transport) and the correction of its boundary planes.
+
+    A periodic grid: the fields as they are (the kernel pads them) and no correction (None).  Otherwise the
+    fields padded here as the JAX path pads them for its convective flux (:func:`pad_fields`), which the
+    kernel sweeps as they are, and (axis, {plane: five increments of −∇·F}) for the planes next to the
+    boundary, where the JAX path's fluxes differ from what the kernel computes from those ghost cells — each
+    difference from the same formulas on slabs one cell thick:
+
+    * Lees–Edwards: the lower boundary face takes the upper one mapped through the boundary
+      (:func:`.boundaries.lees_edwards_faces`);
+    * walls: the convective flux through a wall face is :func:`wall_flux`, and the viscous and heat fluxes of
+      the wall planes (through the wall face, and along the other axes, whose tangential derivatives reach the
+      ghost cells) see the ghost cells of the wall conditions (:func:`pad_viscous`).
+    """
+    bc = grid.boundaries
+    if bc is None or bc.all_periodic:
+        return W, eos, transport, None
+    rho_s = phys.material_density
+    P = pad_fields((*W, *eos), grid, t, velocity=1)
+    Pk = pad_fields(transport, grid, t) if viscous else ()
+    a = bc.shear_axis if bc.shear_axis is not None else bc.wall_axes[0]
+    n, inv_dx = grid.cells[a], 1.0 / grid.spacing[a]
+    slab = SimpleNamespace(cells=tuple(1 if b == a else c for b, c in enumerate(grid.cells)), spacing=grid.spacing,
+                           ndim=grid.ndim, lengths=grid.lengths, boundaries=bc)
+
+    def cut(fields: Sequence[Any], lo: int) -> list[Any]:  # cell lo and G neighbours per side along a
+        return [jax.lax.slice_in_dim(f, lo, lo + 2 * GHOST + 1, axis=a) for f in fields]
+
+    def face(F: Sequence[Any], k: int) -> list[Any]:
+        return [jax.lax.slice_in_dim(f, k, k + 1, axis=a) if jnp.ndim(f) else f for f in F]
+
+    def slab_faces(lo: int, walls: bool, Pv: Sequence[Any] | None = None) -> list[Any]:  # both faces along a
+        F = convective_flux(cut(P, lo), slab.cells, a, limiter, riemann, walls=walls)
+        if viscous:
+            F = [f + v for f, v in zip(F, viscous_flux(cut(P[:5] if Pv is None else Pv, lo), cut(Pk, lo), a, slab,
+                                                       rho_s))]
+        return F
+
+    if bc.shear_axis is not None:
+        own = face(slab_faces(0, False), 0)
+        pair = [jnp.concatenate([lo_, hi], axis=a) for lo_, hi in zip(own, face(slab_faces(n - 1, False), 1))]
+        mapped = face(lees_edwards_faces(pair, slab, a, t), 0)
+        return P[:5], P[5:], Pk if viscous else transport, (a, {0: [(m - f) * inv_dx for m, f in zip(mapped, own)]})
+    Pv = pad_viscous(W, transport, grid, phys, t) if viscous else None
+    fix = {}
+    for plane, k, sign in ((0, 0, 1.0), (n - 1, 1, -1.0)):
+        true, own = face(slab_faces(plane, True, Pv), k), face(slab_faces(plane, False), k)
+        d = [sign * (x - y) * inv_dx for x, y in zip(true, own)]
+        for b in range(grid.ndim) if viscous else ():
+            if b != a:  # the wall plane's viscous fluxes along b, with the viscous ghosts less with the convective
+                Fv = viscous_flux(cut(Pv, plane), cut(Pk, plane), b, slab, rho_s)
+                Fc = viscous_flux(cut(P[:5], plane), cut(Pk, plane), b, slab, rho_s)
+                dF = face_divergence(jnp.stack([x - y for x, y in zip(Fv[1:], Fc[1:])]), slab, b)
+                d = [d[0], *(x + y for x, y in zip(d[1:], dF))]
+        fix[plane] = d
+    return P[:5], P[5:], Pk if viscous else transport, (a, fix)
+
+
+def add_boundary_fluxes(fields: Sequence[Any], fix: Any, grid: Grid, scale: Any = 1.0) -> Any:
+    """``fields`` with ``scale`` × the boundary corrections ``fix`` = (axis, {plane: increments}) of
+    :func:`kernel_fields` added to those planes (unchanged for None)."""
+    if fix is None:
+        return fields
+    a, planes = fix
+    out = list(fields)
+    for plane, d in planes.items():
+        at = (slice(None),) * a + (slice(plane, plane + 1),)
+        out = [f.at[at].add(scale * c) for f, c in zip(out, d)]
+    return type(fields)(out)

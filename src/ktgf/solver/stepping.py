@@ -25,7 +25,8 @@ import jax
 import jax.numpy as jnp
 
 from .friction import cell_coefficients, explicit_part
-from .fluxes import LIMITERS, RIEMANN_SOLVERS, cell_divergence, flux_divergence, materialise, pad_fields
+from .fluxes import (LIMITERS, RIEMANN_SOLVERS, add_boundary_fluxes, cell_divergence, flux_divergence, kernel_fields,
+                     materialise, pad_fields)
 from .grid import Grid
 from .acoustics import MODES as ACOUSTICS
 from .acoustics import AcousticStage, advective_divergence, enthalpy
@@ -238,22 +239,31 @@ def dt_of_limits(lim: Any, num: Numerics) -> Any:
 
 def stage_kernel_applies(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> bool:
     """Whether an SSP-RK3 stage runs as one C++ kernel call (:func:`.flux_kernel.ssprk_stage`): where the
-    flux kernel's stage variant of ``num``'s limiter and Riemann solver applies (CPU, one device, 3D
-    periodic; built now if needed) and no body force adds a source of its own."""
+    flux kernel's stage variant of ``num``'s limiter and Riemann solver applies (CPU, one device, 3D; built
+    now if needed).  Boundaries other than periodic and a body force are corrections added to its output."""
     from . import flux_kernel, fluxes
 
-    return (fluxes.FLUX_KERNEL and fluxes.STAGE_KERNEL and phys.gravity is None
+    return (fluxes.FLUX_KERNEL and fluxes.STAGE_KERNEL
             and flux_kernel.applies(grid, dtype, "stage", num.limiter, num.riemann))
+
+
+def cell_programs_apply(grid: Grid, phys: Physics) -> bool:
+    """Whether the stage kernel may evaluate the closures itself (:mod:`.cell_program`): on a periodic grid
+    (its ghost cells' closures are those of the cells they image) without a body force."""
+    from . import fluxes
+
+    periodic = grid.boundaries is None or grid.boundaries.all_periodic
+    return fluxes.CELL_PROGRAM and periodic and phys.gravity is None
 
 
 def start_program(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> Any:
     """The step-start cell program of the SSP-RK3 stage kernel — the stage closures and the
     :data:`LIMIT_TERMS`, :func:`.flux_kernel.cell_limits` — or None where a step does not start with it
     (no stage kernel or stage program, e.g. walls; another scheme or the implicit sink: :func:`kernel_limits_apply`)."""
-    from . import fluxes
     from .cell_program import for_physics
 
-    if not (fluxes.CELL_PROGRAM and kernel_limits_apply(num) and stage_kernel_applies(grid, phys, num, dtype)):
+    if not (cell_programs_apply(grid, phys) and kernel_limits_apply(num) and stage_kernel_applies(grid, phys, num,
+                                                                                                   dtype)):
         return None
     if for_physics(phys, dtype) is None:  # the later stages need the stage program
         return None
@@ -272,11 +282,10 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
     when = jnp.asarray([0.0, 1.0, 0.5], dtype=jnp.result_type(t, float))  # stage times / Δt
 
     if stage_kernel_applies(grid, phys, num, U[0].dtype):
-        from . import fluxes
         from .cell_program import for_physics, leaf_values
         from .flux_kernel import ssprk_stage, ssprk_stage_cells
 
-        program = for_physics(phys, U[0].dtype) if fluxes.CELL_PROGRAM else None
+        program = for_physics(phys, U[0].dtype) if cell_programs_apply(grid, phys) else None
         if program is not None:  # the closures inside the kernel: each stage is one call
             U = tuple(U)
             # The first stage writes new buffers (U is still needed).
@@ -286,8 +295,15 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
 
         def kernel_stage(k: Any, Uk: tuple, r: Any) -> tuple:
             W, eos, transport, source = kernel_stage_inputs(Uk, r, phys)
-            return ssprk_stage(U, Uk, W, eos, transport, source, coef[k], dt, grid, phys.material_density,
-                               num.limiter, num.riemann)
+            *fields, fix = kernel_fields(W, eos, transport, grid, phys, num.limiter, num.riemann, True,
+                                         t + when[k] * dt)
+            out = ssprk_stage(U, Uk, *fields, source, coef[k], dt, grid, phys.material_density, num.limiter,
+                              num.riemann)
+            if phys.gravity is not None:  # the body force, which the kernel's source does not have
+                force, power = body_force(W, phys)
+                out = (out[0], *(x + ((1.0 - coef[k]) * dt) * f for x, f in zip(out[1:4], force)),
+                       out[4] + ((1.0 - coef[k]) * dt) * power)
+            return add_boundary_fluxes(out, fix, grid, (1.0 - coef[k]) * dt)
 
         if r0 is None:
             r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
