@@ -127,11 +127,16 @@ def test_kernel_rhs_matches_jax(limiter: str, riemann: str, viscous: bool, dtype
 def test_kernel_steps_match_jax(scheme: str, model: str) -> None:
     grid, phys = _grid(), _physics(model)
     U = _state(grid, phys, jnp.float64)
-    num = Numerics(scheme=scheme)
+    new, ref = _three_steps(U, grid, phys, Numerics(scheme=scheme))
+    assert _close(new[0], ref[0]) < RTOL[jnp.float64]
+
+
+def _three_steps(U, grid: Grid, phys: Physics, num: Numerics) -> tuple:
+    """``advance`` by 3 steps with the kernel and on the JAX path (both take the 3 steps)."""
     f = lambda: jax.jit(lambda U: advance.__wrapped__(U, 0.0, 1e30, 3, grid, phys, num))(U)  # noqa: E731
     new, ref = _with_kernel(True, f), _with_kernel(False, f)
     assert int(new[2]) == int(ref[2]) == 3 and int(new[3]) == int(ref[3]) == 0
-    assert _close(new[0], ref[0]) < RTOL[jnp.float64]
+    return new, ref
 
 
 @pytest.mark.contract
@@ -244,12 +249,9 @@ def test_kernel_rhs_between_walls_matches_jax(case: str, axis: str) -> None:
 def test_kernel_steps_between_walls_match_jax(case: str, axis: str, scheme: str) -> None:
     """Three steps; the chute's gravity is added to the stage kernel's output."""
     sim = _walled(case, axis)
-    num = Numerics(scheme=scheme)
     with sim.precision():
         U = tuple(sim.initial_state())
-        f = lambda: jax.jit(lambda U: advance.__wrapped__(U, 0.0, 1e30, 3, sim.grid, sim.phys, num))(U)  # noqa: E731
-        new, ref = _with_kernel(True, f), _with_kernel(False, f)
-    assert int(new[2]) == int(ref[2]) == 3 and int(new[3]) == int(ref[3]) == 0
+        new, ref = _three_steps(U, sim.grid, sim.phys, Numerics(scheme=scheme))
     assert _close_momentum(new[0], ref[0]) < RTOL[jnp.float64]
     assert _close(new[0], U) > 0.1
 
@@ -260,10 +262,7 @@ def test_kernel_steps_between_walls_match_jax(case: str, axis: str, scheme: str)
 def test_kernel_steps_on_a_lees_edwards_grid_match_jax(axis: int, flow: int, scheme: str) -> None:
     grid, phys = _sheared(axis, flow)
     U = _state(grid, phys, jnp.float64)
-    num = Numerics(scheme=scheme)
-    f = lambda: jax.jit(lambda U: advance.__wrapped__(U, 0.0, 1e30, 3, grid, phys, num))(U)  # noqa: E731
-    new, ref = _with_kernel(True, f), _with_kernel(False, f)
-    assert int(new[2]) == int(ref[2]) == 3 and int(new[3]) == int(ref[3]) == 0
+    new, ref = _three_steps(U, grid, phys, Numerics(scheme=scheme))
     assert _close(new[0], ref[0]) < RTOL[jnp.float64]
     assert _close(new[0], U) > 100 * RTOL[jnp.float64]
 
