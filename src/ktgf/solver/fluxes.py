@@ -350,7 +350,7 @@ def kernel_fields(W: Sequence[Any], eos: Sequence[Any], transport: Sequence[Any]
     def slab_faces(lo: int, walls: bool, Pv: Sequence[Any] | None = None) -> list[Any]:  # both faces along a
         F = convective_flux(cut(P, lo), slab.cells, a, limiter, riemann, walls=walls)
         if viscous:
-            F = [f + v for f, v in zip(F, viscous_flux(cut(P[:5] if Pv is None else Pv, lo), cut(Pk, lo), a, slab,
+            F = [f + v for f, v in zip(F, viscous_flux(cut(P[:5], lo) if Pv is None else Pv, cut(Pk, lo), a, slab,
                                                        rho_s))]
         return F
 
@@ -359,19 +359,39 @@ def kernel_fields(W: Sequence[Any], eos: Sequence[Any], transport: Sequence[Any]
         pair = [jnp.concatenate([lo_, hi], axis=a) for lo_, hi in zip(own, face(slab_faces(n - 1, False), 1))]
         mapped = face(lees_edwards_faces(pair, slab, a, t), 0)
         return P[:5], P[5:], Pk if viscous else transport, (a, {0: [(m - f) * inv_dx for m, f in zip(mapped, own)]})
-    Pv = pad_viscous(W, transport, grid, phys, t) if viscous else None
+    Pv = wall_slabs(W, transport, grid, phys, t) if viscous else {}
     fix = {}
     for plane, k, sign in ((0, 0, 1.0), (n - 1, 1, -1.0)):
-        true, own = face(slab_faces(plane, True, Pv), k), face(slab_faces(plane, False), k)
+        true, own = face(slab_faces(plane, True, Pv.get(plane)), k), face(slab_faces(plane, False), k)
         d = [sign * (x - y) * inv_dx for x, y in zip(true, own)]
         for b in range(grid.ndim) if viscous else ():
             if b != a:  # the wall plane's viscous fluxes along b, with the viscous ghosts less with the convective
-                Fv = viscous_flux(cut(Pv, plane), cut(Pk, plane), b, slab, rho_s)
+                Fv = viscous_flux(Pv[plane], cut(Pk, plane), b, slab, rho_s)
                 Fc = viscous_flux(cut(P[:5], plane), cut(Pk, plane), b, slab, rho_s)
                 dF = face_divergence(jnp.stack([x - y for x, y in zip(Fv[1:], Fc[1:])]), slab, b)
                 d = [d[0], *(x + y for x, y in zip(d[1:], dF))]
         fix[plane] = d
     return P[:5], P[5:], Pk if viscous else transport, (a, fix)
+
+
+def wall_slabs(W: Sequence[Any], transport: Sequence[Any], grid: Grid, phys: Physics, t: Any) -> dict:
+    """{plane: the primitive fields padded for the viscous fluxes (:func:`pad_viscous`) around the wall plane,
+    GHOST cells per side along the wall axis} for the two wall planes, padded on the GHOST + 1 cells next to each
+    wall only (the wall conditions read the two nearest; the rest of the grid is not copied)."""
+    a = grid.boundaries.wall_axes[0]
+    n, m = grid.cells[a], GHOST + 1
+    k = n
+    if n > 2 * m:
+        def ends(f: Any) -> Any:
+            return jnp.concatenate([jax.lax.slice_in_dim(f, 0, m, axis=a), jax.lax.slice_in_dim(f, n - m, n, axis=a)],
+                                   axis=a)
+
+        W, transport, k = [ends(f) for f in W], [ends(f) for f in transport], 2 * m
+        grid = SimpleNamespace(cells=tuple(k if b == a else c for b, c in enumerate(grid.cells)), spacing=grid.spacing,
+                               ndim=grid.ndim, boundaries=grid.boundaries)
+    Pv = pad_viscous(W, transport, grid, phys, t)
+    return {plane: [jax.lax.slice_in_dim(f, lo, lo + 2 * GHOST + 1, axis=a) for f in Pv]
+            for plane, lo in ((0, 0), (n - 1, k - 1))}
 
 
 def add_boundary_fluxes(fields: Sequence[Any], fix: Any, grid: Grid, scale: Any = 1.0) -> Any:
