@@ -1,9 +1,10 @@
 """Cost per cell-step of every 3D case against the periodic cooling box, measured in one process (issue 34, item 1).
 
 Run:  PYTHONPATH=src python benchmarks/bench_cases.py [--cells 64] [--steps 2] [--rounds 3] [--cases box,shear,...]
+      [--scheme ssprk3|imex]
 
 Each case is a ``ktgf run`` configuration (RET, e 0.8, φ 0.3, float64, SSP-RK3 with explicit acoustics and sink —
-the scheme of the box's fused loop) on an n³ grid: ``box`` the periodic cooling box, ``shear`` uniform shear
+the scheme of the box's fused loop; ``--scheme imex``: ARS(2,2,2), whose explicit part is the inviscid kernel) on an n³ grid: ``box`` the periodic cooling box, ``shear`` uniform shear
 (Lees–Edwards along y, flow x), ``couette`` (Johnson–Jackson walls on y), ``chute`` (base and lid on y, gravity
 at 25°).  Per case: the marginal wall and CPU ms per step of ``advance`` (a call of 5 × ``--steps`` steps less
 one of ``--steps``: what a run, which advances in chunks, sees), in ``--rounds`` rounds that visit the cases
@@ -64,6 +65,7 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=2)
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--cases", default=",".join(CASES))
+    ap.add_argument("--scheme", default="ssprk3", choices=("ssprk3", "imex"))
     args = ap.parse_args()
 
     import tomllib
@@ -79,15 +81,20 @@ def main() -> None:
     n = args.cells
     runs = {}
     for case in cases:
-        sim = Simulation(parse_config(tomllib.loads(config(case.split(":")[0], n))))
+        sim = Simulation(parse_config(tomllib.loads(config(case.split(":")[0], n).replace(
+            'scheme = "ssprk3"', f'scheme = "{args.scheme}"'))))
         fluxes.FLUX_KERNEL = not case.endswith(":jax")
         with sim.precision():
             U = sim.initial_state()
             grid, phys, num = sim.grid, sim.phys, sim.num
             fused = start_program(grid, phys, num, U.dtype) is not None
             stage = stage_kernel_applies(grid, phys, num, U.dtype)
-            path = "C++ fused loop (cell programs)" if fused else "C++ stage kernel" if stage else (
-                "C++ flux kernel" if fluxes.FLUX_KERNEL and flux_kernel.applies(grid, U.dtype, "rhs", num.limiter, num.riemann) else "JAX path")
+            flux = fluxes.FLUX_KERNEL and flux_kernel.applies(grid, U.dtype, "euler", num.limiter, num.riemann)
+            if args.scheme == "imex":
+                path = "C++ flux kernel (explicit part)" if flux else "JAX path"
+            else:
+                path = "C++ fused loop (cell programs)" if fused else "C++ stage kernel" if stage else (
+                    "C++ flux kernel" if flux else "JAX path")
             t0 = time.perf_counter()
             compiled = jax.jit(lambda *a: advance.__wrapped__(*a)).lower(U, 0.0, 1e30, args.steps, grid, phys,
                                                                          num).compile()
@@ -109,7 +116,7 @@ def main() -> None:
                     assert int(out[2]) == s and int(out[3]) == 0, (case, int(out[2]), int(out[3]))
                 times[case].append(((w[1] - w[0]) / (4 * args.steps) * 1e3, (c[1] - c[0]) / (4 * args.steps) * 1e3))
     cells = n**3
-    print(f"{n}^3 cells, float64 SSP-RK3, {args.rounds} rounds, cpu count {os.cpu_count()}, "
+    print(f"{n}^3 cells, float64 {args.scheme}, {args.rounds} rounds, cpu count {os.cpu_count()}, "
           f"load average {os.getloadavg()}")
     box = statistics.median(w for w, _ in times["box"]) if "box" in times else None
     for case in cases:
