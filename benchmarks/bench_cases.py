@@ -73,9 +73,10 @@ def main() -> None:
     import jax
 
     from ktgf.solver import flux_kernel, fluxes
+    from ktgf.solver.cell_program import for_physics
     from ktgf.solver.config import parse_config
     from ktgf.solver.run import Simulation
-    from ktgf.solver.stepping import advance, stage_kernel_applies, start_program
+    from ktgf.solver.stepping import advance, cell_programs_apply, stage_kernel_applies, start_program
 
     cases = args.cases.split(",")
     n = args.cells
@@ -93,8 +94,9 @@ def main() -> None:
             if args.scheme == "imex":
                 path = "C++ flux kernel (explicit part)" if flux else "JAX path"
             else:
-                path = "C++ fused loop (cell programs)" if fused else "C++ stage kernel" if stage else (
-                    "C++ flux kernel" if flux else "JAX path")
+                cells = stage and cell_programs_apply(grid) and for_physics(phys, U.dtype) is not None
+                path = "C++ fused loop (cell programs)" if fused else "C++ stages with cell programs" if cells else (
+                    "C++ stage kernel" if stage else "C++ flux kernel" if flux else "JAX path")
             t0 = time.perf_counter()
             compiled = jax.jit(lambda *a: advance.__wrapped__(*a)).lower(U, 0.0, 1e30, args.steps, grid, phys,
                                                                          num).compile()

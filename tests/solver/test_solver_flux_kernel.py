@@ -478,8 +478,8 @@ def test_fused_stage_is_in_the_compiled_step_only_where_it_applies() -> None:
     text = _with_kernel(True, lambda: hlo(sheared))
     assert calls(text, flux_kernel.STAGE_TARGET) and not calls(text, flux_kernel.CELLS_TARGET)
     with_gravity = Physics(phys.model, 0.8, D, RHO_S, phys.phi_stop, gravity=(0.0, -9.81, 0.0))
-    text = _with_kernel(True, lambda: hlo(with_gravity))  # a body force: the stage kernel, the force added after
-    assert calls(text, flux_kernel.STAGE_TARGET) and not calls(text, flux_kernel.CELLS_TARGET)
+    text = _with_kernel(True, lambda: hlo(with_gravity))  # a body force: the cell program, the force added after
+    assert calls(text, flux_kernel.CELLS_TARGET) and not calls(text, flux_kernel.STAGE_TARGET)
 
 
 @pytest.mark.contract

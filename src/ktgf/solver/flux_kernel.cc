@@ -81,7 +81,7 @@ struct Consts {
   T inv_dx[3];        // 1/dx_a (normal derivatives, face divergence)
   T half_inv_dx[3];   // 0.5/dx_a (central derivatives)
   T omega_factor[3];  // (1/dx_a)/rho_s
-  bool wrap2 = true;  // the ghost cells along z are periodic images (false: fields padded by the caller)
+  bool wrap2 = true;  // the ghost cells along z are periodic images (false: set by the caller, set_ghosts)
 };
 
 // Field f at the cell (i + d0, j + d1, q + d2) of the cell (i, j, q) at offset c of its plane, through a table of
@@ -261,6 +261,27 @@ void pad(const T* const* in, int nfield, const long* n, T* work) {
           dst[GHOST + n[2] + q] = src[q];
         }
         for (long q = 0; q < n[2]; ++q) dst[GHOST + q] = src[q];
+      }
+    }
+  }
+}
+
+// Overwrites the ghost planes along `axis` of the periodically padded fields in `work` with `ghost`: per field, the
+// GHOST planes below the grid then the GHOST above it, each of the padded shape of the other two axes in order
+// (the boundary conditions of a wall or Lees-Edwards axis, filled by the caller).
+template <class T>
+void set_ghosts(const T* ghost, int nfield, const long* n, int axis, T* work) {
+  const long m[3] = {n[0] + 2 * GHOST, n[1] + 2 * GHOST, n[2] + 2 * GHOST};
+  const long stride[3] = {m[1] * m[2], m[2], 1};
+  const int b = axis == 0 ? 1 : 0, c = axis == 2 ? 1 : 2;
+#pragma omp parallel for collapse(3) schedule(static)
+  for (int f = 0; f < nfield; ++f) {
+    for (int side = 0; side < 2; ++side) {
+      for (long q = 0; q < GHOST; ++q) {
+        const T* src = ghost + ((f * 2 + side) * GHOST + q) * m[b] * m[c];
+        T* dst = work + f * m[0] * stride[0] + (side ? n[axis] + GHOST + q : q) * stride[axis];
+        for (long i = 0; i < m[b]; ++i)
+          for (long j = 0; j < m[c]; ++j) dst[i * stride[b] + j * stride[c]] = src[i * m[c] + j];
       }
     }
   }
@@ -514,8 +535,9 @@ Consts<Real> consts(const long* n, const double* params) {
 
 // Sweeps the padded fields in `work` (NFIELD or GG + 1 of them, each of the padded shape of n) with the output `o`.
 template <class Out>
-void sweep_padded(const long* n, const double* params, const Real* work, const Out& o) {
-  const Consts<Real> k = consts(n, params);
+void sweep_padded(const long* n, const double* params, const Real* work, const Out& o, bool wrap2 = true) {
+  Consts<Real> k = consts(n, params);
+  k.wrap2 = wrap2;
   const long M = (n[0] + 2 * GHOST) * k.stride[0];
   const int nfield = BUILT_VISCOUS ? NFIELD : GG + 1;
   std::vector<const Real*> P(NFIELD, nullptr);
@@ -547,28 +569,45 @@ ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& ty
   return ffi::Error::Success();
 }
 
-// Sweeps the cell fields (the first NFIELD of `in`) on the grid of the output field `grid` with the output `o` (Rhs
-// or Stage): fields of the grid's shape are padded periodically into `work` first; fields of the padded shape
-// (GHOST more per side) are swept as they are, their ghost cells filled by the caller (walls, Lees-Edwards).
+// The ghost planes (set_ghosts) along the axis params[naxis] that `in` holds as its argument nin, if it has one
+// more than nin arguments (else ghost = nullptr, axis = -1), checked against the grid n and nfield fields.
+ffi::Error ghost_planes(ffi::RemainingArgs in, size_t nin, const double* params, size_t naxis, int nfield,
+                        const long* n, const Real*& ghost, int& axis) {
+  ghost = nullptr;
+  axis = -1;
+  if (in.size() != nin + 1) return ffi::Error::Success();
+  axis = int(params[naxis]);
+  auto g = in.get<ffi::AnyBuffer>(nin);
+  const int b = axis == 0 ? 1 : 0, c = axis == 2 ? 1 : 2;
+  const long planes = nfield * 2 * GHOST * (n[b] + 2 * GHOST) * (n[c] + 2 * GHOST);
+  if (axis < 0 || axis > 2 || !g.has_value() || long(g->element_count()) != planes ||
+      g->element_type() != in.get<ffi::AnyBuffer>(0)->element_type())
+    return ffi::Error::InvalidArgument("flux kernel: ghost planes = fields x 2 x GHOST planes of the padded shape of "
+                                       "the other axes, in the fields' precision, axis 0..2");
+  ghost = g->typed_data<Real>();
+  return ffi::Error::Success();
+}
+
+// Sweeps the cell fields (the first NFIELD of `in`, of the grid's shape) on the grid of the output field `grid` with
+// the output `o` (Rhs or Stage), padded periodically into `work` first, then with the ghost planes of `in` after
+// its first nin arguments, if any (ghost_planes: walls, Lees-Edwards).
 template <class Out>
-ffi::Error run(ffi::RemainingArgs in, const ffi::AnyBuffer& grid, const double* params, Real* work, const Out& o) {
+ffi::Error run(ffi::RemainingArgs in, size_t nin, const ffi::AnyBuffer& grid, const double* params, size_t naxis,
+               Real* work, const Out& o) {
   long n[3], m[3];
   if (auto err = grid_shape(grid, n); err.failure()) return err;
   if (auto err = grid_shape(*in.get<ffi::AnyBuffer>(0), m); err.failure()) return err;
-  const bool padded = m[0] == n[0] + 2 * GHOST && m[1] == n[1] + 2 * GHOST && m[2] == n[2] + 2 * GHOST;
-  if (!padded && (m[0] != n[0] || m[1] != n[1] || m[2] != n[2]))
-    return ffi::Error::InvalidArgument("flux kernel: the cell fields must have the grid's shape or the padded one");
+  if (m[0] != n[0] || m[1] != n[1] || m[2] != n[2])
+    return ffi::Error::InvalidArgument("flux kernel: the cell fields must have the grid's shape");
   const int nfield = BUILT_VISCOUS ? NFIELD : GG + 1;
+  const Real* ghost;
+  int axis;
+  if (auto err = ghost_planes(in, nin, params, naxis, nfield, n, ghost, axis); err.failure()) return err;
   std::vector<const Real*> fields(NFIELD, nullptr);
   for (int f = 0; f < nfield; ++f) fields[f] = in.get<ffi::AnyBuffer>(f)->typed_data<Real>();
-  if (padded) {
-    Consts<Real> k = consts(n, params);
-    k.wrap2 = false;
-    sweep<Real, KTGF_LIMITER, KTGF_RIEMANN, BUILT_VISCOUS>(fields.data(), k, o);
-    return ffi::Error::Success();
-  }
   pad<Real>(fields.data(), nfield, n, work);
-  sweep_padded(n, params, work, o);
+  if (ghost) set_ghosts<Real>(ghost, nfield, n, axis, work);
+  sweep_padded(n, params, work, o, axis != 2);
   return ffi::Error::Success();
 }
 
@@ -578,15 +617,18 @@ ffi::Error flux_divergence(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, 
                            ffi::Result<ffi::AnyBuffer> d2, ffi::Result<ffi::AnyBuffer> d3,
                            ffi::Result<ffi::AnyBuffer> d4, ffi::Result<ffi::AnyBuffer> divu,
                            ffi::Result<ffi::AnyBuffer> work) {
-  if (params.element_count() != 4) return ffi::Error::InvalidArgument("flux kernel: params = (dx, dy, dz, rho_s)");
-  if (in.size() != NFIELD) return ffi::Error::InvalidArgument("flux kernel: fields = the 11 cell fields");
+  const bool ghosts = in.size() == NFIELD + 1;
+  if (params.element_count() != 4 + ghosts)
+    return ffi::Error::InvalidArgument("flux kernel: params = (dx, dy, dz, rho_s[, ghost axis])");
+  if (in.size() != NFIELD + ghosts)
+    return ffi::Error::InvalidArgument("flux kernel: fields = the 11 cell fields[, ghost planes]");
   ffi::DataType type;
   if (auto err = same_fields(in, NFIELD, type); err.failure()) return err;
   if (auto err = check_variant("KtgfFluxDivergence", type, limiter, riemann, viscous != 0); err.failure()) return err;
   const Rhs<Real> o{{d0->typed_data<Real>(), d1->typed_data<Real>(), d2->typed_data<Real>(), d3->typed_data<Real>(),
                      d4->typed_data<Real>()},
                     divu->typed_data<Real>()};
-  return run(in, *d0, params.typed_data(), work->typed_data<Real>(), o);
+  return run(in, NFIELD, *d0, params.typed_data(), 4, work->typed_data<Real>(), o);
 }
 #else  // the stage kind
 // Cell programs (ktgf.solver.cell_program), by key: f(n, params, in[5], out[NFIELD + 2 + nlim]) over n cells,
@@ -713,7 +755,7 @@ inline void wait_for(const Progress* progress, int t, int nt, long p) {
 // Returns false (nothing computed) if the threads' rings do not fit in `capacity`.
 template <class T, int LIM, int RIE>
 bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const Stage<T>& o, T* ring_all,
-                 long capacity, int nlim = 0, T* maxima = nullptr) {
+                 long capacity, int nlim = 0, T* maxima = nullptr, const T* ghost = nullptr, int gaxis = -1) {
   const long n0 = kg.n[0], n1 = kg.n[1], n2 = kg.n[2], m2 = kg.stride[1];
   bool fits = true;
   for (int q = 0; q < nlim; ++q) maxima[q] = -std::numeric_limits<T>::infinity();
@@ -757,7 +799,16 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
         if (p >= n0) return;  // planes 0, 1 again: kept
         const long gp = (p + n0) % n0, s = slot_of(p);
         for (long jj = 0; jj < m1; ++jj) {
-          const long gj = ((jlo - GHOST + jj) % n1 + n1) % n1, at = (gp * n1 + gj) * n2;
+          const long J = jlo - GHOST + jj;
+          if (gaxis == 1 && (J < 0 || J >= n1)) {  // a ghost row of a boundary along y: the caller's (set_ghosts)
+            const long side = J < 0 ? 0 : 1, q = J < 0 ? J + GHOST : J - n1;
+            for (int f = 0; f < NFIELD; ++f) {
+              const T* src = ghost + (((long(f) * 2 + side) * GHOST + q) * (n0 + 2 * GHOST) + gp + GHOST) * m2;
+              std::copy(src, src + m2, field(f, s) + jj * m2);
+            }
+            continue;
+          }
+          const long gj = (J % n1 + n1) % n1, at = (gp * n1 + gj) * n2;
           const T* in[5];
           for (int v = 0; v < 5; ++v) in[v] = o.Uk[v] + at;
           if (o.mode == FROM_RATE) {  // Uk as the first stage computed it: 0 U0 + 1 (U0 + dt L0)
@@ -772,11 +823,18 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
           for (int f = 0; f < NRING; ++f) out[f] = field(f, s) + jj * m2 + GHOST;
           fn(n2, leaf, in, out.data());
           row_maxima(out.data() + NRING, n2, nlim, local.data());  // ghost rows too: a maximum again changes nothing
-          for (int f = 0; f < NFIELD; ++f) {  // the row's ghost cells along z
+          for (int f = 0; f < NFIELD; ++f) {  // the row's ghost cells along z: periodic, or the caller's
             T* row = out[f] - GHOST;
+            const long m1g = n1 + 2 * GHOST;
             for (long q = 0; q < GHOST; ++q) {
-              row[q] = row[n2 + q];
-              row[GHOST + n2 + q] = row[GHOST + q];
+              if (gaxis == 2) {
+                row[q] = ghost[((long(f) * 2 * GHOST + q) * (n0 + 2 * GHOST) + gp + GHOST) * m1g + gj + GHOST];
+                row[GHOST + n2 + q] =
+                    ghost[((long(f) * 2 * GHOST + GHOST + q) * (n0 + 2 * GHOST) + gp + GHOST) * m1g + gj + GHOST];
+              } else {
+                row[q] = row[n2 + q];
+                row[GHOST + n2 + q] = row[GHOST + q];
+              }
             }
           }
         }
@@ -832,10 +890,12 @@ ffi::Error ssprk_stage(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int3
                        ffi::Result<ffi::AnyBuffer> u0, ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2,
                        ffi::Result<ffi::AnyBuffer> u3, ffi::Result<ffi::AnyBuffer> u4,
                        ffi::Result<ffi::AnyBuffer> work) {
-  if (params.element_count() != 6)
-    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
-  if (in.size() != NFIELD + 12)
-    return ffi::Error::InvalidArgument("stage kernel: fields = (the 11 cell fields, U0 x5, Uk x5, s0, s1)");
+  const bool ghosts = in.size() == NFIELD + 13;
+  if (params.element_count() != 6 + ghosts)
+    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt[, ghost axis])");
+  if (in.size() != NFIELD + 12 + ghosts)
+    return ffi::Error::InvalidArgument("stage kernel: fields = (the 11 cell fields, U0 x5, Uk x5, s0, s1[, ghost "
+                                       "planes])");
   ffi::DataType type, state_type;
   if (auto err = same_fields(in, NFIELD, type); err.failure()) return err;
   if (auto err = same_fields(in, 12, state_type, NFIELD); err.failure()) return err;
@@ -845,7 +905,7 @@ ffi::Error ssprk_stage(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int3
   Stage<Real> o = stage_output(p, in, NFIELD, NFIELD + 5, {u0, u1, u2, u3, u4});
   o.s0 = in.get<ffi::AnyBuffer>(NFIELD + 10)->typed_data<Real>();
   o.s1 = in.get<ffi::AnyBuffer>(NFIELD + 11)->typed_data<Real>();
-  return run(in, *in.get<ffi::AnyBuffer>(NFIELD), p, work->typed_data<Real>(), o);
+  return run(in, NFIELD + 12, *in.get<ffi::AnyBuffer>(NFIELD), p, 6, work->typed_data<Real>(), o);
 }
 
 // The cell program registered under `program`, checked against the precision of `type`.
@@ -890,14 +950,15 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
                              ffi::Result<ffi::AnyBuffer> u2, ffi::Result<ffi::AnyBuffer> u3,
                              ffi::Result<ffi::AnyBuffer> u4, ffi::Result<ffi::AnyBuffer> maxima,
                              ffi::Result<ffi::AnyBuffer> ring) {
-  if (params.element_count() != 6)
-    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt)");
   if (mode != UPDATE && mode != RATE && mode != FROM_RATE)
     return ffi::Error::InvalidArgument("stage kernel: mode must be 0 (update), 1 (rate) or 2 (from rate)");
   const size_t nstate = mode == RATE ? 5 : 10;
-  if (state.size() != nstate)
-    return ffi::Error::InvalidArgument(mode == RATE ? "stage kernel: state = U0 x5"
-                                                    : "stage kernel: state = (U0 x5, Uk x5)");
+  const bool ghosts = state.size() == nstate + 1;
+  if (params.element_count() != 6 + ghosts)
+    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt[, ghost axis])");
+  if (state.size() != nstate + ghosts)
+    return ffi::Error::InvalidArgument(mode == RATE ? "stage kernel: state = U0 x5[, ghost planes]"
+                                                    : "stage kernel: state = (U0 x5, Uk x5[, ghost planes])");
   ffi::DataType type;
   if (auto err = same_fields(state, nstate, type); err.failure()) return err;
   if (auto err = check_variant("KtgfSsprkStageCells", type, limiter, riemann, true); err.failure()) return err;
@@ -912,11 +973,17 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
   if (ring->element_type() != type || long(ring->element_count()) < ring_elements(n))
     return ffi::Error::InvalidArgument("stage kernel: the ring workspace is smaller than KtgfRingElements");
   const double* par = params.typed_data();
+  const Real* ghost;
+  int axis;
+  if (auto err = ghost_planes(state, nstate, par, 6, NFIELD, n, ghost, axis); err.failure()) return err;
+  if (axis == 0) return ffi::Error::InvalidArgument("stage kernel: cell programs take ghost planes along y or z only");
   Stage<Real> o = stage_output(par, state, 0, mode == RATE ? 0 : 5, {u0, u1, u2, u3, u4});  // s0, s1: the ring's
   o.mode = mode;
-  if (!sweep_fused<Real, KTGF_LIMITER, KTGF_RIEMANN>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(),
-                                                     consts(n, par), o, ring->typed_data<Real>(),
-                                                     long(ring->element_count()), nlim, maxima->typed_data<Real>()))
+  Consts<Real> k = consts(n, par);
+  k.wrap2 = axis != 2;
+  if (!sweep_fused<Real, KTGF_LIMITER, KTGF_RIEMANN>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(), k, o,
+                                                     ring->typed_data<Real>(), long(ring->element_count()), nlim,
+                                                     maxima->typed_data<Real>(), ghost, axis))
     return ffi::Error::InvalidArgument("stage kernel: the ring workspace is too small for the threads");
   return ffi::Error::Success();
 }

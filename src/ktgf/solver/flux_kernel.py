@@ -11,8 +11,8 @@ state-check terms; :func:`cell_limits` is that reduction alone.
 
 It is used where it applies — CPU backend, one device, a 3D grid, float32 or float64 — unless
 :data:`.fluxes.FLUX_KERNEL` is off (``KTGF_FLUX_KERNEL=0``).  With walls or Lees–Edwards boundaries the caller
-passes the fields padded and corrects the planes next to the boundary (:func:`.fluxes.kernel_fields`); the cell
-programs run on periodic grids only.  The JAX path remains the reference and the path for GPUs and sharding.
+passes the ghost planes of the boundary axis, which the kernel puts over its periodic padding, and corrects the
+planes next to the boundary (:func:`.fluxes.kernel_fields`); the cell programs run on periodic grids only.  The JAX path remains the reference and the path for GPUs and sharding.
 
 Build: one shared library per :class:`Variant`, compiled when a solver first needs it (:func:`applies`) by
 :mod:`.cxx` into ``$KTGF_CACHE_DIR`` (default ``~/.cache/ktgf``) and kept there; ``-D`` macros choose the
@@ -183,16 +183,21 @@ def _target(base: str, dtype: Any, limiter: str, riemann: str, kind: str) -> str
 
 
 def _cell_fields(W: Any, eos: Any, transport: Any, grid: Any, viscous: bool) -> tuple[list[Any], Any]:
-    """The kernel's 11 cell-field inputs and its workspace (their copies with periodic ghost cells; none if the
-    fields come padded)."""
+    """The kernel's 11 cell-field inputs and its workspace (their copies with ghost cells)."""
     dtype = W[0].dtype
     fields = [jnp.asarray(f, dtype) for f in (*W, *eos)]
     # Non-viscous calls pass ρ in the unused transport slots (no copy; the kernel ignores them).
     fields += [jnp.asarray(f, dtype) for f in transport] if viscous else [fields[0]] * 4
-    if tuple(fields[0].shape) != tuple(grid.cells):
-        return fields, jax.ShapeDtypeStruct((1,), dtype)
     nfield = 11 if viscous else 7
     return fields, jax.ShapeDtypeStruct((nfield, *(n + 2 * GHOST for n in grid.cells)), dtype)
+
+
+def _ghost_args(params: Any, ghosts: Any, dtype: Any) -> tuple[Any, list[Any]]:
+    """The kernel's params and extra fields with the ghost planes ``ghosts`` = (axis, planes), or None: the axis
+    appended to the params, the planes one extra field."""
+    if ghosts is None:
+        return params, []
+    return jnp.append(params, jnp.asarray(ghosts[0], jnp.float64)), [jnp.asarray(ghosts[1], dtype)]
 
 
 def _schemes(limiter: str, riemann: str) -> dict[str, Any]:
@@ -200,24 +205,28 @@ def _schemes(limiter: str, riemann: str) -> dict[str, Any]:
 
 
 def flux_divergence(W: Any, eos: Any, transport: Any, grid: Any, rho_s: Any, limiter: str, riemann: str,
-                    viscous: bool) -> tuple[list[Any], Any]:
-    """−∇·F of the five conservative fields and the central ∇·u, as :func:`.fluxes.flux_divergence`."""
+                    viscous: bool, ghosts: Any = None) -> tuple[list[Any], Any]:
+    """−∇·F of the five conservative fields and the central ∇·u, as :func:`.fluxes.flux_divergence`.
+
+    ``ghosts``: None (periodic) or (axis, planes): the ghost planes along that axis (:func:`.fluxes.kernel_fields`)."""
     fields, work = _cell_fields(W, eos, transport, grid, viscous)
     field = jax.ShapeDtypeStruct(tuple(grid.cells), W[0].dtype)
     kind = "rhs" if viscous else "euler"
     call = jax.ffi.ffi_call(_target(TARGET, W[0].dtype, limiter, riemann, kind), (field,) * 6 + (work,))
-    params = jnp.stack([jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)])
-    out = call(params, *fields, **_schemes(limiter, riemann), viscous=np.int32(viscous))
+    params, extra = _ghost_args(jnp.stack([jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)]), ghosts,
+                                W[0].dtype)
+    out = call(params, *fields, *extra, **_schemes(limiter, riemann), viscous=np.int32(viscous))
     return list(out[:5]), out[5]
 
 
 def ssprk_stage(U0: Any, Uk: Any, W: Any, eos: Any, transport: Any, source: tuple[Any, Any], a: Any, dt: Any,
-                grid: Any, rho_s: Any, limiter: str, riemann: str) -> tuple[Any, ...]:
+                grid: Any, rho_s: Any, limiter: str, riemann: str, ghosts: Any = None) -> tuple[Any, ...]:
     """One SSP-RK3 stage U' = a U0 + (1 − a)(Uk + Δt L(Uk)), as in :func:`.stepping.ssprk3_step`.
 
     L = −∇·F (convective, viscous and heat fluxes, as :func:`flux_divergence`) plus the energy
     source s0 + s1 ∇·u with ``source`` = (s0, s1) at the cells of Uk (:func:`.sources.cooling_source`
-    is linear in ∇·u); ``W``, ``eos``, ``transport``: the primitive fields and cell coefficients of Uk.
+    is linear in ∇·u); ``W``, ``eos``, ``transport``: the primitive fields and cell coefficients of Uk;
+    ``ghosts`` as in :func:`flux_divergence`.
     """
     dtype = Uk[0].dtype
     fields, work = _cell_fields(W, eos, transport, grid, True)
@@ -227,8 +236,8 @@ def ssprk_stage(U0: Any, Uk: Any, W: Any, eos: Any, transport: Any, source: tupl
     # none of the loop-carry copies XLA inserts when a stage's output cannot take its input's place.
     call = jax.ffi.ffi_call(_target(STAGE_TARGET, dtype, limiter, riemann, "stage"), (field,) * 5 + (work,),
                             input_output_aliases={1 + len(fields) + 5 + v: v for v in range(5)})
-    params = _stage_params(a, dt, grid, rho_s, dtype)
-    return tuple(call(params, *fields, *state, **_schemes(limiter, riemann))[:5])
+    params, extra = _ghost_args(_stage_params(a, dt, grid, rho_s, dtype), ghosts, dtype)
+    return tuple(call(params, *fields, *state, *extra, **_schemes(limiter, riemann))[:5])
 
 
 def _register(program: Any, limiter: str, riemann: str, grid: Any) -> None:
@@ -274,9 +283,9 @@ STAGE_MODES = {"update": 0, "rate": 1, "from_rate": 2}
 
 
 def _stage_cells(state: list, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any, limiter: str,
-                 riemann: str, mode: str, aliases: dict | None) -> tuple:
+                 riemann: str, mode: str, aliases: dict | None, ghosts: Any = None) -> tuple:
     """One ``KtgfSsprkStageCells`` call in ``mode`` (:data:`STAGE_MODES`): (U' or L, the maxima; empty but in
-    mode rate)."""
+    mode rate).  ``ghosts``: as in :func:`flux_divergence`, along y or z (the cell fields of the ghost cells)."""
     _register(program, limiter, riemann, grid)
     dtype = state[0].dtype
     stage = variant(dtype, limiter, riemann, "stage")
@@ -284,14 +293,15 @@ def _stage_cells(state: list, program: Any, leaf: Any, a: Any, dt: Any, grid: An
     maxima = jax.ShapeDtypeStruct((program.nlim if mode == "rate" else 0,), dtype)
     call = jax.ffi.ffi_call(target(CELLS_TARGET, stage), (field,) * 5 + (maxima, _ring(grid, dtype, stage)),
                             input_output_aliases=aliases)
-    params = _stage_params(a, dt, grid, rho_s, dtype)
-    out = call(params, leaf, *state, **_schemes(limiter, riemann), program=np.int64(program.key),
+    params, extra = _ghost_args(_stage_params(a, dt, grid, rho_s, dtype), ghosts, dtype)
+    out = call(params, leaf, *state, *extra, **_schemes(limiter, riemann), program=np.int64(program.key),
                mode=np.int32(STAGE_MODES[mode]))
     return tuple(out[:5]), out[5]
 
 
 def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any,
-                      limiter: str, riemann: str, write_over: str = "uk", from_rate: bool = False) -> tuple[Any, ...]:
+                      limiter: str, riemann: str, write_over: str = "uk", from_rate: bool = False,
+                      ghosts: Any = None) -> tuple[Any, ...]:
     """The SSP-RK3 stage of :func:`ssprk_stage` with the cell fields and the energy source computed in
     the kernel from Uk by a cell program (:func:`.cell_program.for_physics`) with parameters ``leaf``
     (:func:`.cell_program.leaf_values`), plane by plane as it sweeps: no cell field is written to memory.
@@ -299,14 +309,14 @@ def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any
     ``write_over``: the input buffers U' is written over: ``"uk"``, ``"u0"`` (when the caller no longer needs
     the step's start state) or ``"new"`` (a step's first stage, whose Uk = U0 the later stages still read:
     written in place, XLA would first copy U0).  ``from_rate``: ``Uk`` is the rate L0 = L(U0) of
-    :func:`rate_cells`, and the stage's Uk is U0 + Δt L0.
+    :func:`rate_cells`, and the stage's Uk is U0 + Δt L0.  ``ghosts``: as in :func:`_stage_cells`.
     """
     dtype = Uk[0].dtype
     state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
     first = {"u0": 2, "uk": 7, "new": None}[write_over]  # the inputs are params, leaf, U0 (5), Uk (5)
     aliases = None if first is None else {first + i: i for i in range(5)}
     return _stage_cells(state, program, leaf, a, dt, grid, rho_s, limiter, riemann,
-                        "from_rate" if from_rate else "update", aliases)[0]
+                        "from_rate" if from_rate else "update", aliases, ghosts)[0]
 
 
 def rate_cells(U: Any, program: Any, leaf: Any, grid: Any, rho_s: Any, limiter: str, riemann: str) -> tuple:

@@ -288,8 +288,9 @@ def flux_divergence(W: Sequence[Any], coefficients: tuple[tuple[Any, ...], tuple
         from . import flux_kernel
 
         if flux_kernel.applies(grid, W[0].dtype, "rhs" if viscous else "euler", limiter, riemann):
-            *fields, fix = kernel_fields(W, eos, transport, grid, phys, limiter, riemann, viscous, t)
-            dU, divu = flux_kernel.flux_divergence(*fields, grid, phys.material_density, limiter, riemann, viscous)
+            *fields, ghosts, fix = kernel_fields(W, eos, transport, grid, phys, limiter, riemann, viscous, t)
+            dU, divu = flux_kernel.flux_divergence(*fields, grid, phys.material_density, limiter, riemann, viscous,
+                                                   ghosts)
             return add_boundary_fluxes(dU, fix, grid), divu
     P = pad_fields((*W, *eos), grid, t, velocity=1)
     Pk = pad_fields(transport, grid, t) if viscous else ()
@@ -316,13 +317,45 @@ def cell_divergence(Pu: Sequence[Any], grid: Grid) -> Any:
 
 def kernel_fields(W: Sequence[Any], eos: Sequence[Any], transport: Sequence[Any], grid: Grid, phys: Physics,
                   limiter: str, riemann: str, viscous: bool, t: Any = 0.0) -> tuple:
-    """The cell fields the C++ kernel sweeps (W, eos, transport) and the correction of its boundary planes.
+    """The cell fields the C++ kernel sweeps (W, eos, transport), then the ghost planes and the boundary
+    correction of :func:`boundary_terms` (None, None on a periodic grid: the kernel pads periodically)."""
+    if grid.boundaries is None or grid.boundaries.all_periodic:
+        return W, eos, transport, None, None
+    ends = grid_ends((*W, *eos, *transport), grid)
+    return (W, eos, transport, *boundary_terms(ends, grid, phys, limiter, riemann, viscous, t))
 
-    A periodic grid: the fields as they are (the kernel pads them) and no correction (None).  Otherwise the
-    fields padded here as the JAX path pads them for its convective flux (:func:`pad_fields`), which the
-    kernel sweeps as they are, and (axis, {plane: five increments of −∇·F}) for the planes next to the
-    boundary, where the JAX path's fluxes differ from what the kernel computes from those ghost cells — each
-    difference from the same formulas on slabs one cell thick:
+
+def boundary_axis(grid: Grid) -> int:
+    """The axis of a grid's Lees–Edwards boundary or, without one, of its first walls."""
+    bc = grid.boundaries
+    return bc.shear_axis if bc.shear_axis is not None else bc.wall_axes[0]
+
+
+def grid_ends(fields: Sequence[Any], grid: Grid) -> SimpleNamespace:
+    """The GHOST + 1 cells next to each end of the :func:`boundary_axis` ``a`` of ``fields`` (all of them on a grid
+    of ≤ 2(GHOST + 1) cells along a): ``fields``, ``grid`` (the grid they fill: its boundaries see them as the whole
+    axis, so the ghost cells of each end come from the cells of that end or, through a Lees–Edwards boundary, of the
+    other), ``k`` (their number along a) and ``a``."""
+    a = boundary_axis(grid)
+    n, m = grid.cells[a], GHOST + 1
+    k = min(n, 2 * m)
+    if n > 2 * m:
+        fields = [jnp.concatenate([jax.lax.slice_in_dim(f, 0, m, axis=a), jax.lax.slice_in_dim(f, n - m, n, axis=a)],
+                                  axis=a) for f in fields]
+    thin = SimpleNamespace(cells=tuple(k if b == a else c for b, c in enumerate(grid.cells)), spacing=grid.spacing,
+                           ndim=grid.ndim, lengths=grid.lengths, boundaries=grid.boundaries)
+    return SimpleNamespace(fields=list(fields), grid=thin, k=k, a=a)
+
+
+def boundary_terms(ends: SimpleNamespace, grid: Grid, phys: Physics, limiter: str, riemann: str, viscous: bool,
+                   t: Any = 0.0) -> tuple:
+    """What the C++ kernel needs at a wall or Lees–Edwards axis a, from the :func:`grid_ends` of the cell fields
+    (W, eos, then with ``viscous`` transport): (a, ghost planes) and (a, {plane: five increments of −∇·F}).
+
+    The ghost planes are the fields padded as the JAX path pads them for its convective flux (:func:`pad_fields`),
+    GHOST planes per side of the padded shape of the other axes, which the kernel puts over its periodic padding.
+    The increments are for the planes next to the boundary, where the JAX path's fluxes differ from what the
+    kernel computes from those ghost cells — each difference from the same formulas on slabs one cell thick:
 
     * Lees–Edwards: the lower boundary face takes the upper one mapped through the boundary
       (:func:`.boundaries.lees_edwards_faces`);
@@ -330,68 +363,56 @@ def kernel_fields(W: Sequence[Any], eos: Sequence[Any], transport: Sequence[Any]
       the wall planes (through the wall face, and along the other axes, whose tangential derivatives reach the
       ghost cells) see the ghost cells of the wall conditions (:func:`pad_viscous`).
     """
-    bc = grid.boundaries
-    if bc is None or bc.all_periodic:
-        return W, eos, transport, None
-    rho_s = phys.material_density
-    P = pad_fields((*W, *eos), grid, t, velocity=1)
-    Pk = pad_fields(transport, grid, t) if viscous else ()
-    a = bc.shear_axis if bc.shear_axis is not None else bc.wall_axes[0]
+    bc, rho_s, a, k = grid.boundaries, phys.material_density, ends.a, ends.k
     n, inv_dx = grid.cells[a], 1.0 / grid.spacing[a]
+    P = pad_fields(ends.fields[:7], ends.grid, t, velocity=1)
+    Pk = pad_fields(ends.fields[7:], ends.grid, t) if viscous else ()
+    ghosts = jnp.stack([jnp.stack([jnp.moveaxis(jax.lax.slice_in_dim(f, lo, lo + GHOST, axis=a), a, 0)
+                                   for lo in (0, k + GHOST)]) for f in (*P, *Pk)])
     slab = SimpleNamespace(cells=tuple(1 if b == a else c for b, c in enumerate(grid.cells)), spacing=grid.spacing,
                            ndim=grid.ndim, lengths=grid.lengths, boundaries=bc)
 
-    def cut(fields: Sequence[Any], lo: int) -> list[Any]:  # cell lo and G neighbours per side along a
-        return [jax.lax.slice_in_dim(f, lo, lo + 2 * GHOST + 1, axis=a) for f in fields]
+    def cuts(fields: Sequence[Any]) -> list[Any]:  # the end cells 0 and k - 1, G neighbours per side, stacked
+        return [jnp.stack([jax.lax.slice_in_dim(f, lo, lo + 2 * GHOST + 1, axis=a) for lo in (0, k - 1)])
+                for f in fields]
 
-    def face(F: Sequence[Any], k: int) -> list[Any]:
-        return [jax.lax.slice_in_dim(f, k, k + 1, axis=a) if jnp.ndim(f) else f for f in F]
+    def ends_map(fn: Any, *args: Any) -> tuple[list[Any], list[Any]]:
+        """fn of the stacked slabs of both ends at once (half the XLA operations of two calls): its lists of fields
+        at the end 0, at the end k - 1."""
+        out = jax.vmap(fn)(*args)
+        return [f[0] for f in out], [f[1] for f in out]
 
-    def slab_faces(lo: int, walls: bool, Pv: Sequence[Any] | None = None) -> list[Any]:  # both faces along a
-        F = convective_flux(cut(P, lo), slab.cells, a, limiter, riemann, walls=walls)
-        if viscous:
-            F = [f + v for f, v in zip(F, viscous_flux(cut(P[:5], lo) if Pv is None else Pv, cut(Pk, lo), a, slab,
-                                                       rho_s))]
-        return F
+    def slab_faces(walls: bool) -> Any:  # both faces along a of a slab (with walls: the viscous ghosts' slab Cv)
+        def fn(C: Any, Ck: Any, Cv: Any = None) -> list[Any]:
+            F = convective_flux(C, slab.cells, a, limiter, riemann, walls=walls)
+            if not viscous:
+                return F
+            return [f + v for f, v in zip(F, viscous_flux(C[:5] if Cv is None else Cv, Ck, a, slab, rho_s))]
+        return fn
 
+    def face(F: Sequence[Any], side: int) -> list[Any]:
+        return [jax.lax.slice_in_dim(f, side, side + 1, axis=a) for f in F]
+
+    C, Ck = cuts(P), cuts(Pk)
+    lo_own, hi_own = ends_map(slab_faces(False), C, Ck)
     if bc.shear_axis is not None:
-        own = face(slab_faces(0, False), 0)
-        pair = [jnp.concatenate([lo_, hi], axis=a) for lo_, hi in zip(own, face(slab_faces(n - 1, False), 1))]
+        own = face(lo_own, 0)
+        pair = [jnp.concatenate([lo_, hi], axis=a) for lo_, hi in zip(own, face(hi_own, 1))]
         mapped = face(lees_edwards_faces(pair, slab, a, t), 0)
-        return P[:5], P[5:], Pk if viscous else transport, (a, {0: [(m - f) * inv_dx for m, f in zip(mapped, own)]})
-    Pv = wall_slabs(W, transport, grid, phys, t) if viscous else {}
-    fix = {}
-    for plane, k, sign in ((0, 0, 1.0), (n - 1, 1, -1.0)):
-        true, own = face(slab_faces(plane, True, Pv.get(plane)), k), face(slab_faces(plane, False), k)
-        d = [sign * (x - y) * inv_dx for x, y in zip(true, own)]
-        for b in range(grid.ndim) if viscous else ():
-            if b != a:  # the wall plane's viscous fluxes along b, with the viscous ghosts less with the convective
-                Fv = viscous_flux(Pv[plane], cut(Pk, plane), b, slab, rho_s)
-                Fc = viscous_flux(cut(P[:5], plane), cut(Pk, plane), b, slab, rho_s)
-                dF = face_divergence(jnp.stack([x - y for x, y in zip(Fv[1:], Fc[1:])]), slab, b)
-                d = [d[0], *(x + y for x, y in zip(d[1:], dF))]
-        fix[plane] = d
-    return P[:5], P[5:], Pk if viscous else transport, (a, fix)
-
-
-def wall_slabs(W: Sequence[Any], transport: Sequence[Any], grid: Grid, phys: Physics, t: Any) -> dict:
-    """{plane: the primitive fields padded for the viscous fluxes (:func:`pad_viscous`) around the wall plane,
-    GHOST cells per side along the wall axis} for the two wall planes, padded on the GHOST + 1 cells next to each
-    wall only (the wall conditions read the two nearest; the rest of the grid is not copied)."""
-    a = grid.boundaries.wall_axes[0]
-    n, m = grid.cells[a], GHOST + 1
-    k = n
-    if n > 2 * m:
-        def ends(f: Any) -> Any:
-            return jnp.concatenate([jax.lax.slice_in_dim(f, 0, m, axis=a), jax.lax.slice_in_dim(f, n - m, n, axis=a)],
-                                   axis=a)
-
-        W, transport, k = [ends(f) for f in W], [ends(f) for f in transport], 2 * m
-        grid = SimpleNamespace(cells=tuple(k if b == a else c for b, c in enumerate(grid.cells)), spacing=grid.spacing,
-                               ndim=grid.ndim, boundaries=grid.boundaries)
-    Pv = pad_viscous(W, transport, grid, phys, t)
-    return {plane: [jax.lax.slice_in_dim(f, lo, lo + 2 * GHOST + 1, axis=a) for f in Pv]
-            for plane, lo in ((0, 0), (n - 1, k - 1))}
+        return (a, ghosts), (a, {0: [(m - f) * inv_dx for m, f in zip(mapped, own)]})
+    Cv = cuts(pad_viscous(ends.fields[:5], ends.fields[7:], ends.grid, phys, t)) if viscous else []
+    lo_true, hi_true = ends_map(slab_faces(True), C, Ck, *([Cv] if viscous else []))
+    d = {}
+    for plane, side, sign, true, own in ((0, 0, 1.0, lo_true, lo_own), (n - 1, 1, -1.0, hi_true, hi_own)):
+        d[plane] = [sign * (x - y) * inv_dx for x, y in zip(face(true, side), face(own, side))]
+    for b in range(grid.ndim) if viscous else ():
+        if b != a:  # the wall planes' viscous fluxes along b, with the viscous ghosts less with the convective
+            def along_b(Cv: Any, C: Any, Ck: Any, b: int = b) -> list[Any]:
+                Fv, Fc = viscous_flux(Cv, Ck, b, slab, rho_s), viscous_flux(C[:5], Ck, b, slab, rho_s)
+                return list(face_divergence(jnp.stack([x - y for x, y in zip(Fv[1:], Fc[1:])]), slab, b))
+            for plane, dF in zip((0, n - 1), ends_map(along_b, Cv, C, Ck)):
+                d[plane] = [d[plane][0], *(x + y for x, y in zip(d[plane][1:], dF))]
+    return (a, ghosts), (a, d)
 
 
 def add_boundary_fluxes(fields: Sequence[Any], fix: Any, grid: Grid, scale: Any = 1.0) -> Any:

@@ -210,10 +210,7 @@ def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None)
     if r is None:
         r = cell_coefficients(W, grid, phys)
     maxima = [jnp.max(f) for f in limit_terms(W, r, phys, num.acoustics, grid.spacing)]
-    if grid.boundaries is None or grid.boundaries.all_periodic:
-        divu_max = divu_bound(maxima, grid)
-    else:  # a mean shear makes max u − min u large; the central ∇·u itself (any time: only its size matters)
-        divu_max = jnp.max(jnp.abs(cell_divergence(pad_fields(u, grid, velocity=0), grid)))
+    divu_max = divu_size(u, maxima, grid)
     lim = limits_of_maxima(maxima, grid, num, divu_max)
     if num.sink == "implicit":  # ζ0 in the implicit part: SINK_COURANT/ζ0 for it, cfl_source/ζ for the rest
         r_e = r._replace(zeta0=jnp.zeros_like(r.zeta0))
@@ -221,6 +218,18 @@ def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None)
         zeta_e = jnp.max(phys.cooling_rate(rho, theta, 0.0, r_e)) + maxima[4] * divu_max
         lim = lim.at[3].set(jnp.minimum(SINK_COURANT / zeta0, num.cfl_source / zeta_e))
     return lim
+
+
+def periodic(grid: Grid) -> bool:
+    return grid.boundaries is None or grid.boundaries.all_periodic
+
+
+def divu_size(u: Any, maxima: Any, grid: Grid) -> Any:
+    """A bound of |∇·u| over the cells: :func:`divu_bound` on a periodic grid; elsewhere, where a mean shear makes
+    max u − min u large, the largest central ∇·u itself (at any time: only its size matters)."""
+    if periodic(grid):
+        return divu_bound(maxima, grid)
+    return jnp.max(jnp.abs(cell_divergence(pad_fields(u, grid, velocity=0), grid)))
 
 
 def kernel_step_limits(maxima: Any, grid: Grid, num: Numerics) -> Any:
@@ -247,25 +256,53 @@ def stage_kernel_applies(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -
             and flux_kernel.applies(grid, dtype, "stage", num.limiter, num.riemann))
 
 
-def cell_programs_apply(grid: Grid, phys: Physics) -> bool:
+def cell_programs_apply(grid: Grid) -> bool:
     """Whether the stage kernel may evaluate the closures itself (:mod:`.cell_program`): on a periodic grid
-    (its ghost cells' closures are those of the cells they image) without a body force."""
+    (its ghost cells' closures are those of the cells they image) or with its boundaries along y or z, whose
+    ghost cells' fields it then takes from :func:`cell_boundary_terms`."""
     from . import fluxes
 
-    periodic = grid.boundaries is None or grid.boundaries.all_periodic
-    return fluxes.CELL_PROGRAM and periodic and phys.gravity is None
+    return fluxes.CELL_PROGRAM and (periodic(grid) or (grid.ndim == 3 and fluxes.boundary_axis(grid) in (1, 2)))
+
+
+def cell_boundary_terms(Uk: Any, grid: Grid, phys: Physics, num: Numerics, t: Any) -> tuple:
+    """The ghost planes and boundary correction (:func:`.fluxes.boundary_terms`) of a stage at Uk whose closures a
+    cell program evaluates in the kernel: the closures of the cells next to the boundary only, here; (None, None)
+    on a periodic grid."""
+    from .fluxes import boundary_terms, grid_ends
+
+    if periodic(grid):
+        return None, None
+    ends = grid_ends(Uk, grid)
+    W = primitive_fields(ends.fields)
+    r = cell_coefficients(W, ends.grid, phys, t)
+    ends.fields = [*W, *phys.eos(W[0], W[4], r), *phys.transport(W[0], W[4], r)]
+    return boundary_terms(ends, grid, phys, num.limiter, num.riemann, True, t)
 
 
 def start_program(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> Any:
     """The step-start cell program of the SSP-RK3 stage kernel — the stage closures and the
     :data:`LIMIT_TERMS`, :func:`.flux_kernel.cell_limits` — or None where a step does not start with it
-    (no stage kernel or stage program, e.g. walls; another scheme or the implicit sink: :func:`kernel_limits_apply`)."""
+    (a boundary or a body force; no stage kernel or stage program; another scheme or the implicit sink:
+    :func:`kernel_limits_apply`)."""
     from .cell_program import for_physics
 
-    if not (cell_programs_apply(grid, phys) and kernel_limits_apply(num) and stage_kernel_applies(grid, phys, num,
-                                                                                                   dtype)):
+    if not (periodic(grid) and phys.gravity is None and cell_programs_apply(grid) and kernel_limits_apply(num)
+            and stage_kernel_applies(grid, phys, num, dtype)):
         return None
     if for_physics(phys, dtype) is None:  # the later stages need the stage program
+        return None
+    return for_physics(phys, dtype, limits=num.acoustics)
+
+
+def checks_program(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> Any:
+    """The step-start cell program whose kernel reduction (:func:`.flux_kernel.cell_limits`) gives the step limits
+    and the state checks of SSP-RK3 steps on the stage kernel outside the fused loop (boundaries, gravity: where
+    :func:`start_program` is None), or None where those come from XLA reductions (no stage kernel, closures
+    without a cell program, another scheme or the implicit sink)."""
+    from .cell_program import for_physics
+
+    if not (kernel_limits_apply(num) and stage_kernel_applies(grid, phys, num, dtype)):
         return None
     return for_physics(phys, dtype, limits=num.acoustics)
 
@@ -276,7 +313,9 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
     Written as three stages U_{k+1} = a_k U + (1 − a_k)(U_k + Δt L(U_k)), a = (0, 3/4, 1/3),
     in a ``fori_loop`` so the right-hand side is traced (and compiled) once, not three times.
     Where :func:`stage_kernel_applies`, each stage is the closures (XLA) and one kernel call, or
-    only the kernel call where the closures have a cell program (:mod:`.cell_program`).
+    only the kernel call where the closures have a cell program (:mod:`.cell_program`, :func:`cell_programs_apply`);
+    with boundaries, the kernel takes the ghost planes of their axis and the boundary planes' corrections and the
+    body force are added to its output.
     """
     coef = jnp.asarray([0.0, 0.75, 1.0 / 3.0], dtype=U[0].dtype)
     when = jnp.asarray([0.0, 1.0, 0.5], dtype=jnp.result_type(t, float))  # stage times / Δt
@@ -285,25 +324,46 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
         from .cell_program import for_physics, leaf_values
         from .flux_kernel import ssprk_stage, ssprk_stage_cells
 
-        program = for_physics(phys, U[0].dtype) if cell_programs_apply(grid, phys) else None
-        if program is not None:  # the closures inside the kernel: each stage is one call
-            U = tuple(U)
-            # The first stage writes new buffers (U is still needed).
-            U1 = ssprk_stage_cells(U, U, program, leaf_values(phys), coef[0], dt, grid, phys.material_density,
-                                   num.limiter, num.riemann, "new")
-            return later_cell_stages(U, U1, dt, grid, phys, num)
+        def before(ghosts: Any, fix: Any) -> tuple:
+            """The boundary terms, computed before the kernel call: XLA would otherwise compute the correction
+            beside the kernel, whose threads then wait for each other while XLA has a core."""
+            if fix is None:
+                return None, None
+            g, f = jax.lax.optimization_barrier((ghosts[1], fix[1]))
+            return (ghosts[0], g), (fix[0], f)
 
-        def kernel_stage(k: Any, Uk: tuple, r: Any) -> tuple:
-            W, eos, transport, source = kernel_stage_inputs(Uk, r, phys)
-            *fields, fix = kernel_fields(W, eos, transport, grid, phys, num.limiter, num.riemann, True,
-                                         t + when[k] * dt)
-            out = ssprk_stage(U, Uk, *fields, source, coef[k], dt, grid, phys.material_density, num.limiter,
-                              num.riemann)
+        def finish(k: Any, out: tuple, W: Any, fix: Any) -> tuple:
             if phys.gravity is not None:  # the body force, which the kernel's source does not have
                 force, power = body_force(W, phys)
                 out = (out[0], *(x + ((1.0 - coef[k]) * dt) * f for x, f in zip(out[1:4], force)),
                        out[4] + ((1.0 - coef[k]) * dt) * power)
             return add_boundary_fluxes(out, fix, grid, (1.0 - coef[k]) * dt)
+
+        program = for_physics(phys, U[0].dtype) if cell_programs_apply(grid) else None
+        if program is not None:  # the closures inside the kernel: each stage is one call
+            leaf = leaf_values(phys)
+
+            def cells_stage(k: int, Uk: tuple, write_over: str) -> tuple:
+                ghosts, fix = before(*cell_boundary_terms(Uk, grid, phys, num, t + when[k] * dt))
+                out = ssprk_stage_cells(U, Uk, program, leaf, coef[k], dt, grid, phys.material_density, num.limiter,
+                                        num.riemann, write_over, ghosts=ghosts)
+                return finish(k, out, primitive_fields(Uk), fix)
+
+            U = tuple(U)
+            # The first stage writes new buffers (U is still needed), the later ones over their input — unless XLA
+            # reads their input besides (boundaries, gravity), when it would copy it first (measured: 20 copies of
+            # a whole field per step).
+            later = "uk" if periodic(grid) and phys.gravity is None else "new"
+            return cells_stage(2, cells_stage(1, cells_stage(0, U, "new"), later), later)
+
+        def kernel_stage(k: Any, Uk: tuple, r: Any) -> tuple:
+            W, eos, transport, source = kernel_stage_inputs(Uk, r, phys)
+            *fields, ghosts, fix = kernel_fields(W, eos, transport, grid, phys, num.limiter, num.riemann, True,
+                                                 t + when[k] * dt)
+            ghosts, fix = before(ghosts, fix)
+            out = ssprk_stage(U, Uk, *fields, source, coef[k], dt, grid, phys.material_density, num.limiter,
+                              num.riemann, ghosts)
+            return finish(k, out, W, fix)
 
         if r0 is None:
             r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
@@ -472,6 +532,14 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
     bits (the kernels do not depend on the thread count: tests/solver/test_solver_flux_kernel.py).
     """
     program = start_program(grid, phys, num, U[0].dtype)
+    checks = None if program is not None else checks_program(grid, phys, num, U[0].dtype)
+    nlim = len(LIMIT_TERMS)
+    if checks is not None:
+        from .cell_program import leaf_values
+        from .flux_kernel import cell_limits
+
+        def start_maxima(U: Any) -> Any:  # the step limits' and the status' terms of U, reduced by the kernel
+            return cell_limits(U, checks, leaf_values(phys, grid), grid, num.limiter, num.riemann)
 
     def cond_before(limit: Any) -> Any:
         return lambda carry: (carry[1] < t_end) & (carry[2] < limit) & (carry[3] == 0)
@@ -487,17 +555,26 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
         return jnp.where(jnp.isfinite(dt_stable) & (dt > 0), 0, 5)
 
     def body(carry: tuple) -> tuple:
-        U, t, n, _, _ = carry
+        U, t, n, _, _, maxima = carry  # maxima: U's of the checks program (empty without it)
         # The closures of the step start, evaluated by XLA, serve both the step limits and the step's first stage.
         r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
-        dt_stable, dt, last = step_size(step_limits(U, grid, phys, num, r0), t)
+        if checks is None:
+            lim = step_limits(U, grid, phys, num, r0)
+        else:
+            lim = limits_of_maxima(maxima[:nlim], grid, num, divu_size(primitive_fields(U)[1:4], maxima, grid))
+        dt_stable, dt, last = step_size(lim, t)
         U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t, r0)
-        bad_state = state_status(U_new, phys)
+        if checks is None:
+            new_maxima, bad_state = maxima, state_status(U_new, phys)
+        else:  # the new state's check, and the next step's limits
+            new_maxima = start_maxima(U_new)
+            bad_state = status_of_maxima(new_maxima[nlim:], phys)
         status = jnp.where(bad_state != 0, bad_state, size_status(dt_stable, dt))
         status = jnp.where((status == 0) & ~(residual <= RESIDUAL_FAIL), 6, status)
         good = status == 0
         t = jnp.where(good, jnp.where(last, t_end, t + dt), t)
-        return tuple(jnp.where(good, a, b) for a, b in zip(U_new, U)), t, n + good.astype(n.dtype), status, dt
+        return (tuple(jnp.where(good, a, b) for a, b in zip(U_new, U)), t, n + good.astype(n.dtype), status, dt,
+                jnp.where(good, new_maxima, maxima))
 
     U = tuple(U)
     t = jnp.asarray(t, jnp.float64)
@@ -505,14 +582,14 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
     zero = jnp.zeros((), jnp.int32)
     init = (U, t, zero, zero, jnp.zeros((), jnp.float64))
     if program is None:
-        U, t, n, status, dt = jax.lax.while_loop(cond_before(max_steps), body, init)
+        maxima = jnp.zeros((0,), U[0].dtype) if checks is None else start_maxima(U)
+        U, t, n, status, dt, _ = jax.lax.while_loop(cond_before(max_steps), body, (*init, maxima))
         return jnp.stack(U), t, n, status, dt
 
     from .cell_program import leaf_values
     from .flux_kernel import cell_limits, rate_cells
 
     leaf = leaf_values(phys, grid)
-    nlim = len(LIMIT_TERMS)
 
     def fused_body(carry: tuple) -> tuple:
         # U: the state after n steps of the call, the n-th not checked yet; t_before: the time before that step.
