@@ -144,10 +144,8 @@ def profile_errors(history: dict[str, list], ref: Any, y: np.ndarray, u_scale: f
 def describe(grid: Grid) -> str:
     """One-line description of the boundaries (run metadata)."""
     bc = grid.boundaries
-    if bc is None:
-        return ", ".join(f"{AXES[a]}: {PERIODIC}" for a in range(grid.ndim))
     parts = []
-    for a, k in enumerate(bc.kinds):
+    for a, k in enumerate(bc.kinds if bc is not None else (PERIODIC,) * grid.ndim):
         if k == LEES_EDWARDS:
             parts.append(f"{AXES[a]}: lees-edwards (shear rate {float(bc.shear_rate):g}/s, flow {AXES[bc.flow]})")
         elif k == WALL:

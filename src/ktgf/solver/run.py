@@ -124,11 +124,8 @@ class Simulation:
         the clock t, dt is float64 even when the state is float32, as the step loop of :func:`advance` expects)."""
         return _x64(True)
 
+    @_in_precision  # the Haff time and output times are computed with JAX too
     def __init__(self, cfg: Config, directory: str | Path | None = None) -> None:
-        with _x64(True):  # the Haff time and output times are computed with JAX too
-            self._setup(cfg, directory)
-
-    def _setup(self, cfg: Config, directory: str | Path | None) -> None:
         self.cfg = cfg
         check_memory(tuple(cfg.grid.cells), cfg.numerics.precision)
         self.model = get_model(cfg.model.name, **cfg.model.options)
@@ -196,7 +193,6 @@ class Simulation:
         spec = jax.sharding.PartitionSpec(None, "x", *([None] * (self.grid.ndim - 1)))
         return jax.sharding.NamedSharding(mesh, spec)
 
-    # -- state -----------------------------------------------------------------------------
     @_in_precision
     def initial_state(self) -> Any:
         """The configured initial state (conservative, on the configured devices)."""
@@ -226,7 +222,6 @@ class Simulation:
     def config_json(self) -> str:
         return json.dumps(self.cfg.model_dump(mode="json"), sort_keys=True)
 
-    # -- run -------------------------------------------------------------------------------
     @_in_precision
     def run(
         self,
@@ -271,7 +266,7 @@ class Simulation:
             history = {name: [] for name in self.history_keys}
         self.history = history
         ckpt = self.directory / CHECKPOINT
-        bar = _Progress(progress, self.output_times[-1], self.t_haff, self.phys, self.phi0, self.theta0,
+        bar = _Progress(progress, self.output_times[-1], self.phys, self.phi0, self.theta0,
                         case=self.case.name, shear_rate=shear_rate(self.grid))
         chunks = 0
         try:
@@ -595,9 +590,8 @@ class _Progress:
     The first chunk is left out of every rate, because it includes the compilation.
     """
 
-    def __init__(self, enabled: bool, t_end: float, t_haff: float, phys: Physics, phi0: float, theta0: float,
-                 clock: Callable[[], float] = _time.perf_counter, case: str = "cooling",
-                 shear_rate: float = 0.0) -> None:
+    def __init__(self, enabled: bool, t_end: float, phys: Physics, phi0: float, theta0: float,
+                 clock: Callable[[], float] = _time.perf_counter, case: str = "cooling", shear_rate: float = 0.0) -> None:
         self.enabled, self.t_end = enabled, t_end
         self.args = (phys, phi0, theta0)
         self.clock = clock
@@ -605,7 +599,7 @@ class _Progress:
         # A sheared case has no Haff clock; its steps are about equally long in t.
         self._tau = (lambda t: float(tau_of_t(t, *self.args))) if self.case.hcs else float
         self.tau_end = self._tau(t_end)
-        self._steps, self._wall, self._first = 0, 0.0, True
+        self._steps, self._wall = 0, 0.0
         self._start: tuple[float, float] | None = None  # (τ, clock) at the end of the first chunk
         self.remaining: float | None = None  # seconds, once two chunks have run
 
@@ -625,8 +619,7 @@ class _Progress:
     def update(self, t: float, steps: int, wall: float) -> None:
         tau = self._tau(t)
         now = self.clock()
-        if self._first:  # the first chunk includes compilation: keep it out of the step rate and the ETA
-            self._first = False
+        if self._start is None:  # the first chunk includes compilation: keep it out of the step rate and the ETA
             self._start = (tau, now)
         else:
             self._steps += steps
