@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from ..io import atomic_path
 from .grid import Grid
 
 _VTK_TYPES = {np.dtype("float64"): "Float64", np.dtype("float32"): "Float32"}
@@ -62,22 +63,7 @@ def write_vti(path: str | Path, grid: Grid, fields: dict[str, np.ndarray], time:
     return path
 
 
-def read_vti(path: str | Path) -> dict[str, np.ndarray]:
-    """Read back the arrays of a .vti file written by :func:`write_vti` (flat, VTK order)."""
-    import xml.etree.ElementTree as ET
-
-    out = {}
-    for da in ET.parse(path).getroot().iter("DataArray"):
-        raw = base64.b64decode(da.text.strip())
-        n = int(np.frombuffer(raw[:8], dtype="<u8")[0])
-        dtype = "<f8" if da.get("type") == "Float64" else "<f4"
-        out[da.get("Name")] = np.frombuffer(raw[8 : 8 + n], dtype=dtype)
-    return out
-
-
 def _write_text(path: Path, text: str) -> None:
-    from ..io import atomic_path
-
     try:
         with atomic_path(path) as tmp:
             tmp.write_text(text, encoding="ascii")
@@ -104,8 +90,6 @@ def save_checkpoint(path: str | Path, U: np.ndarray, t: float, steps: int, outpu
                     history: dict[str, list], config_json: str) -> Path:
     """Write a checkpoint atomically: state, time, counters, diagnostics so far, the config, a format
     version and a SHA-256 of all of it (checked by :func:`load_checkpoint`)."""
-    from ..io import atomic_path
-
     path = Path(path)
     U = np.asarray(U)
     hist = json.dumps({k: np.asarray(v).tolist() for k, v in history.items()})
