@@ -62,6 +62,8 @@ from typing import Any
 import jax
 import jax.numpy as jnp
 
+from ..errors import InputError
+
 PERIODIC = "periodic"
 LEES_EDWARDS = "lees-edwards"
 WALL = "wall"
@@ -105,8 +107,6 @@ class Boundaries:
     walls: tuple = ()
 
     def __post_init__(self) -> None:
-        from ..errors import InputError
-
         kinds = tuple(self.kinds)
         object.__setattr__(self, "kinds", kinds)
         for a, k in enumerate(kinds):

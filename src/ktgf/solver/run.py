@@ -36,7 +36,7 @@ import numpy as np
 from ..closures import get_model
 from ..closures.coefficients import mean_free_path
 from ..errors import DivergenceError, InputError, KtgfError
-from ..io import write_netcdf
+from ..io import atomic_path, run_metadata, write_netcdf
 from .config import Config, box_lengths, changed_fields, config_value, initial_temperature
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
 from .cases import get_case
@@ -47,6 +47,7 @@ from .initial import haff_time, perturb, random_velocity, shear_mode, single_mod
 from .interrupt import STOP, Interrupted, fault_hook
 from ..plotting.fields import save_slices
 from .io import load_checkpoint, save_checkpoint, write_vti
+from .outdir import RunLock, clear_run_files, run_files
 from .physics import Physics
 from .sequencing import mean_temperature, start_from_run
 from .state import PRIMITIVE_NAMES, conservative, primitive
@@ -239,8 +240,6 @@ class Simulation:
         is locked for the run; a fresh run refuses a folder holding another run's files unless
         ``overwrite`` (which deletes them).  SIGINT/SIGTERM: see the module docstring.
         """
-        from .outdir import RunLock
-
         if resume is not None and overwrite:
             raise InputError("--resume and --overwrite exclude each other: resume continues the run, overwrite deletes it")
         with STOP:
@@ -341,8 +340,6 @@ class Simulation:
             ds.attrs["run_complete"] = 1
             write_netcdf(ds, self.timeseries)
             if self.verification is not None:
-                from ..io import atomic_path
-
                 with atomic_path(self.directory / VERIFICATION_FILE) as tmp:
                     tmp.write_text(json.dumps(self.verification, indent=2) + "\n")
         return ds
@@ -373,8 +370,6 @@ class Simulation:
 
     def _claim_folder(self, overwrite: bool) -> None:
         """Refuse to start afresh over another run's files (or delete them with ``overwrite``)."""
-        from .outdir import clear_run_files, run_files
-
         files = run_files(self.directory)
         if not files:
             return
@@ -522,8 +517,6 @@ class Simulation:
     def dataset(self, history: dict[str, list], steps: int | None = None) -> Any:
         """Diagnostics history as an xarray Dataset with full run metadata (SI units)."""
         import xarray as xr
-
-        from ..io import run_metadata
 
         t = np.asarray(history["time"], dtype=float)
         data = {name: ("time", np.asarray(history[name], dtype=float)) for name in SCALARS}

@@ -33,6 +33,7 @@ import numpy as np
 
 from ..errors import InputError, KtgfError
 from .boundaries import PERIODIC
+from .config import box_lengths, changed_fields, config_value, parse_config
 from .flows import boundaries
 from .io import load_checkpoint
 from .state import NVAR
@@ -68,8 +69,6 @@ def checkpoint_path(path: str | Path) -> Path:
 def load_run(path: str | Path) -> tuple[np.ndarray, Any, int]:
     """(U, config, steps) of an earlier run: its last checkpointed state, its validated :class:`Config` and
     its step count."""
-    from .config import parse_config
-
     ckpt = checkpoint_path(path)
     ck = load_checkpoint(ckpt)
     try:
@@ -93,8 +92,6 @@ def _earlier_cost(path: str | Path, steps: int) -> dict[str, Any]:
 
 def start_from_run(cfg: Any, cells: tuple[int, ...], lengths: tuple[float, ...]) -> tuple[np.ndarray, dict[str, Any]]:
     """The state of ``cfg.initial.from_run`` mapped onto this grid (checked against ``cfg``), and a record of it."""
-    from .config import box_lengths
-
     source = cfg.initial.from_run
     U_old, old, steps = load_run(source)
     old_lengths = box_lengths(old)
@@ -115,8 +112,6 @@ def mean_temperature(U: np.ndarray) -> float:
 def check_compatible(old: Any, new: Any, old_lengths: tuple[float, ...], new_lengths: tuple[float, ...],
                      source: str) -> None:
     """Refuse (one line naming the field) an earlier run that is not the same flow on a mappable box."""
-    from .config import changed_fields, config_value
-
     a, b = old.model_dump(mode="json"), new.model_dump(mode="json")
     where = f"(initial.from_run = {source!r})"
     changed = [f for name in SAME_FIELDS
