@@ -23,34 +23,11 @@ PNG), :mod:`.config` (pydantic/TOML), :mod:`.run` (:class:`Simulation`).
 Precision
     Importing this package leaves JAX's global ``jax_enable_x64`` setting alone.  A run's precision
     is part of its config: :class:`Simulation` runs inside ``jax.enable_x64(True)`` (see
-    :meth:`Simulation.precision`), with the state in ``numerics.precision`` — ``"float64"`` (the
-    default; needed for the verification against linear theory) or ``"float32"`` (≈1.6× faster
-    on CPU; the clock stays float64) or ``"mixed"`` (float32 state, IMEX stage solves with float64
-    inner products, float64 diagnostics; docs/solver.md "Mixed precision").  Calling the lower-level functions (:func:`advance`, ...) directly in
-    float64 needs the same context, or ``jax.config.update("jax_enable_x64", True)`` by the caller.
+    :meth:`Simulation.precision`), with the state in ``numerics.precision`` (``"float64"``, ``"float32"``
+    or ``"mixed"``; docs/solver.md "Mixed precision").  Calling the lower-level functions (:func:`advance`, ...)
+    directly in float64 needs the same context, or ``jax.config.update("jax_enable_x64", True)`` by the caller.
 
-Several devices (one host)
-    ``parallel.devices = N`` shards the first grid axis over N devices with
-    ``jax.sharding.NamedSharding(Mesh(devices, ("x",)), P(None, "x"))``; the same compiled
-    program runs, XLA inserts the halo exchanges for the periodic stencils.  On a CPU, create N
-    devices with ``XLA_FLAGS=--xla_force_host_platform_device_count=N`` (set before Python
-    starts).  The sharded run equals the single-device run to round-off
-    (tests/solver/test_solver_sharding.py).
-
-Several hosts
-    Start one process per host with the same config and call
-    ``jax.distributed.initialize(coordinator_address="host0:1234", num_processes=P,
-    process_id=i)`` before building the :class:`Simulation`; ``jax.devices()`` then lists the
-    devices of all hosts, and ``parallel.devices`` = the total count shards the box across them
-    (grid.cells[0] divisible by it).  Only process 0 should write files: guard outputs with
-    ``jax.process_index() == 0`` and gather fields with
-    ``jax.experimental.multihost_utils.process_allgather`` (not needed on one host).
-
-GPU
-    Install ``jax[cuda12]``; nothing in the solver is CPU specific.  JAX then places arrays on
-    the GPU by default; use float32 on consumer GPUs (slow float64), keep ``time.max_steps_per_call``
-    large (the whole step loop runs on the device inside one ``lax.while_loop``), and shard
-    over several GPUs exactly as above.
+Several devices, several hosts, GPUs: docs/solver.md (``parallel.devices`` shards the first grid axis).
 """
 
 from __future__ import annotations

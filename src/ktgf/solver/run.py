@@ -6,14 +6,8 @@ time in chunks of ``time.max_steps_per_call`` steps.  The step sequence depends 
 state and the next output time (a chunk boundary never shortens a step), so a run resumed
 from any checkpoint reproduces the uninterrupted run bit for bit.
 
-* Ctrl-C / SIGTERM set a flag (:mod:`.interrupt`) polled between chunks; the run then writes
-  ``checkpoint.npz`` and the time series (``<case>.nc``) for the outputs recorded so far and raises
-  :class:`~.interrupt.Interrupted`.  The time series is also written at every checkpoint.
-* The output folder is locked for the run (:mod:`.outdir`); a fresh run will not start over
-  another run's files without ``overwrite``.
-* A step that leaves the physical state space is rejected; the last good state is written
-  to ``checkpoint.npz`` and :class:`~ktgf.errors.DivergenceError` names the field, the cell,
-  its position and the time.
+Ctrl-C / SIGTERM (:mod:`.interrupt`), the locked output folder (:mod:`.outdir`) and a rejected step
+(:class:`~ktgf.errors.DivergenceError`, the last good state in ``checkpoint.npz``): docs/solver.md, "Running".
 """
 
 from __future__ import annotations

@@ -1,25 +1,14 @@
-"""Start a run from an earlier run's result on another grid (grid sequencing, as OpenFOAM's mapFields).
+"""Start a run from an earlier run's result on another grid (grid sequencing, as OpenFOAM's mapFields;
+docs/solver.md, "Starting from an earlier run").
 
-``[initial] from_run = "path"`` names the output folder of an earlier run (its ``checkpoint.npz``)
-or a checkpoint file.  The earlier state is mapped onto the new grid axis by axis:
-
-* along an axis of the same length the cell averages of the conservative variables
-  (ρ, ρu, E) are remapped conservatively (:func:`remap_axis`): a piecewise-linear reconstruction
-  in each old cell (minmod-limited slopes; one-sided at the ends of a wall or Lees–Edwards axis,
-  wrapped on a periodic one) is integrated exactly over each new cell.  Refinement by any factor,
-  coarsening and non-integer ratios are one formula; integer coarsening gives exactly the mean of
-  the fine cells.  If the reconstruction would leave the physical state space anywhere (θ ≤ 0,
-  ρ ≤ 0), the piecewise-constant remap (first order, also conservative) is used instead;
-* along a periodic axis the new box may be an integer multiple m of the old one: the old state is
-  tiled m times first (the means per unit volume are kept);
-* a grid equal to the earlier one gives the earlier state unchanged (bit for bit).
-
-The totals ∫ρ dV, ∫ρu dV and ∫E dV (per unit tile) are conserved to round-off.  The earlier run
-must be the same flow: case, model, restitution, particles, boundaries (walls, wall speeds,
-shear rate), inventory (``initial.solid_fraction``) and dimension; along a wall or Lees–Edwards
-axis the box length must be the same.  Each mismatch is refused in one line naming the field.
-The new run starts at t = 0 from the mapped state (a Lees–Edwards image shift restarts at 0),
-plus ``perturbation = "random"`` (:func:`~.initial.perturb`) if configured.
+``[initial] from_run = "path"`` names the output folder of an earlier run (its ``checkpoint.npz``) or a
+checkpoint file.  Along a periodic axis the new box may be a whole multiple of the old one (the state is tiled
+first); then every axis is remapped conservatively (:func:`remap_axis`, :func:`_remap_state`): order 2, or order
+1 where order 2 would leave the physical state space (θ ≤ 0, ρ ≤ 0).  A grid equal to the earlier one gives the
+earlier state bit for bit.  The earlier run must be the same flow (:data:`SAME_FIELDS`, the dimension, and the
+box length along a wall or Lees–Edwards axis): each mismatch is refused in one line naming the field.  The new
+run starts at t = 0 (a Lees–Edwards image shift restarts at 0), plus ``perturbation = "random"``
+(:func:`~.initial.perturb`) if configured.
 """
 
 from __future__ import annotations
