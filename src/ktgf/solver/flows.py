@@ -3,10 +3,6 @@
 The sheared cases start from the linear profile u_f = γ̇(x_a − L_a/2) (γ̇ = U/L_a in the Couette
 cell; a chute: u_f = ``initial.shear_rate`` · x_a) plus the configured perturbation.
 
-Steady state (``time.steady_tol``, docs/solver.md): the first output at which every steady monitor of
-the case changed by less than the tolerance since the previous one (``Case.steady_change``).  Relaxing
-as e^{−λt}, the change per output interval Δt is ≈ (1 − e^{−λΔt}) times the remaining deviation.
-
 Box-averaged stress tensor.  P = pI − τ with p = ρθp*(φ) and τ = η(∇u + ∇uᵀ − (2/3)∇·u I) +
 λ_b∇·u I (model.md §1), the velocity gradients by central differences across the (ghost-padded)
 cells, averaged over the box: ``stress_<ij>`` [Pa].

@@ -269,10 +269,8 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     Krylov scalars (:func:`_bicgstab64`, :func:`_cg64`); else everything in the dtype of Û.
 
     Returns the stage state, f_I at it, and the largest relative residual divided by ``tol``.
-    Boundaries: the Krylov operators are the linear part of the discrete operator (ghost cells
-    without the Lees–Edwards velocity jump); the jump enters through the right-hand side, which
-    is built from the full (affine) operator.  The FFT preconditioner stays the periodic one
-    (an approximation of the operator, so only the iteration count depends on it).
+    Boundaries: the Krylov operators leave out the affine parts, which enter the right-hand side (:mod:`.boundaries`,
+    "Affine parts"); the FFT preconditioner stays the periodic one (only the iteration count depends on it).
     """
     dtype = Uhat[0].dtype
     Wh = primitive_fields(Uhat)

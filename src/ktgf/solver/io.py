@@ -59,18 +59,16 @@ def write_vti(path: str | Path, grid: Grid, fields: dict[str, np.ndarray], time:
         f'    <Piece Extent="{extent}">\n      <CellData>\n' + "\n".join(arrays) + "\n      </CellData>\n"
         "    </Piece>\n  </ImageData>\n</VTKFile>\n"
     )
-    _write_text(path, xml)
+    try:
+        with atomic_path(path) as tmp:
+            tmp.write_text(xml, encoding="ascii")
+    except OSError as exc:
+        raise InputError(f"cannot write file {str(path)!r}: {exc.strerror or exc}") from exc
     return path
 
 
-def _write_text(path: Path, text: str) -> None:
-    try:
-        with atomic_path(path) as tmp:
-            tmp.write_text(text, encoding="ascii")
-    except (PermissionError, OSError) as exc:
-        raise InputError(f"cannot write file {str(path)!r}: {exc.strerror or exc}") from exc
-
-
+#: File name of a run's checkpoint in its output folder.
+CHECKPOINT = "checkpoint.npz"
 #: Version of the checkpoint layout; :func:`load_checkpoint` refuses any other.
 CHECKPOINT_FORMAT = 2
 _CHECKPOINT_KEYS = ("format", "hash", "U", "t", "steps", "output_index", "history", "config")
@@ -98,7 +96,7 @@ def save_checkpoint(path: str | Path, U: np.ndarray, t: float, steps: int, outpu
         with atomic_path(path) as tmp, open(tmp, "wb") as f:
             np.savez(f, format=np.int64(CHECKPOINT_FORMAT), hash=digest, U=U, t=np.float64(t), steps=np.int64(steps),
                      output_index=np.int64(output_index), history=hist, config=config_json)
-    except (PermissionError, OSError) as exc:
+    except OSError as exc:
         raise InputError(f"cannot write checkpoint {str(path)!r}: {exc.strerror or exc}") from exc
     return path
 

@@ -40,14 +40,13 @@ from .kinematics import gradient_axis, shear_rate
 from .initial import haff_time, perturb, random_velocity, shear_mode, single_mode, t_of_tau, tau_of_t, uniform_fields
 from .interrupt import STOP, Interrupted, fault_hook
 from ..plotting.fields import save_slices
-from .io import load_checkpoint, save_checkpoint, write_vti
+from .io import CHECKPOINT, load_checkpoint, save_checkpoint, write_vti
 from .outdir import RunLock, clear_run_files, run_files
 from .physics import Physics
 from .sequencing import mean_temperature, start_from_run
 from .state import PRIMITIVE_NAMES, conservative, primitive
 from .stepping import LIMIT_NAMES, STATUS_MESSAGES, Numerics, advance, binding_limit, choose_scheme, limits, state_status, step
 
-CHECKPOINT = "checkpoint.npz"
 HISTORY_KEYS = ("time", *SCALARS, *PER_AXIS, *(f"dt_{n}" for n in LIMIT_NAMES))
 #: Config fields that may differ between a checkpoint and the run resuming it: where and how
 #: often files are written, the chunk size (the step sequence does not depend on it) and the
@@ -70,8 +69,8 @@ def machine_memory() -> int | None:
 
 
 def _bytes(n: float) -> str:
-    for unit in ("B", "kB", "MB", "GB", "TB", "PB"):
-        if n < 1000 or unit == "PB":
+    for unit in ("B", "kB", "MB", "GB", "TB"):
+        if n < 1000:
             return f"{n:.3g} {unit}"
         n /= 1000
     return f"{n:.3g} PB"
@@ -310,7 +309,7 @@ class Simulation:
             done = "the run is complete" if k >= n_out else f"{k} of {n_out} outputs written"
             raise Interrupted(
                 f"interrupted at t = {t:.6g} s after {steps} steps ({done}); checkpoint written to {ckpt}",
-                checkpoint=ckpt, t=t, steps=steps, exit_code=STOP.exit_code if STOP.requested else 130,
+                checkpoint=ckpt, exit_code=STOP.exit_code if STOP.requested else 130,
             ) from (None if isinstance(exc, Interrupted) else exc)
         self.state, self.time, self.steps = U, t, steps
         ds = self.dataset(history)

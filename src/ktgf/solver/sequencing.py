@@ -24,10 +24,9 @@ from ..errors import InputError, KtgfError
 from .boundaries import PERIODIC
 from .config import box_lengths, changed_fields, config_value, parse_config
 from .flows import boundaries
-from .io import load_checkpoint
+from .io import CHECKPOINT, load_checkpoint
 from .state import NVAR
 
-CHECKPOINT_NAME = "checkpoint.npz"
 #: Config fields that must be the same in the earlier run (dotted; sections compared leaf by leaf).
 SAME_FIELDS = ("case", "model", "particles", "boundaries", "initial.solid_fraction")
 #: Relative tolerance of the box-length checks (lengths in m from the same config arithmetic).
@@ -38,9 +37,9 @@ def checkpoint_path(path: str | Path) -> Path:
     """The checkpoint of ``initial.from_run``: the file itself, or ``checkpoint.npz`` in a run folder."""
     p = Path(path)
     if p.is_dir():
-        p = p / CHECKPOINT_NAME
+        p = p / CHECKPOINT
         if not p.is_file():
-            raise InputError(f"field initial.from_run = {str(path)!r}: the folder holds no {CHECKPOINT_NAME} "
+            raise InputError(f"field initial.from_run = {str(path)!r}: the folder holds no {CHECKPOINT} "
                              "(valid: the output folder of a finished ktgf run, or its checkpoint file)")
         return p
     if p.suffix == ".toml":
@@ -48,10 +47,10 @@ def checkpoint_path(path: str | Path) -> Path:
                          "ktgf run (or ktgf.solver.chain.run_chain), which runs it first")
     if p.suffix == ".nc":
         raise InputError(f"field initial.from_run = {str(path)!r}: a netCDF time series holds no fields; valid: "
-                         f"the run's output folder or its {CHECKPOINT_NAME}")
+                         f"the run's output folder or its {CHECKPOINT}")
     if not p.is_file():
         raise InputError(f"field initial.from_run = {str(path)!r} does not exist (valid: the output folder of an "
-                         f"earlier run or its {CHECKPOINT_NAME})")
+                         f"earlier run or its {CHECKPOINT})")
     return p
 
 
