@@ -50,11 +50,6 @@ _PLAIN_PROBE = 'extern "C" int ktgf_probe(int n) { return n + 1; }\n'
 _said: set[str] = set()
 
 
-def cache_dir() -> Path:
-    """The folder of the compiled libraries: ``$KTGF_CACHE_DIR``, default ``~/.cache/ktgf``."""
-    return Path(os.environ.get("KTGF_CACHE_DIR", Path.home() / ".cache" / "ktgf"))
-
-
 def compiler() -> str:
     """Path of the C++ compiler (see the module docstring); raises RuntimeError if there is none."""
     name = os.environ.get("CXX")
@@ -227,7 +222,8 @@ def shared_library(name: str, source: str | Path, flags: Sequence[str], what: st
                        "with libomp, set in CXX, restores them)")
     flags = (*COMMON_FLAGS, *tc.flags(threads), *flags)
     text = source.read_bytes() if isinstance(source, Path) else source.encode()
-    lib = cache_dir() / f"{name}-{library_key(text, flags, tc)}.so"
+    folder = Path(os.environ.get("KTGF_CACHE_DIR", Path.home() / ".cache" / "ktgf"))  # module docstring
+    lib = folder / f"{name}-{library_key(text, flags, tc)}.so"
     if lib.exists():
         return lib
     lib.parent.mkdir(parents=True, exist_ok=True)
@@ -260,5 +256,4 @@ def _compile(cxx: str, source: str | Path, flags: Sequence[str], lib: Path, what
         os.replace(tmp, lib)
     finally:
         for path in temporary:
-            if os.path.exists(path):
-                os.unlink(path)
+            Path(path).unlink(missing_ok=True)

@@ -60,14 +60,6 @@ RESUMABLE_CHANGES = ("output.directory", "output.checkpoint_every", "output.vtk_
 MEMORY_FACTOR = 20
 
 
-def machine_memory() -> int | None:
-    """Physical memory of this machine [bytes] (None if unknown)."""
-    try:
-        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):
-        return None
-
-
 def _bytes(n: float) -> str:
     for unit in ("B", "kB", "MB", "GB", "TB"):
         if n < 1000:
@@ -81,7 +73,10 @@ def check_memory(cells: tuple[int, ...], precision: str, available: int | None =
     itemsize = 8 if precision == "float64" else 4
     state = 5 * math.prod(cells) * itemsize
     need = MEMORY_FACTOR * state
-    have = machine_memory() if available is None else available
+    have = available
+    if have is None:  # the physical memory of this machine, where the system says it
+        with contextlib.suppress(ValueError, OSError, AttributeError):
+            have = int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
     if have is not None and need > have:
         raise InputError(
             f"field grid.cells = {list(cells)} needs about {_bytes(need)} of memory ({MEMORY_FACTOR} x the "
@@ -616,7 +611,8 @@ class _Progress:
         if not self.enabled:
             return
         rate = f"{self._steps / self._wall:.1f}" if self._wall > 0 else "-"
-        eta = "-" if self.remaining is None else _format_seconds(self.remaining)
+        s = round(self.remaining or 0.0)
+        eta = "-" if self.remaining is None else f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
         self.bar.update(self.task, completed=t, clock=self.clock_text(t), rate=rate, eta=eta)
 
     def clock_text(self, t: float) -> str:
@@ -626,8 +622,3 @@ class _Progress:
     def __exit__(self, *exc: object) -> None:
         if self.enabled:
             self.bar.__exit__(*exc)
-
-
-def _format_seconds(s: float) -> str:
-    s = int(round(s))
-    return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
