@@ -313,12 +313,12 @@ def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any],
                 d_over_theta = rho_s * jj_dissipation(wall, phi_w, chi, theta_w) / theta_w
                 # the slip work of the collisions only: the frictional traction's is dissipated at the wall contacts
                 work = (sum(c_collision * sl * sl for sl in slip) if c is not None else jnp.zeros_like(beta))
-                heat = ("jj", d_over_theta, work)
+                heat = (d_over_theta, work)
             elif wall.energy == "prescribed":
-                heat = ("fixed", jnp.full_like(beta, wall.temperature), jnp.zeros_like(beta))
+                heat = (jnp.full_like(beta, wall.temperature), jnp.zeros_like(beta))
             else:
-                heat = ("adiabatic", jnp.zeros_like(beta), jnp.zeros_like(beta))
-            out[a, side] = {"ratio": ratio, "offset": offset, "heat": heat[1:], "stress": stress, "slip": slip,
+                heat = (jnp.zeros_like(beta), jnp.zeros_like(beta))
+            out[a, side] = {"ratio": ratio, "offset": offset, "heat": heat, "stress": stress, "slip": slip,
                             "kappa": wall_face(kappa, a, n, side)}
             if wall.friction_angle > 0.0:
                 out[a, side]["c_friction"] = c_friction
@@ -359,8 +359,7 @@ def _wall_ghosts(f: Any, grid: Any, a: int, G: int, role: Any, terms: dict | Non
             j = role[1]
             g0 = T["ratio"][j] * layers[0] + (T["offset"][j] if affine else 0.0)
             ghost = [g0] + [layers[0] + g0 - layers[g] for g in range(1, G)]
-        ghost = ghost[::-1]  # outermost first
-        slabs.append(ghost if side == 0 else ghost[::-1])
+        slabs.append(ghost[::-1] if side == 0 else ghost)  # ghost[0] is next to the wall: outermost first below
     return jnp.concatenate([*slabs[0], f, *slabs[1]], axis=a)
 
 

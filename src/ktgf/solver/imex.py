@@ -274,7 +274,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     """
     dtype = Uhat[0].dtype
     Wh = primitive_fields(Uhat)
-    rho = Wh[0]
+    rho = rho_hat = Wh[0]
     m_hat, E_hat = Uhat[1:4], Uhat[4]
     rho_mean = jnp.mean(rho)
     u, theta = tuple(Wh[1:4]), Wh[4]
@@ -287,7 +287,6 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     # the frictional heating it cancels, frozen with μ_f at the stage start (as a rate ∝ θ, or explicitly,
     # the stage-start θ biased the steady θ by O(ζΔt), 4-7 % measured; explicitly a stiff one overshot).
     friction_sink = 1.5 * rho * theta * r.zeta_f if is_frictional(r) else 0.0
-    rho_hat = rho
     galilean = acoustic is not None and grid.boundaries is not None and grid.boundaries.shear_axis is not None
     if acoustic is not None:
         sweeps = max(sweeps, MIN_SWEEPS)
