@@ -4,14 +4,11 @@ Boxes with per-axis boundaries — periodic, Lees–Edwards (uniform shear) or J
 and an optional body force; the case (cooling box, uniform shear, planar Couette, chute) is data
 (:mod:`.cases`, one module each; :mod:`.boundaries`; docs/solver.md "Cases and boundaries").
 
-Conservative variables (ρ, ρu, E = ρ(|u|²/2 + 3θ/2)) on a uniform periodic grid in 1, 2 or 3
-dimensions (one code path; the velocity always has three components).  MUSCL-reconstructed
-HLL (or Rusanov) convective flux with the granular equation of state p = ρθp*(φ), central
-viscous and heat fluxes (η, λ_b, κ and the ω∇φ term), the closures evaluated once per cell and
-stage through ``Model.reduced(φ, e, check=False)`` (face coefficients: mean of the cells), the
-collisional sink −(3/2)ρθ(ζ0 + ζ_U∇·u), and an adaptive step: IMEX ARS(2,2,2) with implicit
-viscous and heat fluxes (acoustic CFL and cooling limits, :mod:`.imex`) or SSP-RK3 (plus the
-diffusive limits).  Any registered closure model can be used; the solver never branches on its name.
+Conservative variables (ρ, ρu, E = ρ(|u|²/2 + 3θ/2)) on a uniform grid in 1, 2 or 3 dimensions (one code
+path; the velocity always has three components); the discretisation (MUSCL + HLL/Rusanov, central viscous and
+heat fluxes, IMEX ARS(2,2,2) or SSP-RK3): docs/solver.md, "Equations and numerics".  The closures are evaluated
+once per cell and stage through ``Model.reduced(φ, e, check=False)``: any registered closure model can be used,
+and the solver never branches on its name.
 
 Modules: :mod:`.grid` (grid and its boundaries, a pytree), :mod:`.boundaries` (ghost cells of
 each boundary kind), :mod:`.cases` (the cases: checks, start, diagnostics, references), :mod:`.flows` (what they share), :mod:`.state` (variables), :mod:`.physics`
