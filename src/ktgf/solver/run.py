@@ -41,7 +41,7 @@ from .initial import haff_time, perturb, random_velocity, shear_mode, single_mod
 from .interrupt import STOP, Interrupted, fault_hook
 from ..plotting.fields import save_slices
 from .io import CHECKPOINT, load_checkpoint, save_checkpoint, write_vti
-from .outdir import RunLock, clear_run_files, run_files
+from .outdir import RunLock, run_files
 from .physics import Physics
 from .sequencing import mean_temperature, start_from_run
 from .state import PRIMITIVE_NAMES, conservative, primitive
@@ -359,10 +359,10 @@ class Simulation:
     def _claim_folder(self, overwrite: bool) -> None:
         """Refuse to start afresh over another run's files (or delete them with ``overwrite``)."""
         files = run_files(self.directory)
-        if not files:
-            return
         if overwrite:
-            clear_run_files(self.directory)
+            for p in files:
+                p.unlink(missing_ok=True)
+        if overwrite or not files:
             return
         where = repr(str(self.directory))
         ckpt = self.directory / CHECKPOINT
@@ -574,11 +574,10 @@ class _Progress:
     def __init__(self, enabled: bool, t_end: float, phys: Physics, phi0: float, theta0: float,
                  clock: Callable[[], float] = _time.perf_counter, case: str = "cooling", shear_rate: float = 0.0) -> None:
         self.enabled, self.t_end = enabled, t_end
-        self.args = (phys, phi0, theta0)
         self.clock = clock
         self.case, self.shear_rate = get_case(case), shear_rate
         # A sheared case has no Haff clock; its steps are about equally long in t.
-        self._tau = (lambda t: float(tau_of_t(t, *self.args))) if self.case.hcs else float
+        self._tau = (lambda t: float(tau_of_t(t, phys, phi0, theta0))) if self.case.hcs else float
         self.tau_end = self._tau(t_end)
         self._steps, self._wall = 0, 0.0
         self._start: tuple[float, float] | None = None  # (τ, clock) at the end of the first chunk

@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import InputError, KtgfError
 from .boundaries import PERIODIC
 from .config import box_lengths, changed_fields, config_value, parse_config
-from .flows import boundaries
+from .flows import VERIFICATION_FILE, boundaries
 from .io import CHECKPOINT, load_checkpoint
 from .state import NVAR
 
@@ -68,7 +68,7 @@ def load_run(path: str | Path) -> tuple[np.ndarray, Any, int]:
 
 def _earlier_cost(path: str | Path, steps: int) -> dict[str, Any]:
     """Steps, wall and CPU time of the earlier run and of the whole sequence up to it (its verification.json)."""
-    ver = Path(path) / "verification.json" if Path(path).is_dir() else Path(path).with_name("verification.json")
+    ver = Path(path) / VERIFICATION_FILE if Path(path).is_dir() else Path(path).with_name(VERIFICATION_FILE)
     try:
         run = json.loads(ver.read_text())["run"]
     except (OSError, ValueError, KeyError, TypeError):
