@@ -1,8 +1,5 @@
 """What the flow cases share (:mod:`ktgf.solver.cases`): boundaries, base flow, stress, wall columns.
 
-The sheared cases start from the linear profile u_f = γ̇(x_a − L_a/2) (γ̇ = U/L_a in the Couette
-cell; a chute: u_f = ``initial.shear_rate`` · x_a) plus the configured perturbation.
-
 Box-averaged stress tensor.  P = pI − τ with p = ρθp*(φ) and τ = η(∇u + ∇uᵀ − (2/3)∇·u I) +
 λ_b∇·u I (model.md §1), the velocity gradients by central differences across the (ghost-padded)
 cells, averaged over the box: ``stress_<ij>`` [Pa].
