@@ -211,7 +211,7 @@ def test_progress_clock_names_the_case_and_its_time_unit() -> None:
     assert get_case("couette").clock(0.02, shear_rate=100.0) == "t = 0.02 s  γ̇t = 2"
     assert get_case("chute").clock(1.5) == "t = 1.5 s"  # no imposed shear rate, no strain clock
     assert get_case("uniform-shear").label != get_case("cooling").label == "HCS"
-    bar = _Progress(False, 0.04, float("nan"), None, 0.3, None, case="uniform-shear", shear_rate=250.0)
+    bar = _Progress(False, 0.04, None, 0.3, None, case="uniform-shear", shear_rate=250.0)
     assert bar.clock_text(0.04) == "t = 0.04 s  γ̇t = 10"
     assert "τ" not in bar.clock_text(0.04)
 
@@ -230,7 +230,7 @@ def test_run_eta_ignores_compilation_and_follows_collisions() -> None:
         "time": {"end": 20.0, "outputs": 4}, "output": {"vtk": False, "png": False},
     }))
     clock = [0.0]
-    bar = _Progress(False, float(sim.output_times[-1]), sim.t_haff, sim.phys, sim.phi0, sim.theta0, clock=lambda: clock[0])
+    bar = _Progress(False, float(sim.output_times[-1]), sim.phys, sim.phi0, sim.theta0, clock=lambda: clock[0])
     n = 50  # chunks, equal in τ
     taus = np.linspace(0.0, bar.tau_end, n + 1)[1:]
     times = np.asarray(t_of_tau(taus, sim.phys, sim.phi0, sim.theta0), dtype=float)

@@ -17,6 +17,12 @@ def fit_rate(times: np.ndarray, amplitudes: np.ndarray) -> complex:
     return complex(np.polyfit(times, logp.real, 1)[0] + 1j * np.polyfit(times, np.unwrap(logp.imag), 1)[0])
 
 
+def fourier_coefficient(field, grid, mode: tuple[int, ...]) -> complex:
+    """Complex amplitude c of c·e^{ik·x} + c.c. in a real field (k = 2πn/L)."""
+    f = np.fft.fftn(np.asarray(field))
+    return complex(2.0 * f[tuple(int(n) % c for n, c in zip(mode, grid.cells))] / grid.size)
+
+
 def temporal_orders(U0, grid, phys, t_end: float, n0: int, fields: list[int], theta0: float,
                     **numerics) -> tuple[list[float], np.ndarray]:
     """Errors of runs to t_end in n0, 2n0, 4n0 equal steps against 64n0 steps (max over the primitive
@@ -43,7 +49,6 @@ def measure_rate(model: str, cells: tuple[int, ...], mode: tuple[int, ...], ksta
     ``numerics.precision = "mixed"``)."""
     from ktgf.closures import get_model
     from ktgf.closures.coefficients import mean_free_path
-    from ktgf.solver.diagnostics import fourier_coefficient
     from ktgf.solver.grid import Grid
     from ktgf.solver.initial import single_mode, t_of_tau
     from ktgf.solver.physics import Physics

@@ -17,12 +17,12 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 from helpers.couette_case import couette_case
+from helpers.growth import fourier_coefficient
 
 from ktgf.closures import get_model
 from ktgf.closures.coefficients import mean_free_path
 from ktgf.hcs.haff import cooling_time, haff_temperature
 from ktgf.solver import fluxes
-from ktgf.solver.diagnostics import fourier_coefficient
 from ktgf.solver.grid import Grid
 from ktgf.solver.initial import single_mode, t_of_tau, uniform_fields
 from ktgf.solver.physics import Physics

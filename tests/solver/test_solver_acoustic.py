@@ -18,13 +18,12 @@ import math
 
 import numpy as np
 import pytest
-from helpers.growth import fit_rate, temporal_orders
+from helpers.growth import fit_rate, fourier_coefficient, temporal_orders
 
 from ktgf.closures import get_model
 from ktgf.closures.coefficients import mean_free_path
 from ktgf.errors import InputError
 from ktgf.solver.config import parse_config
-from ktgf.solver.diagnostics import fourier_coefficient
 from ktgf.solver.grid import Grid
 from ktgf.solver.initial import single_mode, t_of_tau
 from ktgf.solver.physics import Physics

@@ -7,13 +7,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from helpers.vti import read_vti
 from typer.testing import CliRunner
 
 from ktgf.cli import app
 from ktgf.errors import DivergenceError, InputError
 from ktgf.solver.config import load_config, parse_config
 from ktgf.solver.grid import Grid
-from ktgf.solver.io import load_checkpoint, read_vti, write_vti
+from ktgf.solver.io import load_checkpoint, write_vti
 from ktgf.solver.run import CHECKPOINT, Simulation
 
 TIMESERIES = "cooling.nc"  # the time series of a cooling run

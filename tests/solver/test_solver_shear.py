@@ -367,8 +367,7 @@ def test_sheared_case_resumes_bit_for_bit_and_writes_its_files(tmp_path: Path, c
     import tomllib
 
     import xarray as xr
-
-    from ktgf.solver.io import read_vti
+    from helpers.vti import read_vti
 
     text = {"uniform-shear": lambda: _case([8, 8], "y", "x", 2.0),
             "couette": lambda: _couette([4, 8], 4.0, lengths="[4.0, 8.0]", axis="y", flow="x"),

@@ -21,12 +21,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers.growth import fit_rate
+from helpers.growth import fit_rate, fourier_coefficient
 
 from ktgf.closures import get_model
 from ktgf.shear.stability import shear_matrix
 from ktgf.solver.boundaries import Boundaries
-from ktgf.solver.diagnostics import fourier_coefficient
 from ktgf.solver.flows import add_base_flow, linear_profile
 from ktgf.solver.grid import Grid
 from ktgf.solver.initial import shear_axes, shear_mode

@@ -4,14 +4,11 @@ Boxes with per-axis boundaries — periodic, Lees–Edwards (uniform shear) or J
 and an optional body force; the case (cooling box, uniform shear, planar Couette, chute) is data
 (:mod:`.cases`, one module each; :mod:`.boundaries`; docs/solver.md "Cases and boundaries").
 
-Conservative variables (ρ, ρu, E = ρ(|u|²/2 + 3θ/2)) on a uniform periodic grid in 1, 2 or 3
-dimensions (one code path; the velocity always has three components).  MUSCL-reconstructed
-HLL (or Rusanov) convective flux with the granular equation of state p = ρθp*(φ), central
-viscous and heat fluxes (η, λ_b, κ and the ω∇φ term), the closures evaluated once per cell and
-stage through ``Model.reduced(φ, e, check=False)`` (face coefficients: mean of the cells), the
-collisional sink −(3/2)ρθ(ζ0 + ζ_U∇·u), and an adaptive step: IMEX ARS(2,2,2) with implicit
-viscous and heat fluxes (acoustic CFL and cooling limits, :mod:`.imex`) or SSP-RK3 (plus the
-diffusive limits).  Any registered closure model can be used; the solver never branches on its name.
+Conservative variables (ρ, ρu, E = ρ(|u|²/2 + 3θ/2)) on a uniform grid in 1, 2 or 3 dimensions (one code
+path; the velocity always has three components); the discretisation (MUSCL + HLL/Rusanov, central viscous and
+heat fluxes, IMEX ARS(2,2,2) or SSP-RK3): docs/solver.md, "Equations and numerics".  The closures are evaluated
+once per cell and stage through ``Model.reduced(φ, e, check=False)``: any registered closure model can be used,
+and the solver never branches on its name.
 
 Modules: :mod:`.grid` (grid and its boundaries, a pytree), :mod:`.boundaries` (ghost cells of
 each boundary kind), :mod:`.cases` (the cases: checks, start, diagnostics, references), :mod:`.flows` (what they share), :mod:`.state` (variables), :mod:`.physics`
@@ -23,34 +20,11 @@ PNG), :mod:`.config` (pydantic/TOML), :mod:`.run` (:class:`Simulation`).
 Precision
     Importing this package leaves JAX's global ``jax_enable_x64`` setting alone.  A run's precision
     is part of its config: :class:`Simulation` runs inside ``jax.enable_x64(True)`` (see
-    :meth:`Simulation.precision`), with the state in ``numerics.precision`` — ``"float64"`` (the
-    default; needed for the verification against linear theory) or ``"float32"`` (≈1.6× faster
-    on CPU; the clock stays float64) or ``"mixed"`` (float32 state, IMEX stage solves with float64
-    inner products, float64 diagnostics; docs/solver.md "Mixed precision").  Calling the lower-level functions (:func:`advance`, ...) directly in
-    float64 needs the same context, or ``jax.config.update("jax_enable_x64", True)`` by the caller.
+    :meth:`Simulation.precision`), with the state in ``numerics.precision`` (``"float64"``, ``"float32"``
+    or ``"mixed"``; docs/solver.md "Mixed precision").  Calling the lower-level functions (:func:`advance`, ...)
+    directly in float64 needs the same context, or ``jax.config.update("jax_enable_x64", True)`` by the caller.
 
-Several devices (one host)
-    ``parallel.devices = N`` shards the first grid axis over N devices with
-    ``jax.sharding.NamedSharding(Mesh(devices, ("x",)), P(None, "x"))``; the same compiled
-    program runs, XLA inserts the halo exchanges for the periodic stencils.  On a CPU, create N
-    devices with ``XLA_FLAGS=--xla_force_host_platform_device_count=N`` (set before Python
-    starts).  The sharded run equals the single-device run to round-off
-    (tests/solver/test_solver_sharding.py).
-
-Several hosts
-    Start one process per host with the same config and call
-    ``jax.distributed.initialize(coordinator_address="host0:1234", num_processes=P,
-    process_id=i)`` before building the :class:`Simulation`; ``jax.devices()`` then lists the
-    devices of all hosts, and ``parallel.devices`` = the total count shards the box across them
-    (grid.cells[0] divisible by it).  Only process 0 should write files: guard outputs with
-    ``jax.process_index() == 0`` and gather fields with
-    ``jax.experimental.multihost_utils.process_allgather`` (not needed on one host).
-
-GPU
-    Install ``jax[cuda12]``; nothing in the solver is CPU specific.  JAX then places arrays on
-    the GPU by default; use float32 on consumer GPUs (slow float64), keep ``time.max_steps_per_call``
-    large (the whole step loop runs on the device inside one ``lax.while_loop``), and shard
-    over several GPUs exactly as above.
+Several devices, several hosts, GPUs: docs/solver.md (``parallel.devices`` shards the first grid axis).
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""Boundary conditions of the finite-volume solver as data: one kind per grid axis.
+"""Boundary conditions of the finite-volume solver as data: one kind per grid axis (the conditions, with their
+equations: docs/solver.md, "Cases and boundaries").
 
 Every stencil of :mod:`.fluxes` and :mod:`.imex` reads fields padded with :data:`~.fluxes.GHOST`
 ghost cells per side; the boundaries only decide what the ghost cells hold (:func:`pad`).
@@ -7,43 +8,27 @@ ghost cells per side; the boundaries only decide what the ghost cells hold (:fun
     The ghost cells are the cells at the other end of the axis (the cooling box; the code path
     is the one of :func:`~.fluxes.pad_periodic`, so periodic runs are unchanged bit for bit).
 ``lees-edwards``
-    Shearing-periodic images (Lees & Edwards 1972, *J. Phys. C* 5, 1921): along the gradient
-    axis a (length L_a) the image boxes above and below move with velocity ±γ̇L_a along the
-    flow direction f and are displaced by ±Δ(t), Δ = γ̇L_a t mod L_f.  A ghost cell above the
-    box at position x_f holds the state of the cell it images,
-
-        W(x_f, L_a + s) = W(x_f − Δ, s) + γ̇L_a e_f      (below: W(x_f + Δ, L_a − s) − γ̇L_a e_f)
-
-    with the velocity jump on the flow component only (ρ, θ and the closures are unchanged).
-    Δ is not a whole number of cells: the image is interpolated linearly between the two
-    cells it straddles (second order, like the reconstruction).  If the flow direction is not
-    a grid axis (a 1D grid along the gradient, or a 2D grid x–y with flow along z) there is no
-    displacement to make and only the jump remains.  Uniform shear u_f = γ̇(x_a − L_a/2) is then
-    an exact steady solution of the discrete momentum balance (a linear profile continues
-    across the boundary).
-
+    Shearing-periodic images (Lees & Edwards 1972, *J. Phys. C* 5, 1921): along the gradient axis a the image
+    boxes move with ±γ̇L_a along the flow direction f and are displaced by ±Δ(t), Δ = γ̇L_a t mod L_f; a ghost
+    cell holds the state of the cell it images plus the velocity jump ±γ̇L_a e_f (ρ, θ and the closures are
+    unchanged).  Δ is not a whole number of cells: the image is interpolated linearly between the two cells it
+    straddles (second order, like the reconstruction).  If f is not a grid axis (a 1D grid along the gradient,
+    or a 2D grid x–y with flow along z) only the jump remains.  Uniform shear u_f = γ̇(x_a − L_a/2) is then an
+    exact steady solution of the discrete momentum balance (a linear profile continues across the boundary).
 ``wall``
-    Both ends of the axis are walls (:class:`WallSide`: a :class:`ktgf.couette.walls.Wall` and
-    its velocity), the Johnson & Jackson (1987, *J. Fluid Mech.* 176, 67) conditions of the 1D
-    Couette solver, evaluated by the same functions (:mod:`ktgf.couette.walls`).  With n the
-    normal into the medium, u_sl = u − U_w the slip at the wall and c = ρ_s (π√3/6) φ'(φ/φ_pk)χ√θ:
-
-        η ∂u_t/∂n = c u_sl,t        (tangential momentum: shear stress of the wall)
-        u_n = 0                     (no flux through the wall)
-        −q·n = D − G,  D = ρ_s (π√3/(4φ_pk))(1 − e_w²) φχθ^{3/2},  G = c|u_sl|²
-
-    The convective flux through the wall face is the HLL flux between the medium's face state
-    (reconstructed with a one-sided slope in the wall cell) and its mirror image (u_n odd): no
-    mass, tangential momentum or energy crosses the wall, the normal momentum flux is
-    ρu_n² + p − sρu_n (s = |u_n| + c: the wall pressure, p at rest) (:func:`~.fluxes.wall_flux`).
-    The viscous and heat fluxes see ghost cells that make the central face fluxes equal to the
-    conditions: the face velocity u_f solves η_f(u_c − u_f)/(Δ/2) = c(u_f − U_w) (u_c the wall
-    cell), u_ghost = 2u_f − u_c, and θ_ghost = θ_c − Δ(D − G)/κ_f, so the discrete wall stress is
-    exactly c(u_f − U_w) and the heat flux exactly D − G (η_f, κ_f: the face coefficients of the
-    fluxes, the mean of the wall cell and a limited linear extrapolation).  φ and θ in c, D and G are the values
-    at the wall extrapolated from the two nearest cells (second order), the slip the face u_f.
-    ``momentum = "prescribed"`` (no slip, c → ∞) and ``"free-slip"`` (c = 0), ``energy =
-    "adiabatic"`` (q·n = 0) and ``"prescribed"`` (θ_ghost = 2θ_w − θ_c) are the limits.
+    Both ends of the axis are walls (:class:`WallSide`: a :class:`ktgf.couette.walls.Wall` and its velocity),
+    the Johnson & Jackson (1987, *J. Fluid Mech.* 176, 67) conditions of the 1D Couette solver, evaluated by the
+    same functions (:mod:`ktgf.couette.walls`): wall shear stress c u_sl (u_sl = u − U_w the slip), u_n = 0 and
+    heat flux −q·n = D − G, G = c|u_sl|².  The convective flux through the wall face is
+    :func:`~.fluxes.wall_flux` of the medium's face state (reconstructed with a one-sided slope in the wall
+    cell).  The viscous and heat fluxes see ghost cells that make the central face fluxes equal to the
+    conditions: the face velocity u_f solves η_f(u_c − u_f)/(Δ/2) = c(u_f − U_w) (u_c the wall cell),
+    u_ghost = 2u_f − u_c, and θ_ghost = θ_c − Δ(D − G)/κ_f, so the discrete wall stress is exactly c(u_f − U_w)
+    and the heat flux exactly D − G (η_f, κ_f: the face coefficients of the fluxes, the mean of the wall cell
+    and a limited linear extrapolation).  φ and θ in c, D and G are the values at the wall extrapolated from
+    the two nearest cells (second order), the slip the face u_f.  ``momentum = "prescribed"`` (no slip,
+    c → ∞) and ``"free-slip"`` (c = 0), ``energy = "adiabatic"`` (q·n = 0) and ``"prescribed"``
+    (θ_ghost = 2θ_w − θ_c) are the limits.
 
 Affine parts.  The Lees–Edwards velocity jump, the wall velocity and the wall heat flux G are the
 affine part of the boundary: an operator linear in the velocity or θ (the implicit operators of
@@ -61,6 +46,8 @@ from typing import Any
 
 import jax
 import jax.numpy as jnp
+
+from ..errors import InputError
 
 PERIODIC = "periodic"
 LEES_EDWARDS = "lees-edwards"
@@ -105,8 +92,6 @@ class Boundaries:
     walls: tuple = ()
 
     def __post_init__(self) -> None:
-        from ..errors import InputError
-
         kinds = tuple(self.kinds)
         object.__setattr__(self, "kinds", kinds)
         for a, k in enumerate(kinds):
@@ -328,12 +313,12 @@ def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any],
                 d_over_theta = rho_s * jj_dissipation(wall, phi_w, chi, theta_w) / theta_w
                 # the slip work of the collisions only: the frictional traction's is dissipated at the wall contacts
                 work = (sum(c_collision * sl * sl for sl in slip) if c is not None else jnp.zeros_like(beta))
-                heat = ("jj", d_over_theta, work)
+                heat = (d_over_theta, work)
             elif wall.energy == "prescribed":
-                heat = ("fixed", jnp.full_like(beta, wall.temperature), jnp.zeros_like(beta))
+                heat = (jnp.full_like(beta, wall.temperature), jnp.zeros_like(beta))
             else:
-                heat = ("adiabatic", jnp.zeros_like(beta), jnp.zeros_like(beta))
-            out[a, side] = {"ratio": ratio, "offset": offset, "heat": heat[1:], "stress": stress, "slip": slip,
+                heat = (jnp.zeros_like(beta), jnp.zeros_like(beta))
+            out[a, side] = {"ratio": ratio, "offset": offset, "heat": heat, "stress": stress, "slip": slip,
                             "kappa": wall_face(kappa, a, n, side)}
             if wall.friction_angle > 0.0:
                 out[a, side]["c_friction"] = c_friction
@@ -374,8 +359,7 @@ def _wall_ghosts(f: Any, grid: Any, a: int, G: int, role: Any, terms: dict | Non
             j = role[1]
             g0 = T["ratio"][j] * layers[0] + (T["offset"][j] if affine else 0.0)
             ghost = [g0] + [layers[0] + g0 - layers[g] for g in range(1, G)]
-        ghost = ghost[::-1]  # outermost first
-        slabs.append(ghost if side == 0 else ghost[::-1])
+        slabs.append(ghost[::-1] if side == 0 else ghost)  # ghost[0] is next to the wall: outermost first below
     return jnp.concatenate([*slabs[0], f, *slabs[1]], axis=a)
 
 

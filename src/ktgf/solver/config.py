@@ -1,11 +1,9 @@
 """Validated run configuration (TOML → pydantic), checked completely before anything is compiled.
 
-Tables ``[model]``, ``[particles]``, ``[initial]``, ``[grid]``, ``[numerics]``, ``[time]``, ``[output]``,
-``[parallel]``, ``[case]`` and ``[boundaries]`` (one per non-periodic axis), with the fields and ranges of
-the sections below; examples: ``examples/hcs_3d.toml`` (the cooling box), ``examples/uniform_shear.toml``
-(``[case] kind = "uniform-shear"``, ``y = { kind = "lees-edwards", shear_rate = 50.0, flow = "x" }``).
-The case's own checks are its :meth:`~ktgf.solver.cases.Case.check` (:mod:`ktgf.solver.cases`).
-Errors name the field (``grid.cells.0``, ``initial.solid_fraction``) and the valid range.
+One section class per TOML table (:class:`Config`; ``[boundaries]``: one entry per non-periodic axis); examples:
+``examples/hcs_3d.toml`` (the cooling box), ``examples/uniform_shear.toml``.  The case's own checks are its
+:meth:`~ktgf.solver.cases.Case.check`.  Errors name the field (``grid.cells.0``, ``initial.solid_fraction``) and
+the valid range.
 """
 
 from __future__ import annotations

@@ -1,24 +1,11 @@
 """Compiling the solver's C++ (:mod:`.flux_kernel`, :mod:`.cell_program`) into shared libraries, once per machine.
 
-The compiler is ``$CXX`` when that is set (a name on ``PATH`` or a path; set it to a program that does not
-exist, e.g. ``CXX=ktgf-no-compiler``, to run without one), else the first of :data:`DEFAULT_COMPILERS` on
-``PATH``.  Its flags are probed, not assumed (:func:`toolchain`): the machine's own instruction set
-(``-march=native``, else ``-mcpu=native``, else none), OpenMP threads (``-fopenmp``; Apple's clang refuses it:
-the kernel is then built serial) and OpenMP ``simd`` loops, each kept only if the compiler builds a small
-program with it.  g++ and clang on x86 and ARM are the compilers this is written for.
-
-A library goes to the cache folder ``$KTGF_CACHE_DIR`` (default ``~/.cache/ktgf``) under a name keyed by
-everything that changes the binary (:func:`library_key`): the source, the flags (with the ``-D`` macros of a
-variant), the compiler (its version and target), what ``-march=native`` means on this CPU (the compiler's
-expansion of the flag and the CPU's feature flags), and JAX's version (the FFI headers).  Not the host name:
-two machines of one name with different CPUs get different libraries, and a new container with the same
-compiler and CPU reuses the cache.  A build is compiled into a temporary file and renamed into place, so a
-library in the cache is always whole; a file lock next to it makes processes that need the same library at the
-same time (pytest-xdist workers, two runs) build it once: the others wait, then load it.
-
-Each build is announced on the ``ktgf`` logger at INFO (silent in library use; the ``ktgf`` command shows
-it), with the seconds it took when done.  What runs slower than it could (no OpenMP, a fallback of the callers)
-is said once per process at WARNING (:func:`warn_once`).
+The compiler (``$CXX``, else the first of :data:`DEFAULT_COMPILERS` on ``PATH``; ``CXX`` naming a program that
+does not exist runs without one), the flags probed for it (:func:`toolchain`), the cache folder
+``$KTGF_CACHE_DIR`` and what keys a library there (:func:`library_key`): docs/solver.md, "Compiler, flags and
+cache".  A build is compiled into a temporary file and renamed into place, so a library in the cache is always
+whole; a file lock next to it makes processes that need it at the same time build it once.  Each build is
+announced on the ``ktgf`` logger at INFO; what runs slower than it could is said once at WARNING (:func:`warn_once`).
 """
 
 from __future__ import annotations
@@ -61,11 +48,6 @@ _SIMD_PROBE = ('extern "C" void ktgf_probe(long n, double* x) {\n#pragma omp sim
                "  for (long i = 0; i < n; ++i) x[i] *= 2;\n}\n")
 _PLAIN_PROBE = 'extern "C" int ktgf_probe(int n) { return n + 1; }\n'
 _said: set[str] = set()
-
-
-def cache_dir() -> Path:
-    """The folder of the compiled libraries: ``$KTGF_CACHE_DIR``, default ``~/.cache/ktgf``."""
-    return Path(os.environ.get("KTGF_CACHE_DIR", Path.home() / ".cache" / "ktgf"))
 
 
 def compiler() -> str:
@@ -240,7 +222,8 @@ def shared_library(name: str, source: str | Path, flags: Sequence[str], what: st
                        "with libomp, set in CXX, restores them)")
     flags = (*COMMON_FLAGS, *tc.flags(threads), *flags)
     text = source.read_bytes() if isinstance(source, Path) else source.encode()
-    lib = cache_dir() / f"{name}-{library_key(text, flags, tc)}.so"
+    folder = Path(os.environ.get("KTGF_CACHE_DIR", Path.home() / ".cache" / "ktgf"))  # module docstring
+    lib = folder / f"{name}-{library_key(text, flags, tc)}.so"
     if lib.exists():
         return lib
     lib.parent.mkdir(parents=True, exist_ok=True)
@@ -273,5 +256,4 @@ def _compile(cxx: str, source: str | Path, flags: Sequence[str], lib: Path, what
         os.replace(tmp, lib)
     finally:
         for path in temporary:
-            if os.path.exists(path):
-                os.unlink(path)
+            Path(path).unlink(missing_ok=True)

@@ -75,9 +75,3 @@ def diagnostics(U: Any, grid: Grid, rho_s: float) -> dict[str, Any]:
         "mode_density": jnp.stack(modes_rho),
         "mode_velocity": jnp.stack(modes_u),
     }
-
-
-def fourier_coefficient(field: Any, grid: Grid, mode: tuple[int, ...]) -> complex:
-    """Complex amplitude c of c·e^{ik·x} + c.c. in a real field (k = 2πn/L)."""
-    f = np.fft.fftn(np.asarray(field))
-    return complex(2.0 * f[tuple(int(n) % c for n, c in zip(mode, grid.cells))] / grid.size)

@@ -1,13 +1,13 @@
-"""Frictional models in the 3D solver: the case's dissipation and the frictional stress at the cells.
+"""Frictional models in the 3D solver: the case's dissipation and the frictional stress at the cells
+(docs/solver.md, "Frictional models"; docs/friction.md §7).
 
 The closures are the friction part's own (:mod:`ktgf.closures.friction.model_slot`, the ones the
 Couette solver calls in :mod:`ktgf.couette.frictional_stress`); this module only evaluates them at
-the cells, once per stage (``docs/friction.md`` §7):
+the cells, once per stage:
 
-* **Dissipation per case** (:meth:`ktgf.solver.cases.Case.physics`): the freely cooling box takes the homogeneous-cooling
-  dissipation (``Model.reduced(hcs=True)``), the sheared cases (uniform shear, Couette, chute) the
-  steady-shear one, with the local shear measure dγ̇/√θ of a dissipation correction (extended
-  kinetic theory), γ̇ = √(2 S:S) — |∂u_f/∂x_a| in simple shear, as in the Couette solver.
+* **Dissipation per case** (:meth:`ktgf.solver.cases.Case.physics`): the freely cooling box takes the
+  homogeneous-cooling dissipation, the sheared cases the steady-shear one with the local shear measure
+  dγ̇/√θ of a dissipation correction (extended kinetic theory), γ̇ = √(2 S:S), as in the Couette solver.
 * **Frictional stress** (a model whose friction part has ``stress``): σ_f = −w p_f I + 2μ_f S with
 
       Schaeffer:               μ_f = w p_f sin φ_fr / (2 √(S:S/2 + ε² γ̇_ref²))
@@ -15,17 +15,12 @@ the cells, once per stage (``docs/friction.md`` §7):
 
   S = D − (1/3)(tr D) I the deviatoric strain rate of the full tensor (central differences at the
   cells), γ̇_ref the case's shear-rate scale (U/H, the Lees–Edwards γ̇), ε the option
-  ``regularisation`` — in simple shear exactly the Couette solver's expressions.  As there, the
-  Srivastava–Sundaresan dilatancy factor is taken at ∇·u = 0 (p_f = p_c).  w p_f is added to the
-  pressure (and d(w p_f)/dρ to the sound speed² of the upwind flux), μ_f to the shear viscosity, so
-  it enters the implicit viscous operator of the IMEX stages frozen at the stage start like η.
-* **Frictional work**: as in the Couette solver (``P = F_kinetic Δω``) the work of the frictional
-  stress is dissipated at the contacts and does not feed θ: the fluxes carry σ_f (momentum and the
-  mechanical work in the total energy) and the energy gets the sink σ_f:∇u = 2μ_f S:S − w p_f ∇·u,
-  written as the cooling rates ζ_f = 2μ_f S:S/((3/2)ρθ) and −w p_f/((3/2)ρθ) added to ζ_U (so the
-  sink scales with θ like the collisional one and the step's cooling limit covers it).  SSP-RK3 takes
-  ζ_f explicitly; the IMEX scheme implicitly, in the energy stage solve together with the implicit
-  frictional heating (:func:`explicit_part`; explicitly, with ζ_f frozen at the stage start, a stiff
+  ``regularisation``; the Srivastava–Sundaresan dilatancy factor at ∇·u = 0 (p_f = p_c).  w p_f is added
+  to the pressure (d(w p_f)/dρ to the sound speed² of the upwind flux), μ_f to the shear viscosity.
+* **Frictional work**: dissipated at the contacts, not fed to θ: the energy gets the sink
+  σ_f:∇u = 2μ_f S:S − w p_f ∇·u, as the cooling rates ζ_f = 2μ_f S:S/((3/2)ρθ) and −w p_f/((3/2)ρθ) added
+  to ζ_U (so the step's cooling limit covers it).  SSP-RK3 takes ζ_f explicitly, the IMEX scheme in its
+  energy stage solve with the implicit frictional heating (:func:`explicit_part`; explicitly, a stiff
   frictional work overshot and θ collapsed in homogeneous shear, measured).
 """
 

@@ -27,16 +27,13 @@ temperature θ_k (η, λ_b, κ ∝ √θ, ω ∝ θ^{3/2}) the stage equation sp
     ρ̂u − aΔt ∇·τ[η, λ_b](u) = m̂                                     (3 velocity components)
     (3/2)ρ̂θ − aΔt ∇·(κ∇θ) = Ê − ρ̂|u|²/2 + aΔt ∇·(τ·u + ω∇φ)           (then θ, given u)
 
-The first is solved by BiCGSTAB (the discrete operator is not symmetric for variable η), the
-second by CG (symmetric positive definite), both matrix-free with the exact inverse of the
-constant-coefficient operator (mean ρ̂, η, λ_b, κ) applied by FFT as preconditioner (periodic
-grid; the symbols of the same discrete stencils).  ``sweeps`` Picard passes update θ_k: the
-first uses θ of Û (an O(Δt) error in the coefficients), the second θ of the first solution
-(O(Δt²)), which keeps the scheme second order (measured in tests/solver/test_solver_imex.py).  The
-stage state is then U = Û + aΔt f_I(ρ̂, u, θ) with f_I the same flux divergence the explicit
-scheme uses, so mass, momentum and energy are conserved exactly whatever the solver residual;
-the residual (stage equation minus that state) is checked, and a solve whose relative
-residual exceeds 10× the tolerance rejects the step (status 6).
+solved by BiCGSTAB (the discrete operator is not symmetric for variable η) and CG (symmetric positive
+definite), matrix-free, each preconditioned by the FFT inverse of the constant-coefficient operator (mean ρ̂,
+η, λ_b, κ; the symbols of the same discrete stencils).  θ_k is θ of Û plus the explicit increment of f_I, an
+O(Δt²) estimate of the stage θ that keeps the scheme second order (tests/solver/test_solver_imex.py); each
+further sweep (``sweeps``) takes θ of the previous solution.  The stage state is then U = Û + aΔt f_I(ρ̂, u, θ)
+with the flux divergence of the explicit scheme, so mass, momentum and energy are conserved exactly whatever
+the solver residual; a solve whose relative residual exceeds 10× the tolerance rejects the step (status 6).
 
 With ``numerics.acoustics = "implicit"`` f_I also holds the pressure waves (the mass, pressure and
 enthalpy fluxes of :mod:`.acoustics`), solved in the same momentum problem as a bulk viscosity.
@@ -269,14 +266,12 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     Krylov scalars (:func:`_bicgstab64`, :func:`_cg64`); else everything in the dtype of Û.
 
     Returns the stage state, f_I at it, and the largest relative residual divided by ``tol``.
-    Boundaries: the Krylov operators are the linear part of the discrete operator (ghost cells
-    without the Lees–Edwards velocity jump); the jump enters through the right-hand side, which
-    is built from the full (affine) operator.  The FFT preconditioner stays the periodic one
-    (an approximation of the operator, so only the iteration count depends on it).
+    Boundaries: the Krylov operators leave out the affine parts, which enter the right-hand side (:mod:`.boundaries`,
+    "Affine parts"); the FFT preconditioner stays the periodic one (only the iteration count depends on it).
     """
     dtype = Uhat[0].dtype
     Wh = primitive_fields(Uhat)
-    rho = Wh[0]
+    rho = rho_hat = Wh[0]
     m_hat, E_hat = Uhat[1:4], Uhat[4]
     rho_mean = jnp.mean(rho)
     u, theta = tuple(Wh[1:4]), Wh[4]
@@ -289,7 +284,6 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
     # the frictional heating it cancels, frozen with μ_f at the stage start (as a rate ∝ θ, or explicitly,
     # the stage-start θ biased the steady θ by O(ζΔt), 4-7 % measured; explicitly a stiff one overshot).
     friction_sink = 1.5 * rho * theta * r.zeta_f if is_frictional(r) else 0.0
-    rho_hat = rho
     galilean = acoustic is not None and grid.boundaries is not None and grid.boundaries.shear_axis is not None
     if acoustic is not None:
         sweeps = max(sweeps, MIN_SWEEPS)
@@ -359,9 +353,8 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         # Absolute floors from the scale of the state (thermal momentum ρ√θ, energy Ê), not of
         # the correction: in a nearly uniform gas the correction itself is round-off.
         atol_m = floor * _norm(rho, acc) * jnp.sqrt(jnp.mean(theta))
-        # BiCGSTAB, not GMRES: jax.scipy's GMRES returned a zero correction for a state of the
-        # 0.7 L⊥ paper box late in its decay (θ ~ 5e-13 m²/s², step 1064; BiCGSTAB: residual
-        # 0.006 of the limit).  Solved on a unit right-hand side.
+        # BiCGSTAB, not GMRES: jax.scipy's GMRES returned a zero correction late in the decay of the 0.7 L⊥
+        # paper box (θ ~ 5e-13 m²/s²), where BiCGSTAB converged.  Solved on a unit right-hand side.
         sb = _unit(b, acc)
         du, _ = solve_m(A, tuple(x / sb for x in b), tol=tol, atol=atol_m / sb, maxiter=RESTART * maxiter, M=M)
         u = tuple(x + sb * dx for x, dx in zip(u, du))

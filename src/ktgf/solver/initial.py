@@ -57,13 +57,6 @@ def _plane_wave(grid: Grid, mode: tuple[int, ...]) -> tuple[np.ndarray, np.ndarr
     return k, np.exp(1j * sum(k[a] * x[a] for a in range(grid.ndim)))
 
 
-def _direction(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    khat = k / np.linalg.norm(k)
-    ref = np.array([0.0, 0.0, 1.0]) if abs(khat[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-    perp = np.cross(ref, khat)
-    return khat, perp / np.linalg.norm(perp)
-
-
 def single_mode(
     grid: Grid, phys: Physics, phi0: float, theta0: float, mode: tuple[int, ...], kind: str,
     amplitude: float, branch: int = 0,
@@ -76,7 +69,9 @@ def single_mode(
     """
     k, phase = _plane_wave(grid, mode)
     kstar = float(np.linalg.norm(k)) * mean_free_path(phi0, phys.diameter)
-    khat, perp = _direction(k)
+    khat = k / np.linalg.norm(k)
+    perp = np.cross(np.array([0.0, 0.0, 1.0]) if abs(khat[2]) < 0.9 else np.array([1.0, 0.0, 0.0]), khat)
+    perp = perp / np.linalg.norm(perp)
     r = phys.model.reduced(phi0, phys.restitution, hcs=phys.hcs)
     rho, u, theta = uniform_fields(grid, phys, phi0, theta0)
     w_scale = math.sqrt(2.0 * theta0)

@@ -73,10 +73,9 @@ class Interrupted(KeyboardInterrupt):
     """A run stopped by a signal after writing a consistent checkpoint (a KeyboardInterrupt, so
     notebooks and scripts see the usual exception)."""
 
-    def __init__(self, message: str, checkpoint: Any = None, t: float = 0.0, steps: int = 0,
-                 exit_code: int = 130) -> None:
+    def __init__(self, message: str, checkpoint: Any = None, exit_code: int = 130) -> None:
         super().__init__(message)
-        self.checkpoint, self.t, self.steps, self.exit_code = checkpoint, t, steps, exit_code
+        self.checkpoint, self.exit_code = checkpoint, exit_code
 
 
 def fault_hook(point: str, n: int = 0) -> None:

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from ..io import atomic_path
 from .grid import Grid
 
 _VTK_TYPES = {np.dtype("float64"): "Float64", np.dtype("float32"): "Float32"}
@@ -58,33 +59,16 @@ def write_vti(path: str | Path, grid: Grid, fields: dict[str, np.ndarray], time:
         f'    <Piece Extent="{extent}">\n      <CellData>\n' + "\n".join(arrays) + "\n      </CellData>\n"
         "    </Piece>\n  </ImageData>\n</VTKFile>\n"
     )
-    _write_text(path, xml)
+    try:
+        with atomic_path(path) as tmp:
+            tmp.write_text(xml, encoding="ascii")
+    except OSError as exc:
+        raise InputError(f"cannot write file {str(path)!r}: {exc.strerror or exc}") from exc
     return path
 
 
-def read_vti(path: str | Path) -> dict[str, np.ndarray]:
-    """Read back the arrays of a .vti file written by :func:`write_vti` (flat, VTK order)."""
-    import xml.etree.ElementTree as ET
-
-    out = {}
-    for da in ET.parse(path).getroot().iter("DataArray"):
-        raw = base64.b64decode(da.text.strip())
-        n = int(np.frombuffer(raw[:8], dtype="<u8")[0])
-        dtype = "<f8" if da.get("type") == "Float64" else "<f4"
-        out[da.get("Name")] = np.frombuffer(raw[8 : 8 + n], dtype=dtype)
-    return out
-
-
-def _write_text(path: Path, text: str) -> None:
-    from ..io import atomic_path
-
-    try:
-        with atomic_path(path) as tmp:
-            tmp.write_text(text, encoding="ascii")
-    except (PermissionError, OSError) as exc:
-        raise InputError(f"cannot write file {str(path)!r}: {exc.strerror or exc}") from exc
-
-
+#: File name of a run's checkpoint in its output folder.
+CHECKPOINT = "checkpoint.npz"
 #: Version of the checkpoint layout; :func:`load_checkpoint` refuses any other.
 CHECKPOINT_FORMAT = 2
 _CHECKPOINT_KEYS = ("format", "hash", "U", "t", "steps", "output_index", "history", "config")
@@ -104,8 +88,6 @@ def save_checkpoint(path: str | Path, U: np.ndarray, t: float, steps: int, outpu
                     history: dict[str, list], config_json: str) -> Path:
     """Write a checkpoint atomically: state, time, counters, diagnostics so far, the config, a format
     version and a SHA-256 of all of it (checked by :func:`load_checkpoint`)."""
-    from ..io import atomic_path
-
     path = Path(path)
     U = np.asarray(U)
     hist = json.dumps({k: np.asarray(v).tolist() for k, v in history.items()})
@@ -114,7 +96,7 @@ def save_checkpoint(path: str | Path, U: np.ndarray, t: float, steps: int, outpu
         with atomic_path(path) as tmp, open(tmp, "wb") as f:
             np.savez(f, format=np.int64(CHECKPOINT_FORMAT), hash=digest, U=U, t=np.float64(t), steps=np.int64(steps),
                      output_index=np.int64(output_index), history=hist, config=config_json)
-    except (PermissionError, OSError) as exc:
+    except OSError as exc:
         raise InputError(f"cannot write checkpoint {str(path)!r}: {exc.strerror or exc}") from exc
     return path
 

@@ -102,11 +102,3 @@ def run_files(directory: str | Path) -> list[Path]:
 
     d = Path(directory)
     return sorted({p for pattern in (*RUN_FILES, *(c.timeseries for c in CASES.values())) for p in d.glob(pattern) if p.is_file() and p.name != LOCK})
-
-
-def clear_run_files(directory: str | Path) -> list[Path]:
-    """Delete the files an earlier run left in ``directory`` (``--overwrite``); return them."""
-    files = run_files(directory)
-    for p in files:
-        p.unlink(missing_ok=True)
-    return files

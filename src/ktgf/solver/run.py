@@ -6,14 +6,8 @@ time in chunks of ``time.max_steps_per_call`` steps.  The step sequence depends 
 state and the next output time (a chunk boundary never shortens a step), so a run resumed
 from any checkpoint reproduces the uninterrupted run bit for bit.
 
-* Ctrl-C / SIGTERM set a flag (:mod:`.interrupt`) polled between chunks; the run then writes
-  ``checkpoint.npz`` and the time series (``<case>.nc``) for the outputs recorded so far and raises
-  :class:`~.interrupt.Interrupted`.  The time series is also written at every checkpoint.
-* The output folder is locked for the run (:mod:`.outdir`); a fresh run will not start over
-  another run's files without ``overwrite``.
-* A step that leaves the physical state space is rejected; the last good state is written
-  to ``checkpoint.npz`` and :class:`~ktgf.errors.DivergenceError` names the field, the cell,
-  its position and the time.
+Ctrl-C / SIGTERM (:mod:`.interrupt`), the locked output folder (:mod:`.outdir`) and a rejected step
+(:class:`~ktgf.errors.DivergenceError`, the last good state in ``checkpoint.npz``): docs/solver.md, "Running".
 """
 
 from __future__ import annotations
@@ -36,7 +30,7 @@ import numpy as np
 from ..closures import get_model
 from ..closures.coefficients import mean_free_path
 from ..errors import DivergenceError, InputError, KtgfError
-from ..io import write_netcdf
+from ..io import atomic_path, run_metadata, write_netcdf
 from .config import Config, box_lengths, changed_fields, config_value, initial_temperature
 from .diagnostics import PER_AXIS, SCALARS, diagnostics
 from .cases import get_case
@@ -46,13 +40,13 @@ from .kinematics import gradient_axis, shear_rate
 from .initial import haff_time, perturb, random_velocity, shear_mode, single_mode, t_of_tau, tau_of_t, uniform_fields
 from .interrupt import STOP, Interrupted, fault_hook
 from ..plotting.fields import save_slices
-from .io import load_checkpoint, save_checkpoint, write_vti
+from .io import CHECKPOINT, load_checkpoint, save_checkpoint, write_vti
+from .outdir import RunLock, run_files
 from .physics import Physics
 from .sequencing import mean_temperature, start_from_run
 from .state import PRIMITIVE_NAMES, conservative, primitive
 from .stepping import LIMIT_NAMES, STATUS_MESSAGES, Numerics, advance, binding_limit, choose_scheme, limits, state_status, step
 
-CHECKPOINT = "checkpoint.npz"
 HISTORY_KEYS = ("time", *SCALARS, *PER_AXIS, *(f"dt_{n}" for n in LIMIT_NAMES))
 #: Config fields that may differ between a checkpoint and the run resuming it: where and how
 #: often files are written, the chunk size (the step sequence does not depend on it) and the
@@ -66,17 +60,9 @@ RESUMABLE_CHANGES = ("output.directory", "output.checkpoint_every", "output.vtk_
 MEMORY_FACTOR = 20
 
 
-def machine_memory() -> int | None:
-    """Physical memory of this machine [bytes] (None if unknown)."""
-    try:
-        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):
-        return None
-
-
 def _bytes(n: float) -> str:
-    for unit in ("B", "kB", "MB", "GB", "TB", "PB"):
-        if n < 1000 or unit == "PB":
+    for unit in ("B", "kB", "MB", "GB", "TB"):
+        if n < 1000:
             return f"{n:.3g} {unit}"
         n /= 1000
     return f"{n:.3g} PB"
@@ -87,7 +73,10 @@ def check_memory(cells: tuple[int, ...], precision: str, available: int | None =
     itemsize = 8 if precision == "float64" else 4
     state = 5 * math.prod(cells) * itemsize
     need = MEMORY_FACTOR * state
-    have = machine_memory() if available is None else available
+    have = available
+    if have is None:  # the physical memory of this machine, where the system says it
+        with contextlib.suppress(ValueError, OSError, AttributeError):
+            have = int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
     if have is not None and need > have:
         raise InputError(
             f"field grid.cells = {list(cells)} needs about {_bytes(need)} of memory ({MEMORY_FACTOR} x the "
@@ -124,11 +113,8 @@ class Simulation:
         the clock t, dt is float64 even when the state is float32, as the step loop of :func:`advance` expects)."""
         return _x64(True)
 
+    @_in_precision  # the Haff time and output times are computed with JAX too
     def __init__(self, cfg: Config, directory: str | Path | None = None) -> None:
-        with _x64(True):  # the Haff time and output times are computed with JAX too
-            self._setup(cfg, directory)
-
-    def _setup(self, cfg: Config, directory: str | Path | None) -> None:
         self.cfg = cfg
         check_memory(tuple(cfg.grid.cells), cfg.numerics.precision)
         self.model = get_model(cfg.model.name, **cfg.model.options)
@@ -196,7 +182,6 @@ class Simulation:
         spec = jax.sharding.PartitionSpec(None, "x", *([None] * (self.grid.ndim - 1)))
         return jax.sharding.NamedSharding(mesh, spec)
 
-    # -- state -----------------------------------------------------------------------------
     @_in_precision
     def initial_state(self) -> Any:
         """The configured initial state (conservative, on the configured devices)."""
@@ -226,7 +211,6 @@ class Simulation:
     def config_json(self) -> str:
         return json.dumps(self.cfg.model_dump(mode="json"), sort_keys=True)
 
-    # -- run -------------------------------------------------------------------------------
     @_in_precision
     def run(
         self,
@@ -244,8 +228,6 @@ class Simulation:
         is locked for the run; a fresh run refuses a folder holding another run's files unless
         ``overwrite`` (which deletes them).  SIGINT/SIGTERM: see the module docstring.
         """
-        from .outdir import RunLock
-
         if resume is not None and overwrite:
             raise InputError("--resume and --overwrite exclude each other: resume continues the run, overwrite deletes it")
         with STOP:
@@ -271,7 +253,7 @@ class Simulation:
             history = {name: [] for name in self.history_keys}
         self.history = history
         ckpt = self.directory / CHECKPOINT
-        bar = _Progress(progress, self.output_times[-1], self.t_haff, self.phys, self.phi0, self.theta0,
+        bar = _Progress(progress, self.output_times[-1], self.phys, self.phi0, self.theta0,
                         case=self.case.name, shear_rate=shear_rate(self.grid))
         chunks = 0
         try:
@@ -322,7 +304,7 @@ class Simulation:
             done = "the run is complete" if k >= n_out else f"{k} of {n_out} outputs written"
             raise Interrupted(
                 f"interrupted at t = {t:.6g} s after {steps} steps ({done}); checkpoint written to {ckpt}",
-                checkpoint=ckpt, t=t, steps=steps, exit_code=STOP.exit_code if STOP.requested else 130,
+                checkpoint=ckpt, exit_code=STOP.exit_code if STOP.requested else 130,
             ) from (None if isinstance(exc, Interrupted) else exc)
         self.state, self.time, self.steps = U, t, steps
         ds = self.dataset(history)
@@ -346,8 +328,6 @@ class Simulation:
             ds.attrs["run_complete"] = 1
             write_netcdf(ds, self.timeseries)
             if self.verification is not None:
-                from ..io import atomic_path
-
                 with atomic_path(self.directory / VERIFICATION_FILE) as tmp:
                     tmp.write_text(json.dumps(self.verification, indent=2) + "\n")
         return ds
@@ -378,13 +358,11 @@ class Simulation:
 
     def _claim_folder(self, overwrite: bool) -> None:
         """Refuse to start afresh over another run's files (or delete them with ``overwrite``)."""
-        from .outdir import clear_run_files, run_files
-
         files = run_files(self.directory)
-        if not files:
-            return
         if overwrite:
-            clear_run_files(self.directory)
+            for p in files:
+                p.unlink(missing_ok=True)
+        if overwrite or not files:
             return
         where = repr(str(self.directory))
         ckpt = self.directory / CHECKPOINT
@@ -528,8 +506,6 @@ class Simulation:
         """Diagnostics history as an xarray Dataset with full run metadata (SI units)."""
         import xarray as xr
 
-        from ..io import run_metadata
-
         t = np.asarray(history["time"], dtype=float)
         data = {name: ("time", np.asarray(history[name], dtype=float)) for name in SCALARS}
         data.update({name: (("time", "axis"), np.asarray(history[name], dtype=float).reshape(len(t), -1))
@@ -595,17 +571,15 @@ class _Progress:
     The first chunk is left out of every rate, because it includes the compilation.
     """
 
-    def __init__(self, enabled: bool, t_end: float, t_haff: float, phys: Physics, phi0: float, theta0: float,
-                 clock: Callable[[], float] = _time.perf_counter, case: str = "cooling",
-                 shear_rate: float = 0.0) -> None:
+    def __init__(self, enabled: bool, t_end: float, phys: Physics, phi0: float, theta0: float,
+                 clock: Callable[[], float] = _time.perf_counter, case: str = "cooling", shear_rate: float = 0.0) -> None:
         self.enabled, self.t_end = enabled, t_end
-        self.args = (phys, phi0, theta0)
         self.clock = clock
         self.case, self.shear_rate = get_case(case), shear_rate
         # A sheared case has no Haff clock; its steps are about equally long in t.
-        self._tau = (lambda t: float(tau_of_t(t, *self.args))) if self.case.hcs else float
+        self._tau = (lambda t: float(tau_of_t(t, phys, phi0, theta0))) if self.case.hcs else float
         self.tau_end = self._tau(t_end)
-        self._steps, self._wall, self._first = 0, 0.0, True
+        self._steps, self._wall = 0, 0.0
         self._start: tuple[float, float] | None = None  # (τ, clock) at the end of the first chunk
         self.remaining: float | None = None  # seconds, once two chunks have run
 
@@ -625,8 +599,7 @@ class _Progress:
     def update(self, t: float, steps: int, wall: float) -> None:
         tau = self._tau(t)
         now = self.clock()
-        if self._first:  # the first chunk includes compilation: keep it out of the step rate and the ETA
-            self._first = False
+        if self._start is None:  # the first chunk includes compilation: keep it out of the step rate and the ETA
             self._start = (tau, now)
         else:
             self._steps += steps
@@ -637,7 +610,8 @@ class _Progress:
         if not self.enabled:
             return
         rate = f"{self._steps / self._wall:.1f}" if self._wall > 0 else "-"
-        eta = "-" if self.remaining is None else _format_seconds(self.remaining)
+        s = round(self.remaining or 0.0)
+        eta = "-" if self.remaining is None else f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
         self.bar.update(self.task, completed=t, clock=self.clock_text(t), rate=rate, eta=eta)
 
     def clock_text(self, t: float) -> str:
@@ -647,8 +621,3 @@ class _Progress:
     def __exit__(self, *exc: object) -> None:
         if self.enabled:
             self.bar.__exit__(*exc)
-
-
-def _format_seconds(s: float) -> str:
-    s = int(round(s))
-    return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"

@@ -1,25 +1,14 @@
-"""Start a run from an earlier run's result on another grid (grid sequencing, as OpenFOAM's mapFields).
+"""Start a run from an earlier run's result on another grid (grid sequencing, as OpenFOAM's mapFields;
+docs/solver.md, "Starting from an earlier run").
 
-``[initial] from_run = "path"`` names the output folder of an earlier run (its ``checkpoint.npz``)
-or a checkpoint file.  The earlier state is mapped onto the new grid axis by axis:
-
-* along an axis of the same length the cell averages of the conservative variables
-  (ρ, ρu, E) are remapped conservatively (:func:`remap_axis`): a piecewise-linear reconstruction
-  in each old cell (minmod-limited slopes; one-sided at the ends of a wall or Lees–Edwards axis,
-  wrapped on a periodic one) is integrated exactly over each new cell.  Refinement by any factor,
-  coarsening and non-integer ratios are one formula; integer coarsening gives exactly the mean of
-  the fine cells.  If the reconstruction would leave the physical state space anywhere (θ ≤ 0,
-  ρ ≤ 0), the piecewise-constant remap (first order, also conservative) is used instead;
-* along a periodic axis the new box may be an integer multiple m of the old one: the old state is
-  tiled m times first (the means per unit volume are kept);
-* a grid equal to the earlier one gives the earlier state unchanged (bit for bit).
-
-The totals ∫ρ dV, ∫ρu dV and ∫E dV (per unit tile) are conserved to round-off.  The earlier run
-must be the same flow: case, model, restitution, particles, boundaries (walls, wall speeds,
-shear rate), inventory (``initial.solid_fraction``) and dimension; along a wall or Lees–Edwards
-axis the box length must be the same.  Each mismatch is refused in one line naming the field.
-The new run starts at t = 0 from the mapped state (a Lees–Edwards image shift restarts at 0),
-plus ``perturbation = "random"`` (:func:`~.initial.perturb`) if configured.
+``[initial] from_run = "path"`` names the output folder of an earlier run (its ``checkpoint.npz``) or a
+checkpoint file.  Along a periodic axis the new box may be a whole multiple of the old one (the state is tiled
+first); then every axis is remapped conservatively (:func:`remap_axis`, :func:`_remap_state`): order 2, or order
+1 where order 2 would leave the physical state space (θ ≤ 0, ρ ≤ 0).  A grid equal to the earlier one gives the
+earlier state bit for bit.  The earlier run must be the same flow (:data:`SAME_FIELDS`, the dimension, and the
+box length along a wall or Lees–Edwards axis): each mismatch is refused in one line naming the field.  The new
+run starts at t = 0 (a Lees–Edwards image shift restarts at 0), plus ``perturbation = "random"``
+(:func:`~.initial.perturb`) if configured.
 """
 
 from __future__ import annotations
@@ -33,11 +22,11 @@ import numpy as np
 
 from ..errors import InputError, KtgfError
 from .boundaries import PERIODIC
-from .flows import boundaries
-from .io import load_checkpoint
+from .config import box_lengths, changed_fields, config_value, parse_config
+from .flows import VERIFICATION_FILE, boundaries
+from .io import CHECKPOINT, load_checkpoint
 from .state import NVAR
 
-CHECKPOINT_NAME = "checkpoint.npz"
 #: Config fields that must be the same in the earlier run (dotted; sections compared leaf by leaf).
 SAME_FIELDS = ("case", "model", "particles", "boundaries", "initial.solid_fraction")
 #: Relative tolerance of the box-length checks (lengths in m from the same config arithmetic).
@@ -48,9 +37,9 @@ def checkpoint_path(path: str | Path) -> Path:
     """The checkpoint of ``initial.from_run``: the file itself, or ``checkpoint.npz`` in a run folder."""
     p = Path(path)
     if p.is_dir():
-        p = p / CHECKPOINT_NAME
+        p = p / CHECKPOINT
         if not p.is_file():
-            raise InputError(f"field initial.from_run = {str(path)!r}: the folder holds no {CHECKPOINT_NAME} "
+            raise InputError(f"field initial.from_run = {str(path)!r}: the folder holds no {CHECKPOINT} "
                              "(valid: the output folder of a finished ktgf run, or its checkpoint file)")
         return p
     if p.suffix == ".toml":
@@ -58,18 +47,16 @@ def checkpoint_path(path: str | Path) -> Path:
                          "ktgf run (or ktgf.solver.chain.run_chain), which runs it first")
     if p.suffix == ".nc":
         raise InputError(f"field initial.from_run = {str(path)!r}: a netCDF time series holds no fields; valid: "
-                         f"the run's output folder or its {CHECKPOINT_NAME}")
+                         f"the run's output folder or its {CHECKPOINT}")
     if not p.is_file():
         raise InputError(f"field initial.from_run = {str(path)!r} does not exist (valid: the output folder of an "
-                         f"earlier run or its {CHECKPOINT_NAME})")
+                         f"earlier run or its {CHECKPOINT})")
     return p
 
 
 def load_run(path: str | Path) -> tuple[np.ndarray, Any, int]:
     """(U, config, steps) of an earlier run: its last checkpointed state, its validated :class:`Config` and
     its step count."""
-    from .config import parse_config
-
     ckpt = checkpoint_path(path)
     ck = load_checkpoint(ckpt)
     try:
@@ -81,7 +68,7 @@ def load_run(path: str | Path) -> tuple[np.ndarray, Any, int]:
 
 def _earlier_cost(path: str | Path, steps: int) -> dict[str, Any]:
     """Steps, wall and CPU time of the earlier run and of the whole sequence up to it (its verification.json)."""
-    ver = Path(path) / "verification.json" if Path(path).is_dir() else Path(path).with_name("verification.json")
+    ver = Path(path) / VERIFICATION_FILE if Path(path).is_dir() else Path(path).with_name(VERIFICATION_FILE)
     try:
         run = json.loads(ver.read_text())["run"]
     except (OSError, ValueError, KeyError, TypeError):
@@ -93,8 +80,6 @@ def _earlier_cost(path: str | Path, steps: int) -> dict[str, Any]:
 
 def start_from_run(cfg: Any, cells: tuple[int, ...], lengths: tuple[float, ...]) -> tuple[np.ndarray, dict[str, Any]]:
     """The state of ``cfg.initial.from_run`` mapped onto this grid (checked against ``cfg``), and a record of it."""
-    from .config import box_lengths
-
     source = cfg.initial.from_run
     U_old, old, steps = load_run(source)
     old_lengths = box_lengths(old)
@@ -115,8 +100,6 @@ def mean_temperature(U: np.ndarray) -> float:
 def check_compatible(old: Any, new: Any, old_lengths: tuple[float, ...], new_lengths: tuple[float, ...],
                      source: str) -> None:
     """Refuse (one line naming the field) an earlier run that is not the same flow on a mappable box."""
-    from .config import changed_fields, config_value
-
     a, b = old.model_dump(mode="json"), new.model_dump(mode="json")
     where = f"(initial.from_run = {source!r})"
     changed = [f for name in SAME_FIELDS

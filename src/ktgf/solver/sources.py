@@ -1,10 +1,10 @@
 """Sources: the collisional energy sink −(3/2)ρθζ, ζ = ζ0 + ζ_U∇·u (model.md §1), and a body force.
 
-The sink is integrated explicitly, together with the convective fluxes.  Each SSP-RK3 stage is
-a convex combination of forward-Euler steps, and a forward-Euler step of dθ/dt = −ζθ keeps θ
-positive whenever ζΔt < 1; :func:`~ktgf.solver.stepping.step_limits` limits Δt by
-``cfl_source/max|ζ|`` (< 1), so the sink alone can never make θ non-positive.  (The explicit
-part of the IMEX scheme is not SSP; the same limit applies.)
+Both are integrated explicitly with the convective fluxes (the sink implicitly with ``numerics.sink =
+"implicit"``, :mod:`.imex`).  Each SSP-RK3 stage is a convex combination of forward-Euler steps, and a
+forward-Euler step of dθ/dt = −ζθ keeps θ positive whenever ζΔt < 1: Δt ≤ ``cfl_source/max|ζ|`` (< 1;
+:func:`~ktgf.solver.stepping.step_limits`), so the sink alone never makes θ non-positive.  (The explicit part of
+the IMEX scheme is not SSP; the same limit applies.)
 """
 
 from __future__ import annotations
