@@ -3,9 +3,9 @@
 Run:  PYTHONPATH=src python benchmarks/bench_cases.py [--cells 64] [--steps 2] [--rounds 3] [--cases box,shear,...]
       [--scheme ssprk3|imex]
 
-Each case is a ``ktgf run`` configuration (RET, e 0.8, φ 0.3, float64, SSP-RK3 with explicit acoustics and sink —
-the scheme of the box's fused loop; ``--scheme imex``: ARS(2,2,2), whose explicit part is the inviscid kernel) on an n³ grid: ``box`` the periodic cooling box, ``shear`` uniform shear
-(Lees–Edwards along y, flow x), ``couette`` (Johnson–Jackson walls on y), ``chute`` (base and lid on y, gravity
+Each case is a ``ktgf run`` configuration (RET, e 0.8, φ 0.3, float64, SSP-RK3 with explicit acoustics and sink;
+``--scheme imex``: ARS(2,2,2), whose explicit part is the inviscid kernel) on an n³ grid: ``box`` the periodic
+cooling box, ``shear`` uniform shear (Lees–Edwards along y, flow x), ``couette`` (Johnson–Jackson walls on y), ``chute`` (base and lid on y, gravity
 at 25°).  Per case: the marginal wall and CPU ms per step of ``advance`` (a call of 5 × ``--steps`` steps less
 one of ``--steps``: what a run, which advances in chunks, sees), in ``--rounds`` rounds that visit the cases
 in turn (the VM's speed drifts within minutes, so every round times every case); printed: the median per case,
@@ -76,7 +76,7 @@ def main() -> None:
     from ktgf.solver.cell_program import for_physics
     from ktgf.solver.config import parse_config
     from ktgf.solver.run import Simulation
-    from ktgf.solver.stepping import advance, cell_programs_apply, stage_kernel_applies, start_program
+    from ktgf.solver.stepping import advance, cell_programs_apply, stage_kernel_applies
 
     cases = args.cases.split(",")
     n = args.cells
@@ -88,14 +88,13 @@ def main() -> None:
         with sim.precision():
             U = sim.initial_state()
             grid, phys, num = sim.grid, sim.phys, sim.num
-            fused = start_program(grid, phys, num, U.dtype) is not None
             stage = stage_kernel_applies(grid, phys, num, U.dtype)
             flux = fluxes.FLUX_KERNEL and flux_kernel.applies(grid, U.dtype, "euler", num.limiter, num.riemann)
             if args.scheme == "imex":
                 path = "C++ flux kernel (explicit part)" if flux else "JAX path"
             else:
                 cells = stage and cell_programs_apply(grid) and for_physics(phys, U.dtype) is not None
-                path = "C++ fused loop (cell programs)" if fused else "C++ stages with cell programs" if cells else (
+                path = "C++ stages with cell programs" if cells else (
                     "C++ stage kernel" if stage else "C++ flux kernel" if flux else "JAX path")
             t0 = time.perf_counter()
             compiled = jax.jit(lambda *a: advance.__wrapped__(*a)).lower(U, 0.0, 1e30, args.steps, grid, phys,

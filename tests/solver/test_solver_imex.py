@@ -93,25 +93,25 @@ def test_auto_scheme_follows_the_step_limits() -> None:
 @pytest.mark.contract
 def test_auto_scheme_weighs_the_cost_of_the_explicit_step() -> None:
     """``auto`` takes IMEX where its step is more than twice the break-even longer than SSP-RK3's: 2 × 3 for the
-    SSP-RK3 of the JAX path (a 1D grid), 2 × 9 where SSP-RK3 runs the fused kernel loop (a 3D periodic grid on
-    the CPU; measured costs, stepping.IMEX_COST*).  A 32³ box of 4 d at φ = 0.5 (Δx ≈ ℓ/2) has the IMEX step
-    10.7× longer: SSP-RK3 with the fused loop, IMEX without it."""
+    SSP-RK3 of the JAX path (a 1D grid), 2 × IMEX_COST_CELLS where SSP-RK3's stages run on cell programs (a 3D
+    periodic grid on the CPU; measured costs, stepping.IMEX_COST*).  A 32³ box of 4 d at φ = 0.5 (Δx ≈ ℓ/2) has
+    the IMEX step 10.7× longer: SSP-RK3 with cell programs, IMEX without them."""
     from ktgf.solver import fluxes
-    from ktgf.solver.stepping import IMEX_COST, IMEX_COST_FUSED, Numerics, auto_ratio
+    from ktgf.solver.stepping import IMEX_COST, IMEX_COST_CELLS, Numerics, auto_ratio
 
     cfg = {**_base(), "time": {"end": 1.0, "scheme": "auto"}, "initial": {"solid_fraction": 0.5, "temperature": 1e-4},
            "grid": {"cells": [32, 32, 32], "length_d": 4.0}}
     line = Simulation(parse_config({**cfg, "grid": {"cells": [64], "length_d": 5.0}}))
     assert auto_ratio(line.grid, line.phys, line.num, jnp.float64) == 2.0 * IMEX_COST
     box = Simulation(parse_config(cfg))
-    if auto_ratio(box.grid, box.phys, box.num, jnp.float64) != 2.0 * IMEX_COST_FUSED:
-        pytest.skip("the fused SSP-RK3 loop does not apply here (no C++ compiler, or not the CPU)")
+    if auto_ratio(box.grid, box.phys, box.num, jnp.float64) != 2.0 * IMEX_COST_CELLS:
+        pytest.skip("SSP-RK3 on cell programs does not apply here (no C++ compiler, or not the CPU)")
     assert box.num.scheme == "ssprk3"
     implicit = Numerics(scheme="imex", acoustics="implicit", sink="implicit")  # any numerics: SSP-RK3's is explicit
-    assert auto_ratio(box.grid, box.phys, implicit, jnp.float64) == 2.0 * IMEX_COST_FUSED
+    assert auto_ratio(box.grid, box.phys, implicit, jnp.float64) == 2.0 * IMEX_COST_CELLS
     saved = fluxes.CELL_PROGRAM
     try:
-        fluxes.CELL_PROGRAM = False  # SSP-RK3 without the fused loop: its step costs a third of IMEX's
+        fluxes.CELL_PROGRAM = False  # SSP-RK3 without cell programs: its step costs a third of IMEX's
         assert Simulation(parse_config(cfg)).num.scheme == "imex"
     finally:
         fluxes.CELL_PROGRAM = saved

@@ -15,9 +15,7 @@
 // * KtgfSsprkStageCells: the same stage with the cell fields and source computed from Uk by a cell program
 //   (ktgf.solver.cell_program, registered by key with KtgfRegisterCells) plane by plane as the sweep goes
 //   (sweep_fused), so they never go to memory (1.3x faster per stage at 64^3 than writing them first).
-//   `mode` (StageMode): the update; the rate L with the maxima of a step-start program's limit terms;
-//   or the second stage from that rate.
-// * KtgfCellLimits: those maxima alone (the check of a chunk's last state).
+// * KtgfCellLimits: the maxima of a step-start program's terms (step limits, state checks) at a state.
 // The padded fields (two periodic ghost cells per side) are swept in blocks of ROW_BLOCK rows so that the
 // five planes a stencil reaches stay in L2 (1.3x faster at 64^3 than whole planes); each cell's MUSCL
 // slope along an axis is kept for its second face.
@@ -206,18 +204,15 @@ struct Rhs {
   T* dU[5];
   T* divu;
 };
-// What a stage writes (Stage::mode): U' = a U0 + b (Uk + dt L); L (a step's first stage, before dt is known);
-// or U' with Uk = U0 + dt L0 (the second stage, from the first one's rate L0).
-enum StageMode { UPDATE = 0, RATE = 1, FROM_RATE = 2 };
+// What a stage writes: U' = a U0 + b (Uk + dt L).
 template <class T>
 struct Stage {
   const T* U0[5];
-  const T* Uk[5];  // FROM_RATE: L0
+  const T* Uk[5];
   const T* s0;  // energy source = s0 + s1 div u
   const T* s1;
   T a, b, dt;   // U' = a U0 + b (Uk + dt L), b = 1 - a
-  T* U[5];      // RATE: L
-  int mode = UPDATE;
+  T* U[5];
 };
 
 // Face fluxes along A of the row starting at padded cell c0: the faces between q and its
@@ -310,7 +305,7 @@ KTGF_INLINE void write_row(const Rhs<T>& o, const T* const* P, long c0, long out
 }
 
 // Field v of a stage's output row at offset `out` (write_row); SRC: with the energy source s0 + s1 div u.
-template <class T, int MODE, bool SRC>
+template <class T, bool SRC>
 KTGF_INLINE void stage_row(const Stage<T>& o, int v, long out, const Consts<T>& k, const T* lo, const T* hi,
                            const T* ylo, const T* yhi, const T* zv, const T* divu, const T* s0, const T* s1) {
   const long n2 = k.n[2];
@@ -321,21 +316,8 @@ KTGF_INLINE void stage_row(const Stage<T>& o, int v, long out, const Consts<T>& 
   for (long q = 0; q < n2; ++q) {
     T L = cell_div(lo, hi, ylo, yhi, zv, q, k);
     if (SRC) L = L + (s0[q] + s1[q] * divu[q]);
-    if (MODE == RATE) {
-      d[q] = L;
-    } else {
-      const T u = MODE == FROM_RATE ? u0[q] + o.dt * uk[q] : uk[q];
-      d[q] = o.a * u0[q] + o.b * (u + o.dt * L);
-    }
+    d[q] = o.a * u0[q] + o.b * (uk[q] + o.dt * L);
   }
-}
-
-template <class T, int MODE>
-KTGF_INLINE void stage_rows(const Stage<T>& o, long out, const Consts<T>& k, const T* const* lo, const T* const* hi,
-                            const T* z, long zld, const T* divu, const T* s0, const T* s1) {
-  for (int v = 0; v < 4; ++v)
-    stage_row<T, MODE, false>(o, v, out, k, lo[v], hi[v], lo[5 + v], hi[5 + v], z + v * zld, divu, s0, s1);
-  stage_row<T, MODE, true>(o, 4, out, k, lo[4], hi[4], lo[9], hi[9], z + 4 * zld, divu, s0, s1);
 }
 
 template <class T>
@@ -343,9 +325,9 @@ KTGF_INLINE void write_row(const Stage<T>& o, const T* const* P, long c0, long o
                            const T* const* lo, const T* const* hi, const T* z, long zld, T* divu, const T* s0,
                            const T* s1) {
   row_divu(P, c0, k, divu);
-  if (o.mode == RATE) stage_rows<T, RATE>(o, out, k, lo, hi, z, zld, divu, s0, s1);
-  else if (o.mode == FROM_RATE) stage_rows<T, FROM_RATE>(o, out, k, lo, hi, z, zld, divu, s0, s1);
-  else stage_rows<T, UPDATE>(o, out, k, lo, hi, z, zld, divu, s0, s1);
+  for (int v = 0; v < 4; ++v)
+    stage_row<T, false>(o, v, out, k, lo[v], hi[v], lo[5 + v], hi[5 + v], z + v * zld, divu, s0, s1);
+  stage_row<T, true>(o, 4, out, k, lo[4], hi[4], lo[9], hi[9], z + 4 * zld, divu, s0, s1);
 }
 
 // The energy source rows of the output at offset `out` (a stage's s0, s1; none for Rhs).
@@ -533,18 +515,6 @@ Consts<Real> consts(const long* n, const double* params) {
   return k;
 }
 
-// Sweeps the padded fields in `work` (NFIELD or GG + 1 of them, each of the padded shape of n) with the output `o`.
-template <class Out>
-void sweep_padded(const long* n, const double* params, const Real* work, const Out& o, bool wrap2 = true) {
-  Consts<Real> k = consts(n, params);
-  k.wrap2 = wrap2;
-  const long M = (n[0] + 2 * GHOST) * k.stride[0];
-  const int nfield = BUILT_VISCOUS ? NFIELD : GG + 1;
-  std::vector<const Real*> P(NFIELD, nullptr);
-  for (int f = 0; f < nfield; ++f) P[f] = work + f * M;
-  sweep<Real, KTGF_LIMITER, KTGF_RIEMANN, BUILT_VISCOUS>(P.data(), k, o);
-}
-
 // The grid shape of a 3D cell field, or an error.
 ffi::Error grid_shape(const ffi::AnyBuffer& field, long* n) {
   auto dims = field.dimensions();
@@ -607,7 +577,11 @@ ffi::Error run(ffi::RemainingArgs in, size_t nin, const ffi::AnyBuffer& grid, co
   for (int f = 0; f < nfield; ++f) fields[f] = in.get<ffi::AnyBuffer>(f)->typed_data<Real>();
   pad<Real>(fields.data(), nfield, n, work);
   if (ghost) set_ghosts<Real>(ghost, nfield, n, axis, work);
-  sweep_padded(n, params, work, o, axis != 2);
+  Consts<Real> k = consts(n, params);
+  k.wrap2 = axis != 2;
+  const long M = (n[0] + 2 * GHOST) * k.stride[0];
+  for (int f = 0; f < nfield; ++f) fields[f] = work + f * M;  // the padded fields, swept
+  sweep<Real, KTGF_LIMITER, KTGF_RIEMANN, BUILT_VISCOUS>(fields.data(), k, o);
   return ffi::Error::Success();
 }
 
@@ -749,21 +723,19 @@ inline void wait_for(const Progress* progress, int t, int nt, long p) {
 // side, in its ring (a slice of `ring_all`); before it sweeps plane i it computes plane i + 2 into the slot of
 // plane i - 2 (planes 0 and 1, needed again at the end, keep their own slots).  U' may be written over Uk: a
 // thread reads Uk of plane p before it writes U' of plane p, and then only once its neighbours have computed
-// plane p (wait_for); or over U0, read only at the cell being written (but by FROM_RATE's closures, which wait
-// too).  FROM_RATE rows of Uk are computed from U0 and L0 as they are read.  nlim > 0: the maxima of the
-// program's nlim limit terms also go to `maxima` (ghost rows too: a maximum taken twice is the same).
+// plane p (wait_for); or over U0, read only at the cell being written.  A boundary along y (gaxis 1) or z (2):
+// the ghost cells' fields are the caller's `ghost` planes (set_ghosts), not the program's.
 // Returns false (nothing computed) if the threads' rings do not fit in `capacity`.
 template <class T, int LIM, int RIE>
 bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const Stage<T>& o, T* ring_all,
-                 long capacity, int nlim = 0, T* maxima = nullptr, const T* ghost = nullptr, int gaxis = -1) {
+                 long capacity, const T* ghost = nullptr, int gaxis = -1) {
   const long n0 = kg.n[0], n1 = kg.n[1], n2 = kg.n[2], m2 = kg.stride[1];
   bool fits = true;
-  for (int q = 0; q < nlim; ++q) maxima[q] = -std::numeric_limits<T>::infinity();
   const int threads = fused_threads(kg.n);
-  // Whether U' is written over what the neighbours read for their ghost rows (Uk; with FROM_RATE also U0): only
-  // then does a thread wait for them before it writes a plane.
+  // Whether U' is written over what the neighbours read for their ghost rows (Uk): only then does a thread wait
+  // for them before it writes a plane.
   bool shared = false;
-  for (int v = 0; v < 5; ++v) shared = shared || o.U[v] == o.Uk[v] || (o.mode == FROM_RATE && o.U[v] == o.U0[v]);
+  for (int v = 0; v < 5; ++v) shared = shared || o.U[v] == o.Uk[v];
   std::vector<Progress> progress(threads);
   for (auto& p : progress) p.placed.store(-3, std::memory_order_relaxed);
 #pragma omp parallel num_threads(threads)
@@ -783,11 +755,7 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
       T* ring = ring_all + t * per;
       const Consts<T>& k = kg;  // the ring's rows have the padded row stride (planes are reached through the tables)
       RowBuffers<T> r(nj, n2);  // nj >= MIN_ROWS: fused_threads
-      // FROM_RATE: a row of Uk = U0 + dt L0; nlim > 0: a row of the limit terms and the thread's maxima.
-      std::vector<T> uk_row(o.mode == FROM_RATE ? 5 * n2 : 0), terms(size_t(nlim) * n2);
-      std::vector<T> local(nlim, -std::numeric_limits<T>::infinity());
-      std::vector<T*> out(NRING + nlim);  // the program's outputs: the ring's fields, then the limit terms
-      for (int q = 0; q < nlim; ++q) out[NRING + q] = terms.data() + q * n2;
+      std::vector<T*> out(NRING);  // the program's outputs: the ring's fields
       // Slot of plane p (-2 <= p < n0 + 2; planes 0, 1 and their periodic images n0, n0 + 1 in the kept slots).
       auto slot_of = [&](long p) {
         const long q = p >= n0 ? p - n0 : p;
@@ -811,18 +779,8 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
           const long gj = (J % n1 + n1) % n1, at = (gp * n1 + gj) * n2;
           const T* in[5];
           for (int v = 0; v < 5; ++v) in[v] = o.Uk[v] + at;
-          if (o.mode == FROM_RATE) {  // Uk as the first stage computed it: 0 U0 + 1 (U0 + dt L0)
-            for (int v = 0; v < 5; ++v) {
-              T* u = uk_row.data() + v * n2;
-              const T *u0 = o.U0[v] + at, *l0 = o.Uk[v] + at;
-#pragma omp simd
-              for (long q = 0; q < n2; ++q) u[q] = u0[q] + o.dt * l0[q];
-              in[v] = u;
-            }
-          }
           for (int f = 0; f < NRING; ++f) out[f] = field(f, s) + jj * m2 + GHOST;
           fn(n2, leaf, in, out.data());
-          row_maxima(out.data() + NRING, n2, nlim, local.data());  // ghost rows too: a maximum again changes nothing
           for (int f = 0; f < NFIELD; ++f) {  // the row's ghost cells along z: periodic, or the caller's
             T* row = out[f] - GHOST;
             const long m1g = n1 + 2 * GHOST;
@@ -863,8 +821,6 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
                                         src[1] = field(NFIELD + 1, si) + row(b);
                                       }, k, o, r);
       }
-#pragma omp critical(ktgf_fused_maxima)
-      for (int q = 0; q < nlim; ++q) maxima[q] = max_nan(maxima[q], local[q]);
     }
   }
   return fits;
@@ -942,30 +898,21 @@ ffi::Error cell_limits_entry(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs stat
   return ffi::Error::Success();
 }
 
-// KtgfSsprkStageCells (sweep_fused; `ring` its per-thread planes, ring_elements).  `mode` (StageMode): UPDATE,
-// state (U0, Uk); RATE, state U0, writes L(U0) and the maxima (empty in the other modes); FROM_RATE, (U0, L0).
+// KtgfSsprkStageCells (sweep_fused; `ring` its per-thread planes, ring_elements): state (U0, Uk[, ghost planes]).
 ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state,
-                             int32_t limiter, int32_t riemann, int64_t program, int32_t mode,
-                             ffi::Result<ffi::AnyBuffer> u0, ffi::Result<ffi::AnyBuffer> u1,
-                             ffi::Result<ffi::AnyBuffer> u2, ffi::Result<ffi::AnyBuffer> u3,
-                             ffi::Result<ffi::AnyBuffer> u4, ffi::Result<ffi::AnyBuffer> maxima,
+                             int32_t limiter, int32_t riemann, int64_t program, ffi::Result<ffi::AnyBuffer> u0,
+                             ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2,
+                             ffi::Result<ffi::AnyBuffer> u3, ffi::Result<ffi::AnyBuffer> u4,
                              ffi::Result<ffi::AnyBuffer> ring) {
-  if (mode != UPDATE && mode != RATE && mode != FROM_RATE)
-    return ffi::Error::InvalidArgument("stage kernel: mode must be 0 (update), 1 (rate) or 2 (from rate)");
-  const size_t nstate = mode == RATE ? 5 : 10;
+  const size_t nstate = 10;
   const bool ghosts = state.size() == nstate + 1;
   if (params.element_count() != 6 + ghosts)
     return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt[, ghost axis])");
   if (state.size() != nstate + ghosts)
-    return ffi::Error::InvalidArgument(mode == RATE ? "stage kernel: state = U0 x5[, ghost planes]"
-                                                    : "stage kernel: state = (U0 x5, Uk x5[, ghost planes])");
+    return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5[, ghost planes])");
   ffi::DataType type;
   if (auto err = same_fields(state, nstate, type); err.failure()) return err;
   if (auto err = check_variant("KtgfSsprkStageCells", type, limiter, riemann, true); err.failure()) return err;
-  const int nlim = int(maxima->element_count());
-  if ((mode != RATE && nlim != 0) || maxima->element_type() != type)
-    return ffi::Error::InvalidArgument("stage kernel: maxima must be of the state precision (and empty unless "
-                                       "mode = 1)");
   CellProgram p{nullptr, 0};
   if (auto err = find_program(program, type, p); err.failure()) return err;
   long n[3];
@@ -977,13 +924,12 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
   int axis;
   if (auto err = ghost_planes(state, nstate, par, 6, NFIELD, n, ghost, axis); err.failure()) return err;
   if (axis == 0) return ffi::Error::InvalidArgument("stage kernel: cell programs take ghost planes along y or z only");
-  Stage<Real> o = stage_output(par, state, 0, mode == RATE ? 0 : 5, {u0, u1, u2, u3, u4});  // s0, s1: the ring's
-  o.mode = mode;
+  Stage<Real> o = stage_output(par, state, 0, 5, {u0, u1, u2, u3, u4});  // s0, s1: the ring's
   Consts<Real> k = consts(n, par);
   k.wrap2 = axis != 2;
   if (!sweep_fused<Real, KTGF_LIMITER, KTGF_RIEMANN>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(), k, o,
-                                                     ring->typed_data<Real>(), long(ring->element_count()), nlim,
-                                                     maxima->typed_data<Real>(), ghost, axis))
+                                                     ring->typed_data<Real>(), long(ring->element_count()), ghost,
+                                                     axis))
     return ffi::Error::InvalidArgument("stage kernel: the ring workspace is too small for the threads");
   return ffi::Error::Success();
 }
@@ -1025,17 +971,15 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStageCells, ssprk_stage_cells,
                               ffi::Ffi::Bind()
                                   .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s, a, dt)
                                   .Arg<ffi::Buffer<ffi::F64>>()  // the cell program's parameters
-                                  .RemainingArgs()               // U0 (5)[, Uk or L0 (5)]
+                                  .RemainingArgs()               // U0 (5), Uk (5)[, ghost planes]
                                   .Attr<int32_t>("limiter")
                                   .Attr<int32_t>("riemann")
                                   .Attr<int64_t>("program")
-                                  .Attr<int32_t>("mode")
-                                  .Ret<ffi::AnyBuffer>()  // U' density (RATE: L)
+                                  .Ret<ffi::AnyBuffer>()  // U' density
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_x
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_y
                                   .Ret<ffi::AnyBuffer>()  // ... rho u_z
                                   .Ret<ffi::AnyBuffer>()  // ... E
-                                  .Ret<ffi::AnyBuffer>()  // maxima of the program's limit terms (RATE; else empty)
                                   .Ret<ffi::AnyBuffer>());  // the planes of the fused sweep (workspace, KtgfRingElements)
 
 XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfCellLimits, cell_limits_entry,

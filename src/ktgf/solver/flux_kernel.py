@@ -5,9 +5,8 @@ stress and heat flux, face divergence, ∇·u), computing each face once instead
 (docs/solver.md, Speed); it agrees with the JAX path to round-off (tests/solver/test_solver_flux_kernel.py).
 Every closure stays in Python.  :func:`ssprk_stage` also applies the energy source and the stage update of
 :func:`.stepping.ssprk3_step`; :func:`ssprk_stage_cells` also evaluates the closures, by a cell program
-generated from them (:mod:`.cell_program`), plane by plane as it sweeps, so a stage is one call.  A step's
-first stage, before Δt is known, is :func:`rate_cells`: the rate L(U) and the maxima of the step-limit and
-state-check terms; :func:`cell_limits` is that reduction alone.
+generated from them (:mod:`.cell_program`), plane by plane as it sweeps, so a stage is one call;
+:func:`cell_limits` reduces the step-limit and state-check terms of a state.
 
 It is used where it applies — CPU backend, one device, a 3D grid, float32 or float64 — unless
 :data:`.fluxes.FLUX_KERNEL` is off (``KTGF_FLUX_KERNEL=0``).  With walls or Lees–Edwards boundaries the caller
@@ -278,51 +277,25 @@ def _ring(grid: Any, dtype: Any, v: Variant) -> Any:
     return jax.ShapeDtypeStruct((int(_library(v).KtgfRingElements(*n)),), dtype)
 
 
-#: The modes of a stage of :func:`ssprk_stage_cells` (StageMode of flux_kernel.cc).
-STAGE_MODES = {"update": 0, "rate": 1, "from_rate": 2}
-
-
-def _stage_cells(state: list, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any, limiter: str,
-                 riemann: str, mode: str, aliases: dict | None, ghosts: Any = None) -> tuple:
-    """One ``KtgfSsprkStageCells`` call in ``mode`` (:data:`STAGE_MODES`): (U' or L, the maxima; empty but in
-    mode rate).  ``ghosts``: as in :func:`flux_divergence`, along y or z (the cell fields of the ghost cells)."""
-    _register(program, limiter, riemann, grid)
-    dtype = state[0].dtype
-    stage = variant(dtype, limiter, riemann, "stage")
-    field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
-    maxima = jax.ShapeDtypeStruct((program.nlim if mode == "rate" else 0,), dtype)
-    call = jax.ffi.ffi_call(target(CELLS_TARGET, stage), (field,) * 5 + (maxima, _ring(grid, dtype, stage)),
-                            input_output_aliases=aliases)
-    params, extra = _ghost_args(_stage_params(a, dt, grid, rho_s, dtype), ghosts, dtype)
-    out = call(params, leaf, *state, *extra, **_schemes(limiter, riemann), program=np.int64(program.key),
-               mode=np.int32(STAGE_MODES[mode]))
-    return tuple(out[:5]), out[5]
-
-
 def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any,
-                      limiter: str, riemann: str, write_over: str = "uk", from_rate: bool = False,
-                      ghosts: Any = None) -> tuple[Any, ...]:
+                      limiter: str, riemann: str, write_over: str = "uk", ghosts: Any = None) -> tuple[Any, ...]:
     """The SSP-RK3 stage of :func:`ssprk_stage` with the cell fields and the energy source computed in
     the kernel from Uk by a cell program (:func:`.cell_program.for_physics`) with parameters ``leaf``
     (:func:`.cell_program.leaf_values`), plane by plane as it sweeps: no cell field is written to memory.
 
-    ``write_over``: the input buffers U' is written over: ``"uk"``, ``"u0"`` (when the caller no longer needs
-    the step's start state) or ``"new"`` (a step's first stage, whose Uk = U0 the later stages still read:
-    written in place, XLA would first copy U0).  ``from_rate``: ``Uk`` is the rate L0 = L(U0) of
-    :func:`rate_cells`, and the stage's Uk is U0 + Δt L0.  ``ghosts``: as in :func:`_stage_cells`.
+    ``write_over``: the input buffers U' is written over: ``"uk"`` or ``"new"`` (where Uk is still read
+    elsewhere: written in place, XLA would first copy it).  ``ghosts``: as in :func:`flux_divergence`, along y
+    or z (the cell fields of the ghost cells).
     """
+    _register(program, limiter, riemann, grid)
     dtype = Uk[0].dtype
     state = [jnp.asarray(f, dtype) for f in (*U0, *Uk)]
-    first = {"u0": 2, "uk": 7, "new": None}[write_over]  # the inputs are params, leaf, U0 (5), Uk (5)
-    aliases = None if first is None else {first + i: i for i in range(5)}
-    return _stage_cells(state, program, leaf, a, dt, grid, rho_s, limiter, riemann,
-                        "from_rate" if from_rate else "update", aliases, ghosts)[0]
-
-
-def rate_cells(U: Any, program: Any, leaf: Any, grid: Any, rho_s: Any, limiter: str, riemann: str) -> tuple:
-    """The first stage of a fused SSP-RK3 step before its Δt is known: ``(L, maxima)``, the rate
-    L(U) = −∇·F + S (into new buffers) and the maxima over the cells of the terms of the step-start cell
-    program ``program`` (parameters ``leaf``), from one evaluation of the closures.  The step's second stage
-    takes L as its ``Uk`` (:func:`ssprk_stage_cells` with ``from_rate``)."""
-    state = [jnp.asarray(f, U[0].dtype) for f in U]
-    return _stage_cells(state, program, leaf, 0.0, 0.0, grid, rho_s, limiter, riemann, "rate", None)
+    stage = variant(dtype, limiter, riemann, "stage")
+    field = jax.ShapeDtypeStruct(tuple(grid.cells), dtype)
+    # The inputs are params, leaf, U0 (5), Uk (5).
+    aliases = {"uk": {7 + i: i for i in range(5)}, "new": None}[write_over]
+    call = jax.ffi.ffi_call(target(CELLS_TARGET, stage), (field,) * 5 + (_ring(grid, dtype, stage),),
+                            input_output_aliases=aliases)
+    params, extra = _ghost_args(_stage_params(a, dt, grid, rho_s, dtype), ghosts, dtype)
+    out = call(params, leaf, *state, *extra, **_schemes(limiter, riemann), program=np.int64(program.key))
+    return tuple(out[:5])

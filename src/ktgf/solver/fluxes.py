@@ -88,26 +88,25 @@ def pad_viscous(W: Sequence[Any], transport: Sequence[Any], grid: Grid, phys: Ph
     return pad_fields(W, grid, t, velocity=1, theta=4, walls=walls)
 
 
-#: Use the C++ kernel (:mod:`.flux_kernel`) for :func:`flux_divergence` where it applies (CPU,
-#: one device, 3D fully periodic grid).  Default on; ``KTGF_FLUX_KERNEL=0`` switches it off.
-FLUX_KERNEL = os.environ.get("KTGF_FLUX_KERNEL", "1").lower() not in ("0", "off", "false", "no")
-#: Where the flux kernel applies, run each SSP-RK3 stage as one kernel call with the source and the
-#: stage update fused in (:func:`.flux_kernel.ssprk_stage`).  Default on; ``KTGF_STAGE_KERNEL=0``
-#: keeps the flux kernel for the fluxes only (the A/B reference of ``benchmarks/bench_solver.py``).
-STAGE_KERNEL = os.environ.get("KTGF_STAGE_KERNEL", "1").lower() not in ("0", "off", "false", "no")
-#: Where the fused stage runs, evaluate the cell closures inside it by a generated cell program
-#: (:mod:`.cell_program`, :func:`.flux_kernel.ssprk_stage_cells`) instead of an XLA closure pass.
-#: Default on; ``KTGF_CELL_PROGRAM=0`` keeps the XLA pass.
-CELL_PROGRAM = os.environ.get("KTGF_CELL_PROGRAM", "1").lower() not in ("0", "off", "false", "no")
+def _switch(name: str) -> bool:
+    return os.environ.get(name, "1").lower() not in ("0", "off", "false", "no")
+
+
+#: Use the C++ kernel (:mod:`.flux_kernel`) for :func:`flux_divergence` where it applies (CPU, one device, a 3D
+#: grid).  Default on; ``KTGF_FLUX_KERNEL=0`` switches it off.
+FLUX_KERNEL = _switch("KTGF_FLUX_KERNEL")
+#: Where the flux kernel applies, run each SSP-RK3 stage as one kernel call with the source and the stage update
+#: fused in (:func:`.flux_kernel.ssprk_stage`).  ``KTGF_STAGE_KERNEL=0`` keeps the flux kernel for the fluxes only
+#: (the A/B reference of ``benchmarks/bench_solver.py``).
+STAGE_KERNEL = _switch("KTGF_STAGE_KERNEL")
+#: Where the stage kernel runs, evaluate the cell closures inside it by a generated cell program
+#: (:mod:`.cell_program`, :func:`.flux_kernel.ssprk_stage_cells`).  ``KTGF_CELL_PROGRAM=0`` keeps the XLA pass.
+CELL_PROGRAM = _switch("KTGF_CELL_PROGRAM")
 
 
 def pad_periodic(W: Sequence[Any], ndim: int) -> tuple[Any, ...]:
-    """Fields with GHOST periodic ghost cells on each side of every grid axis.
-
-    Padding once per stage and then reading stencils as static slices keeps the fused loops
-    free of the concatenations that ``jnp.roll`` would put in every one of them.  (A gather from a
-    precomputed index pads 3.5× faster alone, but whole steps ranged from 1.25× faster to 0.88×.)
-    """
+    """Fields with GHOST periodic ghost cells on each side of every grid axis: padding once per stage and then
+    reading stencils as static slices keeps the loops free of the concatenations of ``jnp.roll``."""
     return materialise(tuple(jnp.pad(f, [(GHOST, GHOST)] * ndim, mode="wrap") for f in W))
 
 

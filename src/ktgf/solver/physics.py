@@ -39,7 +39,7 @@ class Physics:
     phi_stop : float
         A run stops with a diagnosis once any cell reaches this solid fraction.
     gravity : tuple of 3 floats or None
-        Body force per unit mass g [m/s²] (None: none; :func:`~ktgf.solver.sources.body_force`).
+        Body force per unit mass g [m/s²] (None: none; :func:`~ktgf.solver.sources.add_body_force`).
     hcs : bool
         The case is a freely cooling gas: the closures' homogeneous-cooling dissipation
         (``Model.reduced(hcs=True)``, frictional models: rotation at its HCS ratio) instead of the

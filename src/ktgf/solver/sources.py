@@ -22,12 +22,11 @@ def cooling_source(W: Any, divu: Any, phys: Physics, r: Reduced) -> tuple[Any, A
     return -1.5 * rho * theta * zeta, zeta
 
 
-def body_force(W: Any, phys: Physics) -> tuple[tuple[Any, Any, Any], Any]:
-    """Momentum source ρg [N/m³] per component and its power ρg·u [W/m³] (gravity at any angle).
-
-    ``phys.gravity`` = (g_x, g_y, g_z) per unit mass; explicit, like the convective terms.
-    """
-    rho, u = W[0], W[1:4]
-    g = phys.gravity
-    force = tuple(rho * g[j] for j in range(3))
-    return force, sum(f * v for f, v in zip(force, u))
+def add_body_force(dU: Any, W: Any, phys: Physics, scale: Any = 1.0) -> list[Any]:
+    """dU (ρ, ρu, E) plus ``scale`` × the momentum source ρg [N/m³] and its power ρg·u [W/m³] (gravity at any
+    angle, ``phys.gravity`` = (g_x, g_y, g_z) per unit mass; explicit, like the convective terms; dU without it)."""
+    if phys.gravity is None:
+        return list(dU)
+    force = tuple(W[0] * g for g in phys.gravity)
+    power = sum(f * v for f, v in zip(force, W[1:4]))
+    return [dU[0], *(d + scale * f for d, f in zip(dU[1:4], force)), dU[4] + scale * power]

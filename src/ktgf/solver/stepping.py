@@ -32,7 +32,7 @@ from .acoustics import MODES as ACOUSTICS
 from .acoustics import AcousticStage, advective_divergence, enthalpy
 from .imex import EXPLICIT_WEIGHTS, GAMMA, IMPLICIT_WEIGHTS, implicit_stage
 from .physics import Physics
-from .sources import body_force, cooling_source
+from .sources import add_body_force, cooling_source
 from .state import primitive_fields
 from .cell_terms import LIMIT_TERMS, kernel_stage_inputs, limit_terms, status_terms
 
@@ -166,10 +166,7 @@ def explicit_rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, viscous: bool
         dU, divu = flux_divergence(W, (eos, transport), grid, phys, num.limiter, num.riemann, viscous=viscous, t=t)
     source, _ = cooling_source(W, divu, phys, r)
     dU[4] = dU[4] + source
-    if phys.gravity is not None:
-        force, power = body_force(W, phys)
-        dU = [dU[0], *(d + f for d, f in zip(dU[1:4], force)), dU[4] + power]
-    return dU
+    return add_body_force(dU, W, phys)
 
 
 def rhs(U: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0) -> Any:
@@ -194,13 +191,6 @@ def limits_of_maxima(maxima: Any, grid: Grid, num: Numerics, divu_max: Any) -> A
     conductive = num.cfl_diffusion / (2.0 * inv_dx2 * maxima[2])
     cooling = num.cfl_source / (maxima[3] + maxima[4] * divu_max)
     return jnp.stack([num.cfl / maxima[0], viscous, conductive, cooling])
-
-
-def kernel_limits_apply(num: Numerics) -> bool:
-    """Whether the step-start maxima may come from the stage kernel (:func:`.flux_kernel.cell_limits`, which
-    runs on periodic grids only: :func:`stage_kernel_applies`): SSP-RK3 with the explicit sink, whose
-    cooling limit is :func:`limits_of_maxima`'s."""
-    return num.scheme == "ssprk3" and num.sink == "explicit"
 
 
 def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None) -> Any:
@@ -232,10 +222,9 @@ def divu_size(u: Any, maxima: Any, grid: Grid) -> Any:
     return jnp.max(jnp.abs(cell_divergence(pad_fields(u, grid, velocity=0), grid)))
 
 
-def kernel_step_limits(maxima: Any, grid: Grid, num: Numerics) -> Any:
-    """:func:`step_limits` from the maxima the stage kernel reduced (:func:`.flux_kernel.cell_limits`;
-    where :func:`kernel_limits_apply`)."""
-    return limits_of_maxima(maxima, grid, num, divu_bound(maxima, grid))
+def kernel_step_limits(maxima: Any, u: Any, grid: Grid, num: Numerics) -> Any:
+    """:func:`step_limits` from the maxima the kernel reduced (:func:`.flux_kernel.cell_limits`) and the velocity."""
+    return limits_of_maxima(maxima[:len(LIMIT_TERMS)], grid, num, divu_size(u, maxima, grid))
 
 
 def dt_of_limits(lim: Any, num: Numerics) -> Any:
@@ -280,29 +269,14 @@ def cell_boundary_terms(Uk: Any, grid: Grid, phys: Physics, num: Numerics, t: An
     return boundary_terms(ends, grid, phys, num.limiter, num.riemann, True, t)
 
 
-def start_program(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> Any:
-    """The step-start cell program of the SSP-RK3 stage kernel — the stage closures and the
-    :data:`LIMIT_TERMS`, :func:`.flux_kernel.cell_limits` — or None where a step does not start with it
-    (a boundary or a body force; no stage kernel or stage program; another scheme or the implicit sink:
-    :func:`kernel_limits_apply`)."""
-    from .cell_program import for_physics
-
-    if not (periodic(grid) and phys.gravity is None and cell_programs_apply(grid) and kernel_limits_apply(num)
-            and stage_kernel_applies(grid, phys, num, dtype)):
-        return None
-    if for_physics(phys, dtype) is None:  # the later stages need the stage program
-        return None
-    return for_physics(phys, dtype, limits=num.acoustics)
-
-
 def checks_program(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> Any:
     """The step-start cell program whose kernel reduction (:func:`.flux_kernel.cell_limits`) gives the step limits
-    and the state checks of SSP-RK3 steps on the stage kernel outside the fused loop (boundaries, gravity: where
-    :func:`start_program` is None), or None where those come from XLA reductions (no stage kernel, closures
-    without a cell program, another scheme or the implicit sink)."""
+    and the state checks of SSP-RK3 steps on the stage kernel, or None where those come from XLA reductions (no
+    stage kernel, closures without a cell program, another scheme, or the implicit sink, whose cooling limit is not
+    :func:`limits_of_maxima`'s)."""
     from .cell_program import for_physics
 
-    if not (kernel_limits_apply(num) and stage_kernel_applies(grid, phys, num, dtype)):
+    if not (num.scheme == "ssprk3" and num.sink == "explicit" and stage_kernel_applies(grid, phys, num, dtype)):
         return None
     return for_physics(phys, dtype, limits=num.acoustics)
 
@@ -332,12 +306,9 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
             g, f = jax.lax.optimization_barrier((ghosts[1], fix[1]))
             return (ghosts[0], g), (fix[0], f)
 
-        def finish(k: Any, out: tuple, W: Any, fix: Any) -> tuple:
-            if phys.gravity is not None:  # the body force, which the kernel's source does not have
-                force, power = body_force(W, phys)
-                out = (out[0], *(x + ((1.0 - coef[k]) * dt) * f for x, f in zip(out[1:4], force)),
-                       out[4] + ((1.0 - coef[k]) * dt) * power)
-            return add_boundary_fluxes(out, fix, grid, (1.0 - coef[k]) * dt)
+        def finish(k: Any, out: tuple, W: Any, fix: Any) -> tuple:  # the body force, which the kernel lacks
+            return add_boundary_fluxes(tuple(add_body_force(out, W, phys, (1.0 - coef[k]) * dt)), fix, grid,
+                                       (1.0 - coef[k]) * dt)
 
         program = for_physics(phys, U[0].dtype) if cell_programs_apply(grid) else None
         if program is not None:  # the closures inside the kernel: each stage is one call
@@ -377,25 +348,6 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
         return tuple(a * u + (1.0 - a) * (uk + dt * l) for u, uk, l in zip(U, Uk, L))
 
     return jax.lax.fori_loop(0, 3, stage, tuple(U))
-
-
-def later_cell_stages(U: tuple, Uk: tuple, dt: Any, grid: Grid, phys: Physics, num: Numerics, consume: bool = False,
-                      from_rate: bool = False) -> tuple:
-    """The second and third stages of an SSP-RK3 step from U whose stages are kernel calls with the closures
-    in a cell program (:func:`ssprk3_step`): from the first stage's U1 = ``Uk``, or (``from_rate``) from its rate
-    L(U) (:func:`.flux_kernel.rate_cells`: U1 = U + Δt L).  The second stage writes over its input, the third
-    over its input or (``consume``) over U."""
-    from .cell_program import for_physics, leaf_values
-    from .flux_kernel import ssprk_stage_cells
-
-    program, leaf = for_physics(phys, U[0].dtype), leaf_values(phys)
-
-    def cells_stage(a: float, Uk: tuple, write_over: str, from_rate: bool = False) -> tuple:
-        return ssprk_stage_cells(U, Uk, program, leaf, jnp.asarray(a, U[0].dtype), dt, grid, phys.material_density,
-                                 num.limiter, num.riemann, write_over, from_rate)
-
-    U2 = cells_stage(0.75, Uk, "uk", from_rate)
-    return cells_stage(1.0 / 3.0, U2, "u0" if consume else "uk")
 
 
 def imex_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: Any = 0.0,
@@ -464,19 +416,19 @@ def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
 
 #: CPU time of one IMEX step over one SSP-RK3 step, measured (RET at φ = 0.5 with Δx = ℓ, 32³: 108 against 36 ms).
 IMEX_COST = 3.0
-#: The same where SSP-RK3 runs as the fused loop of cell-program kernel calls (:func:`start_program`), measured
-#: likewise in float64 at the steady state: 9.5, 8.6, 9.2× at 16³, 32³, 64³ (430.8 against 46.9 ms at 64³).
-IMEX_COST_FUSED = 9.0
+#: The same where SSP-RK3's stages run on cell programs (:func:`cell_programs_apply`), measured likewise in
+#: float64 at the steady state, CPU time: 9.5, 11.2× at 32³, 64³ (513.6 against 45.7 ms at 64³).
+IMEX_COST_CELLS = 10.0
 
 
 def auto_ratio(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> float:
     """The step ratio (IMEX over SSP-RK3) above which ``auto`` picks IMEX: twice the break-even, whose cost
-    ratio is :data:`IMEX_COST_FUSED` where SSP-RK3 would run the fused loop, else :data:`IMEX_COST`.  The factor
-    two is a margin for IMEX's compilation (≈ 4× that of SSP-RK3, measured; 10× against the fused loop: 6.8 s
-    against 0.6–0.7 s at 32³)."""
+    ratio is :data:`IMEX_COST_CELLS` where SSP-RK3's stages would run on cell programs, else :data:`IMEX_COST`.
+    The factor two is a margin for IMEX's compilation (≈ 4× that of SSP-RK3, measured; 10× against SSP-RK3 on
+    cell programs: 6.8 s against 0.6–0.7 s at 32³)."""
     explicit = replace(num, scheme="ssprk3", sink="explicit", acoustics="explicit")
-    fused = start_program(grid, phys, explicit, dtype) is not None
-    return 2.0 * (IMEX_COST_FUSED if fused else IMEX_COST)
+    cells = cell_programs_apply(grid) and checks_program(grid, phys, explicit, dtype) is not None
+    return 2.0 * (IMEX_COST_CELLS if cells else IMEX_COST)
 
 
 def choose_scheme(U: Any, grid: Grid, phys: Physics, num: Numerics) -> str:
@@ -522,18 +474,10 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
     accepted steps, the status code of the first rejected step (0 if none) and the Δt of the
     last attempted step (to reproduce a failure for its diagnosis).
 
-    With a step-start cell program (:func:`start_program`) a step is three kernel calls and keeps no second
-    state.  Its first stage evaluates the closures of U once for both the rate L(U) and the maxima of the
-    :data:`START_TERMS` (:func:`.flux_kernel.rate_cells`), so Δt is known after it, and the second stage takes
-    U + Δt L(U) as its input (:func:`later_cell_stages`); the third writes the new state over U.  The maxima
-    also hold U's status: a step's state is checked in the next step's first stage (the last one's by
-    :func:`.flux_kernel.cell_limits` after the loop), and a rejected step has overwritten the last good state,
-    which is computed again from U by repeating the accepted steps: the same compiled steps, so the same
-    bits (the kernels do not depend on the thread count: tests/solver/test_solver_flux_kernel.py).
+    With a step-start cell program (:func:`checks_program`) the kernel reduces the :data:`START_TERMS` of each
+    new state once (:func:`.flux_kernel.cell_limits`): its status, and the next step's limits.
     """
-    program = start_program(grid, phys, num, U[0].dtype)
-    checks = None if program is not None else checks_program(grid, phys, num, U[0].dtype)
-    nlim = len(LIMIT_TERMS)
+    checks = checks_program(grid, phys, num, U[0].dtype)
     if checks is not None:
         from .cell_program import leaf_values
         from .flux_kernel import cell_limits
@@ -556,19 +500,21 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
 
     def body(carry: tuple) -> tuple:
         U, t, n, _, _, maxima = carry  # maxima: U's of the checks program (empty without it)
-        # The closures of the step start, evaluated by XLA, serve both the step limits and the step's first stage.
-        r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
+        # The closures of the step start, evaluated by XLA, serve both the step limits and the step's first stage
+        # (none with cell programs: the kernel evaluates them).
+        cells = checks is not None and cell_programs_apply(grid)
+        r0 = None if cells else cell_coefficients(primitive_fields(U), grid, phys, t)
         if checks is None:
             lim = step_limits(U, grid, phys, num, r0)
         else:
-            lim = limits_of_maxima(maxima[:nlim], grid, num, divu_size(primitive_fields(U)[1:4], maxima, grid))
+            lim = kernel_step_limits(maxima, primitive_fields(U)[1:4], grid, num)
         dt_stable, dt, last = step_size(lim, t)
         U_new, residual = scheme_step(U, dt.astype(U[0].dtype), grid, phys, num, t, r0)
         if checks is None:
             new_maxima, bad_state = maxima, state_status(U_new, phys)
         else:  # the new state's check, and the next step's limits
             new_maxima = start_maxima(U_new)
-            bad_state = status_of_maxima(new_maxima[nlim:], phys)
+            bad_state = status_of_maxima(new_maxima[len(LIMIT_TERMS):], phys)
         status = jnp.where(bad_state != 0, bad_state, size_status(dt_stable, dt))
         status = jnp.where((status == 0) & ~(residual <= RESIDUAL_FAIL), 6, status)
         good = status == 0
@@ -581,41 +527,9 @@ def advance(U: Any, t: Any, t_end: Any, max_steps: Any, grid: Grid, phys: Physic
     t_end = jnp.asarray(t_end, jnp.float64)
     zero = jnp.zeros((), jnp.int32)
     init = (U, t, zero, zero, jnp.zeros((), jnp.float64))
-    if program is None:
-        maxima = jnp.zeros((0,), U[0].dtype) if checks is None else start_maxima(U)
-        U, t, n, status, dt, _ = jax.lax.while_loop(cond_before(max_steps), body, (*init, maxima))
-        return jnp.stack(U), t, n, status, dt
-
-    from .cell_program import leaf_values
-    from .flux_kernel import cell_limits, rate_cells
-
-    leaf = leaf_values(phys, grid)
-
-    def fused_body(carry: tuple) -> tuple:
-        # U: the state after n steps of the call, the n-th not checked yet; t_before: the time before that step.
-        U, t, n, _, dt_before, t_before = carry
-        L, maxima = rate_cells(U, program, leaf, grid, phys.material_density, num.limiter, num.riemann)
-        dt_stable, dt, last = step_size(kernel_step_limits(maxima[:nlim], grid, num), t)
-        U_new = later_cell_stages(U, L, dt.astype(U[0].dtype), grid, phys, num, consume=True, from_rate=True)
-        bad = status_of_maxima(maxima[nlim:], phys)
-        # A bad U rejects the step that made it (if any: U may be the call's start) and this one is not taken.
-        undo = (bad != 0) & (n > 0)
-        status = jnp.where(bad != 0, bad, size_status(dt_stable, dt))
-        good = status == 0
-        t_new = jnp.where(good, jnp.where(last, t_end, t + dt), jnp.where(undo, t_before, t))
-        n_new = n + good.astype(n.dtype) - undo.astype(n.dtype)
-        return U_new, t_new, n_new, status, jnp.where(undo, dt_before, dt), t
-
-    start = (*init, t)
-    U_end, t, n, status, dt, t_before = jax.lax.while_loop(cond_before(max_steps), fused_body, start)
-    last_state = status_of_maxima(cell_limits(U_end, program, leaf, grid, num.limiter, num.riemann)[nlim:], phys)
-    undo = (status == 0) & (n > 0) & (last_state != 0)  # the last step's state, checked here
-    status = jnp.where(undo, last_state, status)
-    t = jnp.where(undo, t_before, t)
-    n = n - undo.astype(n.dtype)
-    U_end = jax.lax.cond(status == 0, lambda: U_end,
-                         lambda: jax.lax.while_loop(cond_before(n), fused_body, start)[0])
-    return jnp.stack(U_end), t, n, status, dt
+    maxima = jnp.zeros((0,), U[0].dtype) if checks is None else start_maxima(U)
+    U, t, n, status, dt, _ = jax.lax.while_loop(cond_before(max_steps), body, (*init, maxima))
+    return jnp.stack(U), t, n, status, dt
 
 
 @jax.jit
