@@ -417,7 +417,7 @@ def scheme_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
 #: CPU time of one IMEX step over one SSP-RK3 step, measured (RET at φ = 0.5 with Δx = ℓ, 32³: 108 against 36 ms).
 IMEX_COST = 3.0
 #: The same where SSP-RK3's stages run on cell programs (:func:`cell_programs_apply`), measured likewise in
-#: float64 at the steady state, CPU time: 9.5, 11.2× at 32³, 64³ (513.6 against 45.7 ms at 64³).
+#: float64 at the steady state, CPU time: 9.4, 11.6× at 32³, 64³ (528.3 against 45.7 ms at 64³).
 IMEX_COST_CELLS = 10.0
 
 
