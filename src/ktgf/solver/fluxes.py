@@ -376,8 +376,9 @@ def boundary_terms(ends: SimpleNamespace, grid: Grid, phys: Physics, limiter: st
                 for f in fields]
 
     def ends_map(fn: Any, *args: Any) -> tuple[list[Any], list[Any]]:
-        """fn of the stacked slabs of both ends at once (half the XLA operations of two calls): its lists of fields
-        at the end 0, at the end k - 1."""
+        """fn of the stacked slabs of both ends at once (one traced computation; XLA's operation count is not lower:
+        1,719 small operations per 64³ Couette step against 1,524 for two calls): its lists of fields at the end 0,
+        at the end k - 1."""
         out = jax.vmap(fn)(*args)
         return [f[0] for f in out], [f[1] for f in out]
 
