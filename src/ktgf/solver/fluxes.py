@@ -28,7 +28,7 @@ import jax
 import jax.numpy as jnp
 
 from .boundaries import lees_edwards_faces
-from .grid import Grid
+from .grid import Grid, periodic
 from .physics import Physics
 from .state import conservative_fields
 from .stencil import GHOST, LIMITERS, RIEMANN_SOLVERS  # noqa: F401  (fluxes.GHOST etc. are read elsewhere)
@@ -66,7 +66,7 @@ def pad_fields(W: Sequence[Any], grid: Grid, t: Any = 0.0, velocity: int | None 
     """Fields with GHOST ghost cells per side, filled by the grid's boundaries (:func:`.boundaries.pad`)."""
     from .boundaries import pad
 
-    if grid.boundaries is None or grid.boundaries.all_periodic:
+    if periodic(grid):
         return pad_periodic(W, grid.ndim)
     return materialise(pad(W, grid, GHOST, t, velocity, affine, theta, walls))
 
@@ -318,7 +318,7 @@ def kernel_fields(W: Sequence[Any], eos: Sequence[Any], transport: Sequence[Any]
                   limiter: str, riemann: str, viscous: bool, t: Any = 0.0) -> tuple:
     """The cell fields the C++ kernel sweeps (W, eos, transport), then the ghost planes and the boundary
     correction of :func:`boundary_terms` (None, None on a periodic grid: the kernel pads periodically)."""
-    if grid.boundaries is None or grid.boundaries.all_periodic:
+    if periodic(grid):
         return W, eos, transport, None, None
     ends = grid_ends((*W, *eos, *transport), grid)
     return (W, eos, transport, *boundary_terms(ends, grid, phys, limiter, riemann, viscous, t))

@@ -100,3 +100,8 @@ class Grid:
         for a, n in enumerate(mode):
             k[a] = 2.0 * math.pi * n / self.lengths[a]
         return k
+
+
+def periodic(grid: Any) -> bool:
+    """Whether every axis of ``grid`` (a :class:`Grid` or a grid-like namespace) is periodic."""
+    return grid.boundaries is None or grid.boundaries.all_periodic

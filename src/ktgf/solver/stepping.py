@@ -27,7 +27,7 @@ import jax.numpy as jnp
 from .friction import cell_coefficients, explicit_part
 from .fluxes import (LIMITERS, RIEMANN_SOLVERS, add_boundary_fluxes, cell_divergence, flux_divergence, kernel_fields,
                      materialise, pad_fields)
-from .grid import Grid
+from .grid import Grid, periodic
 from .acoustics import MODES as ACOUSTICS
 from .acoustics import AcousticStage, advective_divergence, enthalpy
 from .imex import EXPLICIT_WEIGHTS, GAMMA, IMPLICIT_WEIGHTS, implicit_stage
@@ -208,10 +208,6 @@ def step_limits(U: Any, grid: Grid, phys: Physics, num: Numerics, r: Any = None)
         zeta_e = jnp.max(phys.cooling_rate(rho, theta, 0.0, r_e)) + maxima[4] * divu_max
         lim = lim.at[3].set(jnp.minimum(SINK_COURANT / zeta0, num.cfl_source / zeta_e))
     return lim
-
-
-def periodic(grid: Grid) -> bool:
-    return grid.boundaries is None or grid.boundaries.all_periodic
 
 
 def divu_size(u: Any, maxima: Any, grid: Grid) -> Any:
