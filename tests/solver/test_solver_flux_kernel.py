@@ -253,7 +253,7 @@ def test_kernel_rhs_between_walls_matches_jax(case: str, axis: str) -> None:
 @pytest.mark.parametrize("case, axis, scheme", _some_slow([(*w, m) for w in WALLS for m in ("ssprk3", "imex")],
                                                           {("couette", "y", "ssprk3"), ("chute", "z", "imex")}))
 def test_kernel_steps_between_walls_match_jax(case: str, axis: str, scheme: str) -> None:
-    """Three steps; the chute's gravity is added to the stage kernel's output."""
+    """Three steps; the stage kernel adds the chute's gravity."""
     sim = _walled(case, axis)
     with sim.precision():
         U = tuple(sim.initial_state())
@@ -476,7 +476,7 @@ def test_fused_stage_is_in_the_compiled_step_only_where_it_applies() -> None:
     text = _with_kernel(True, lambda: hlo(sheared))
     assert calls(text, flux_kernel.STAGE_TARGET) and not calls(text, flux_kernel.CELLS_TARGET)
     with_gravity = Physics(phys.model, 0.8, D, RHO_S, phys.phi_stop, gravity=(0.0, -9.81, 0.0))
-    text = _with_kernel(True, lambda: hlo(with_gravity))  # a body force: the cell program, the force added after
+    text = _with_kernel(True, lambda: hlo(with_gravity))  # a body force: the cell program, which adds it
     assert calls(text, flux_kernel.CELLS_TARGET) and not calls(text, flux_kernel.STAGE_TARGET)
 
 
@@ -490,10 +490,14 @@ def test_closures_once_per_stage(monkeypatch) -> None:
     calls = []
     original = Physics.reduced
     monkeypatch.setattr(Physics, "reduced", lambda self, *a, **k: calls.append(1) or original(self, *a, **k))
+    num = Numerics(scheme="ssprk3")
     for stage in (True, False):
+        # The step-start cell program is generated (by tracing the closures) once per process and then cached: here
+        # before counting, so that the count does not depend on the tests run before this one.
+        _with_kernel(True, lambda: checks_program(grid, phys, num, jnp.float64), stage=stage, cells=False)
         calls.clear()
         _with_kernel(True, lambda: jax.jit(lambda U: advance.__wrapped__(
-            U, 0.0, 1e30, 1, grid, phys, Numerics(scheme="ssprk3"))).lower(U), stage=stage, cells=False)
+            U, 0.0, 1e30, 1, grid, phys, num)).lower(U), stage=stage, cells=False)
         assert len(calls) == 2
     from ktgf.solver import cell_program
 

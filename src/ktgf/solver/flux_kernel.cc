@@ -10,8 +10,8 @@
 // * KtgfFluxDivergence: float64 (dx, dy, dz, rho_s), then the cell fields (enum Field, each (n0, n1, n2),
 //   C order) -> -div F of the five conservative fields and the central div u.
 // * KtgfSsprkStage: one SSP-RK3 stage U' = a U0 + (1 - a)(Uk + dt L), L = -div F + s0 + s1 div u (the
-//   cooling rate is linear in div u, model.md §1); inputs float64 (dx, dy, dz, rho_s, a, dt), then the cell
-//   fields at Uk, U0, Uk, s0, s1.
+//   cooling rate is linear in div u, model.md §1) + the body force rho g and its power; inputs float64 (dx, dy,
+//   dz, rho_s, a, dt, g_x, g_y, g_z), then the cell fields at Uk, U0, Uk, s0, s1.
 // * KtgfSsprkStageCells: the same stage with the cell fields and source computed from Uk by a cell program
 //   (ktgf.solver.cell_program, registered by key with KtgfRegisterCells) plane by plane as the sweep goes
 //   (sweep_fused), so they never go to memory (1.3x faster per stage at 64^3 than writing them first).
@@ -212,6 +212,10 @@ struct Stage {
   const T* s0;  // energy source = s0 + s1 div u
   const T* s1;
   T a, b, dt;   // U' = a U0 + b (Uk + dt L), b = 1 - a
+  T g[3];       // the body force per unit mass: L gains rho g (momentum) and g . (rho u) (energy), from Uk
+  bool gravity;  // g != 0
+  const T* fix;  // boundary corrections of L (fix_row), or nullptr
+  int fix_axis;
   T* U[5];
 };
 
@@ -304,19 +308,62 @@ KTGF_INLINE void write_row(const Rhs<T>& o, const T* const* P, long c0, long out
   row_divu(P, c0, k, o.divu + out);
 }
 
-// Field v of a stage's output row at offset `out` (write_row); SRC: with the energy source s0 + s1 div u.
-template <class T, bool SRC>
+// Field v of a stage's output row at offset `out` (write_row); SRC: with the energy source s0 + s1 div u (the
+// energy row); G: with the body force, rho g_v on a momentum row (v = 1, 2, 3) or its power g . (rho u) on the energy row.
+template <class T, bool SRC, bool G>
 KTGF_INLINE void stage_row(const Stage<T>& o, int v, long out, const Consts<T>& k, const T* lo, const T* hi,
                            const T* ylo, const T* yhi, const T* zv, const T* divu, const T* s0, const T* s1) {
   const long n2 = k.n[2];
   const T* u0 = o.U0[v] + out;
   const T* uk = o.Uk[v] + out;
+  const T* rho = o.Uk[0] + out;
+  const T* m0 = o.Uk[1] + out;
+  const T* m1 = o.Uk[2] + out;
+  const T* m2 = o.Uk[3] + out;
+  const T gv = G && !SRC ? o.g[v - 1] : T(0);
   T* d = o.U[v] + out;
 #pragma omp simd
   for (long q = 0; q < n2; ++q) {
     T L = cell_div(lo, hi, ylo, yhi, zv, q, k);
     if (SRC) L = L + (s0[q] + s1[q] * divu[q]);
+    if (G) L = L + (SRC ? o.g[0] * m0[q] + o.g[1] * m1[q] + o.g[2] * m2[q] : gv * rho[q]);
     d[q] = o.a * u0[q] + o.b * (uk[q] + o.dt * L);
+  }
+}
+
+template <class T, bool G>
+KTGF_INLINE void stage_rows(const Stage<T>& o, long out, const Consts<T>& k, const T* const* lo, const T* const* hi,
+                            const T* z, long zld, const T* divu, const T* s0, const T* s1) {
+  stage_row<T, false, false>(o, 0, out, k, lo[0], hi[0], lo[5], hi[5], z, divu, s0, s1);
+  for (int v = 1; v < 4; ++v)
+    stage_row<T, false, G>(o, v, out, k, lo[v], hi[v], lo[5 + v], hi[5 + v], z + v * zld, divu, s0, s1);
+  stage_row<T, true, G>(o, 4, out, k, lo[4], hi[4], lo[9], hi[9], z + 4 * zld, divu, s0, s1);
+}
+
+// Adds b dt x the boundary corrections o.fix to the output row at offset `out`, after it is written, as the JAX
+// path adds them (fluxes.add_boundary_fluxes): o.fix holds 2 ends x 5 fields of the planes next to each end of the
+// axis o.fix_axis (the cells 0 and n - 1 along it), each a plane of the other two axes in C order.
+template <class T>
+KTGF_INLINE void fix_row(const Stage<T>& o, long out, const Consts<T>& k) {
+  const long n1 = k.n[1], n2 = k.n[2];
+  const long i = out / (n1 * n2), j = (out / n2) % n1;
+  const int a = o.fix_axis;
+  const long np = a == 0 ? n1 * n2 : a == 1 ? k.n[0] * n2 : k.n[0] * n1;
+  const T w = o.b * o.dt;
+  for (int s = 0; s < 2; ++s) {
+    const T* f = o.fix + s * 5 * np;
+    if (a == 2) {  // one cell of the row
+      const long q = s ? n2 - 1 : 0, at = i * n1 + j;
+      for (int v = 0; v < 5; ++v) o.U[v][out + q] = o.U[v][out + q] + w * f[v * np + at];
+    } else if ((a == 0 ? i : j) == (s ? k.n[a] - 1 : 0)) {  // the whole row
+      const long at = (a == 0 ? j : i) * n2;
+      for (int v = 0; v < 5; ++v) {
+        T* d = o.U[v] + out;
+        const T* c = f + v * np + at;
+#pragma omp simd
+        for (long q = 0; q < n2; ++q) d[q] = d[q] + w * c[q];
+      }
+    }
   }
 }
 
@@ -325,9 +372,11 @@ KTGF_INLINE void write_row(const Stage<T>& o, const T* const* P, long c0, long o
                            const T* const* lo, const T* const* hi, const T* z, long zld, T* divu, const T* s0,
                            const T* s1) {
   row_divu(P, c0, k, divu);
-  for (int v = 0; v < 4; ++v)
-    stage_row<T, false>(o, v, out, k, lo[v], hi[v], lo[5 + v], hi[5 + v], z + v * zld, divu, s0, s1);
-  stage_row<T, true>(o, 4, out, k, lo[4], hi[4], lo[9], hi[9], z + 4 * zld, divu, s0, s1);
+  if (o.gravity)
+    stage_rows<T, true>(o, out, k, lo, hi, z, zld, divu, s0, s1);
+  else
+    stage_rows<T, false>(o, out, k, lo, hi, z, zld, divu, s0, s1);
+  if (o.fix) fix_row(o, out, k);
 }
 
 // The energy source rows of the output at offset `out` (a stage's s0, s1; none for Rhs).
@@ -539,13 +588,13 @@ ffi::Error same_fields(ffi::RemainingArgs state, size_t count, ffi::DataType& ty
   return ffi::Error::Success();
 }
 
-// The ghost planes (set_ghosts) along the axis params[naxis] that `in` holds as its argument nin, if it has one
-// more than nin arguments (else ghost = nullptr, axis = -1), checked against the grid n and nfield fields.
+// The ghost planes (set_ghosts) along the axis params[naxis] that `in` holds as its argument nin, if it has more
+// than nin arguments (else ghost = nullptr, axis = -1), checked against the grid n and nfield fields.
 ffi::Error ghost_planes(ffi::RemainingArgs in, size_t nin, const double* params, size_t naxis, int nfield,
                         const long* n, const Real*& ghost, int& axis) {
   ghost = nullptr;
   axis = -1;
-  if (in.size() != nin + 1) return ffi::Error::Success();
+  if (in.size() <= nin) return ffi::Error::Success();
   axis = int(params[naxis]);
   auto g = in.get<ffi::AnyBuffer>(nin);
   const int b = axis == 0 ? 1 : 0, c = axis == 2 ? 1 : 2;
@@ -826,7 +875,21 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
   return fits;
 }
 
-// A stage's output (Stage) with params (dx, dy, dz, rho_s, a, dt), U0 and Uk the fields from in[u0], in[uk].
+// The boundary corrections (Stage::fix) along `axis` that `in` holds as its argument at, checked against the grid n.
+ffi::Error fix_planes(ffi::RemainingArgs in, size_t at, int axis, const long* n, Stage<Real>& o) {
+  auto f = in.get<ffi::AnyBuffer>(at);
+  const long np = axis == 0 ? n[1] * n[2] : axis == 1 ? n[0] * n[2] : n[0] * n[1];
+  if (!f.has_value() || long(f->element_count()) != 2 * 5 * np || f->element_type() != in.get<ffi::AnyBuffer>(0)->element_type())
+    return ffi::Error::InvalidArgument("stage kernel: boundary corrections = 2 ends x 5 fields x the cells of a plane "
+                                       "across the ghost axis, in the fields' precision");
+  o.fix = f->typed_data<Real>();
+  o.fix_axis = axis;
+  return ffi::Error::Success();
+}
+
+constexpr size_t NSTAGE_PARAMS = 9;
+
+// A stage's output (Stage) with params (dx, dy, dz, rho_s, a, dt, g_x, g_y, g_z), U0 and Uk the fields from in[u0], in[uk].
 Stage<Real> stage_output(const double* p, ffi::RemainingArgs in, size_t u0, size_t uk,
                          std::array<ffi::Result<ffi::AnyBuffer>, 5> out) {
   Stage<Real> o;
@@ -839,6 +902,10 @@ Stage<Real> stage_output(const double* p, ffi::RemainingArgs in, size_t u0, size
   o.a = Real(p[4]);
   o.b = Real(1) - o.a;  // as the JAX path: 1 - a in the state precision
   o.dt = Real(p[5]);
+  for (int a = 0; a < 3; ++a) o.g[a] = Real(p[6 + a]);
+  o.gravity = p[6] != 0 || p[7] != 0 || p[8] != 0;
+  o.fix = nullptr;
+  o.fix_axis = -1;
   return o;
 }
 
@@ -846,12 +913,13 @@ ffi::Error ssprk_stage(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int3
                        ffi::Result<ffi::AnyBuffer> u0, ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2,
                        ffi::Result<ffi::AnyBuffer> u3, ffi::Result<ffi::AnyBuffer> u4,
                        ffi::Result<ffi::AnyBuffer> work) {
-  const bool ghosts = in.size() == NFIELD + 13;
-  if (params.element_count() != 6 + ghosts)
-    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt[, ghost axis])");
-  if (in.size() != NFIELD + 12 + ghosts)
+  const size_t nin = NFIELD + 12;
+  const bool bounded = in.size() == nin + 2;
+  if (params.element_count() != NSTAGE_PARAMS + bounded)
+    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt, g_x, g_y, g_z[, ghost axis])");
+  if (in.size() != nin + 2 * bounded)
     return ffi::Error::InvalidArgument("stage kernel: fields = (the 11 cell fields, U0 x5, Uk x5, s0, s1[, ghost "
-                                       "planes])");
+                                       "planes, boundary corrections])");
   ffi::DataType type, state_type;
   if (auto err = same_fields(in, NFIELD, type); err.failure()) return err;
   if (auto err = same_fields(in, 12, state_type, NFIELD); err.failure()) return err;
@@ -861,7 +929,12 @@ ffi::Error ssprk_stage(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int3
   Stage<Real> o = stage_output(p, in, NFIELD, NFIELD + 5, {u0, u1, u2, u3, u4});
   o.s0 = in.get<ffi::AnyBuffer>(NFIELD + 10)->typed_data<Real>();
   o.s1 = in.get<ffi::AnyBuffer>(NFIELD + 11)->typed_data<Real>();
-  return run(in, NFIELD + 12, *in.get<ffi::AnyBuffer>(NFIELD), p, 6, work->typed_data<Real>(), o);
+  if (bounded) {
+    long n[3];
+    if (auto err = grid_shape(*in.get<ffi::AnyBuffer>(NFIELD), n); err.failure()) return err;
+    if (auto err = fix_planes(in, nin + 1, int(p[NSTAGE_PARAMS]), n, o); err.failure()) return err;
+  }
+  return run(in, nin, *in.get<ffi::AnyBuffer>(NFIELD), p, NSTAGE_PARAMS, work->typed_data<Real>(), o);
 }
 
 // The cell program registered under `program`, checked against the precision of `type`.
@@ -898,18 +971,19 @@ ffi::Error cell_limits_entry(ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs stat
   return ffi::Error::Success();
 }
 
-// KtgfSsprkStageCells (sweep_fused; `ring` its per-thread planes, ring_elements): state (U0, Uk[, ghost planes]).
+// KtgfSsprkStageCells (sweep_fused; `ring` its per-thread planes, ring_elements): state (U0, Uk[, ghost planes,
+// boundary corrections]).
 ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64> leaf, ffi::RemainingArgs state,
                              int32_t limiter, int32_t riemann, int64_t program, ffi::Result<ffi::AnyBuffer> u0,
                              ffi::Result<ffi::AnyBuffer> u1, ffi::Result<ffi::AnyBuffer> u2,
                              ffi::Result<ffi::AnyBuffer> u3, ffi::Result<ffi::AnyBuffer> u4,
                              ffi::Result<ffi::AnyBuffer> ring) {
   const size_t nstate = 10;
-  const bool ghosts = state.size() == nstate + 1;
-  if (params.element_count() != 6 + ghosts)
-    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt[, ghost axis])");
-  if (state.size() != nstate + ghosts)
-    return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5[, ghost planes])");
+  const bool bounded = state.size() == nstate + 2;
+  if (params.element_count() != NSTAGE_PARAMS + bounded)
+    return ffi::Error::InvalidArgument("stage kernel: params = (dx, dy, dz, rho_s, a, dt, g_x, g_y, g_z[, ghost axis])");
+  if (state.size() != nstate + 2 * bounded)
+    return ffi::Error::InvalidArgument("stage kernel: state = (U0 x5, Uk x5[, ghost planes, boundary corrections])");
   ffi::DataType type;
   if (auto err = same_fields(state, nstate, type); err.failure()) return err;
   if (auto err = check_variant("KtgfSsprkStageCells", type, limiter, riemann, true); err.failure()) return err;
@@ -922,9 +996,11 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
   const double* par = params.typed_data();
   const Real* ghost;
   int axis;
-  if (auto err = ghost_planes(state, nstate, par, 6, NFIELD, n, ghost, axis); err.failure()) return err;
+  if (auto err = ghost_planes(state, nstate, par, NSTAGE_PARAMS, NFIELD, n, ghost, axis); err.failure()) return err;
   if (axis == 0) return ffi::Error::InvalidArgument("stage kernel: cell programs take ghost planes along y or z only");
   Stage<Real> o = stage_output(par, state, 0, 5, {u0, u1, u2, u3, u4});  // s0, s1: the ring's
+  if (bounded)
+    if (auto err = fix_planes(state, nstate + 1, axis, n, o); err.failure()) return err;
   Consts<Real> k = consts(n, par);
   k.wrap2 = axis != 2;
   if (!sweep_fused<Real, KTGF_LIMITER, KTGF_RIEMANN>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(), k, o,
@@ -956,8 +1032,8 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfFluxDivergence, flux_divergence,
 #else  // the stage kind
 XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStage, ssprk_stage,
                               ffi::Ffi::Bind()
-                                  .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s, a, dt)
-                                  .RemainingArgs()               // the cell fields at Uk, U0 (5), Uk (5), s0, s1
+                                  .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s, a, dt, g)
+                                  .RemainingArgs()               // cell fields at Uk, U0, Uk (5 each), s0, s1[, ghosts, fix]
                                   .Attr<int32_t>("limiter")
                                   .Attr<int32_t>("riemann")
                                   .Ret<ffi::AnyBuffer>()  // U' density
@@ -969,9 +1045,9 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStage, ssprk_stage,
 
 XLA_FFI_DEFINE_HANDLER_SYMBOL(KtgfSsprkStageCells, ssprk_stage_cells,
                               ffi::Ffi::Bind()
-                                  .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s, a, dt)
+                                  .Arg<ffi::Buffer<ffi::F64>>()  // (dx, dy, dz, rho_s, a, dt, g)
                                   .Arg<ffi::Buffer<ffi::F64>>()  // the cell program's parameters
-                                  .RemainingArgs()               // U0 (5), Uk (5)[, ghost planes]
+                                  .RemainingArgs()               // U0 (5), Uk (5)[, ghost planes, boundary fix]
                                   .Attr<int32_t>("limiter")
                                   .Attr<int32_t>("riemann")
                                   .Attr<int64_t>("program")

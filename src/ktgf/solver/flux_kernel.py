@@ -191,12 +191,21 @@ def _cell_fields(W: Any, eos: Any, transport: Any, grid: Any, viscous: bool) -> 
     return fields, jax.ShapeDtypeStruct((nfield, *(n + 2 * GHOST for n in grid.cells)), dtype)
 
 
-def _ghost_args(params: Any, ghosts: Any, dtype: Any) -> tuple[Any, list[Any]]:
+def _ghost_args(params: Any, ghosts: Any, dtype: Any, fix: Any = None, grid: Any = None) -> tuple[Any, list[Any]]:
     """The kernel's params and extra fields with the ghost planes ``ghosts`` = (axis, planes), or None: the axis
-    appended to the params, the planes one extra field."""
+    appended to the params, the planes one extra field; a stage's boundary corrections ``fix`` (as
+    :func:`.fluxes.add_boundary_fluxes` takes them, on ``grid``) a second one, their planes next to the cells 0 and
+    n − 1 of the axis (zero where ``fix`` has none), five fields each."""
     if ghosts is None:
         return params, []
-    return jnp.append(params, jnp.asarray(ghosts[0], jnp.float64)), [jnp.asarray(ghosts[1], dtype)]
+    extra = [jnp.asarray(ghosts[1], dtype)]
+    if fix is not None:
+        a, planes = fix
+        shape = tuple(c for b, c in enumerate(grid.cells) if b != a)
+        zero = [jnp.zeros(shape, dtype)] * 5
+        extra.append(jnp.stack([jnp.stack([jnp.reshape(c, shape).astype(dtype) for c in planes.get(p, zero)])
+                                for p in (0, grid.cells[a] - 1)]))
+    return jnp.append(params, jnp.asarray(ghosts[0], jnp.float64)), extra
 
 
 def _schemes(limiter: str, riemann: str) -> dict[str, Any]:
@@ -219,13 +228,16 @@ def flux_divergence(W: Any, eos: Any, transport: Any, grid: Any, rho_s: Any, lim
 
 
 def ssprk_stage(U0: Any, Uk: Any, W: Any, eos: Any, transport: Any, source: tuple[Any, Any], a: Any, dt: Any,
-                grid: Any, rho_s: Any, limiter: str, riemann: str, ghosts: Any = None) -> tuple[Any, ...]:
+                grid: Any, rho_s: Any, limiter: str, riemann: str, ghosts: Any = None, fix: Any = None,
+                gravity: Any = None) -> tuple[Any, ...]:
     """One SSP-RK3 stage U' = a U0 + (1 − a)(Uk + Δt L(Uk)), as in :func:`.stepping.ssprk3_step`.
 
     L = −∇·F (convective, viscous and heat fluxes, as :func:`flux_divergence`) plus the energy
     source s0 + s1 ∇·u with ``source`` = (s0, s1) at the cells of Uk (:func:`.sources.cooling_source`
-    is linear in ∇·u); ``W``, ``eos``, ``transport``: the primitive fields and cell coefficients of Uk;
-    ``ghosts`` as in :func:`flux_divergence`.
+    is linear in ∇·u) plus the body force (:func:`.sources.add_body_force`, ``gravity`` = g or None);
+    ``W``, ``eos``, ``transport``: the primitive fields and cell coefficients of Uk; ``ghosts`` as in
+    :func:`flux_divergence`, with the boundary corrections ``fix`` of :func:`.fluxes.boundary_terms` (L's on
+    the planes next to the boundary; the kernel adds them to its output).
     """
     dtype = Uk[0].dtype
     fields, work = _cell_fields(W, eos, transport, grid, True)
@@ -235,7 +247,7 @@ def ssprk_stage(U0: Any, Uk: Any, W: Any, eos: Any, transport: Any, source: tupl
     # none of the loop-carry copies XLA inserts when a stage's output cannot take its input's place.
     call = jax.ffi.ffi_call(_target(STAGE_TARGET, dtype, limiter, riemann, "stage"), (field,) * 5 + (work,),
                             input_output_aliases={1 + len(fields) + 5 + v: v for v in range(5)})
-    params, extra = _ghost_args(_stage_params(a, dt, grid, rho_s, dtype), ghosts, dtype)
+    params, extra = _ghost_args(_stage_params(a, dt, grid, rho_s, dtype, gravity), ghosts, dtype, fix, grid)
     return tuple(call(params, *fields, *state, *extra, **_schemes(limiter, riemann))[:5])
 
 
@@ -265,9 +277,9 @@ def cell_limits(Uk: Any, program: Any, leaf: Any, grid: Any, limiter: str, riema
     return call(leaf, *(jnp.asarray(f, dtype) for f in Uk), program=np.int64(program.key))
 
 
-def _stage_params(a: Any, dt: Any, grid: Any, rho_s: Any, dtype: Any) -> Any:
-    # a and Δt as the state precision rounds them (the JAX path computes in that precision).
-    coef = [jnp.asarray(v).astype(dtype).astype(jnp.float64) for v in (a, dt)]
+def _stage_params(a: Any, dt: Any, grid: Any, rho_s: Any, dtype: Any, gravity: Any) -> Any:
+    # a, Δt and g as the state precision rounds them (the JAX path computes in that precision).
+    coef = [jnp.asarray(v).astype(dtype).astype(jnp.float64) for v in (a, dt, *(gravity or (0.0, 0.0, 0.0)))]
     return jnp.stack([*(jnp.asarray(v, jnp.float64) for v in (*grid.spacing, rho_s)), *coef])
 
 
@@ -278,14 +290,15 @@ def _ring(grid: Any, dtype: Any, v: Variant) -> Any:
 
 
 def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any, grid: Any, rho_s: Any,
-                      limiter: str, riemann: str, write_over: str = "uk", ghosts: Any = None) -> tuple[Any, ...]:
+                      limiter: str, riemann: str, write_over: str = "uk", ghosts: Any = None, fix: Any = None,
+                      gravity: Any = None) -> tuple[Any, ...]:
     """The SSP-RK3 stage of :func:`ssprk_stage` with the cell fields and the energy source computed in
     the kernel from Uk by a cell program (:func:`.cell_program.for_physics`) with parameters ``leaf``
     (:func:`.cell_program.leaf_values`), plane by plane as it sweeps: no cell field is written to memory.
 
     ``write_over``: the input buffers U' is written over: ``"uk"`` or ``"new"`` (where Uk is still read
     elsewhere: written in place, XLA would first copy it).  ``ghosts``: as in :func:`flux_divergence`, along y
-    or z (the cell fields of the ghost cells).
+    or z (the cell fields of the ghost cells); ``fix``, ``gravity``: as in :func:`ssprk_stage`.
     """
     _register(program, limiter, riemann, grid)
     dtype = Uk[0].dtype
@@ -296,6 +309,6 @@ def ssprk_stage_cells(U0: Any, Uk: Any, program: Any, leaf: Any, a: Any, dt: Any
     aliases = {"uk": {7 + i: i for i in range(5)}, "new": None}[write_over]
     call = jax.ffi.ffi_call(target(CELLS_TARGET, stage), (field,) * 5 + (_ring(grid, dtype, stage),),
                             input_output_aliases=aliases)
-    params, extra = _ghost_args(_stage_params(a, dt, grid, rho_s, dtype), ghosts, dtype)
+    params, extra = _ghost_args(_stage_params(a, dt, grid, rho_s, dtype, gravity), ghosts, dtype, fix, grid)
     out = call(params, leaf, *state, *extra, **_schemes(limiter, riemann), program=np.int64(program.key))
     return tuple(out[:5])

@@ -415,8 +415,8 @@ def boundary_terms(ends: SimpleNamespace, grid: Grid, phys: Physics, limiter: st
     return (a, ghosts), (a, d)
 
 
-def add_boundary_fluxes(fields: Sequence[Any], fix: Any, grid: Grid, scale: Any = 1.0) -> Any:
-    """``fields`` with ``scale`` × the boundary corrections ``fix`` = (axis, {plane: increments}) of
+def add_boundary_fluxes(fields: Sequence[Any], fix: Any, grid: Grid) -> Any:
+    """``fields`` with the boundary corrections ``fix`` = (axis, {plane: increments}) of
     :func:`kernel_fields` added to those planes (unchanged for None)."""
     if fix is None:
         return fields
@@ -424,5 +424,5 @@ def add_boundary_fluxes(fields: Sequence[Any], fix: Any, grid: Grid, scale: Any 
     out = list(fields)
     for plane, d in planes.items():
         at = (slice(None),) * a + (slice(plane, plane + 1),)
-        out = [f.at[at].add(scale * c) for f, c in zip(out, d)]
+        out = [f.at[at].add(c) for f, c in zip(out, d)]
     return type(fields)(out)

@@ -25,7 +25,7 @@ import jax
 import jax.numpy as jnp
 
 from .friction import cell_coefficients, explicit_part
-from .fluxes import (LIMITERS, RIEMANN_SOLVERS, add_boundary_fluxes, cell_divergence, flux_divergence, kernel_fields,
+from .fluxes import (LIMITERS, RIEMANN_SOLVERS, cell_divergence, flux_divergence, kernel_fields,
                      materialise, pad_fields)
 from .grid import Grid, periodic
 from .acoustics import MODES as ACOUSTICS
@@ -234,7 +234,8 @@ def dt_of_limits(lim: Any, num: Numerics) -> Any:
 def stage_kernel_applies(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> bool:
     """Whether an SSP-RK3 stage runs as one C++ kernel call (:func:`.flux_kernel.ssprk_stage`): where the
     flux kernel's stage variant of ``num``'s limiter and Riemann solver applies (CPU, one device, 3D; built
-    now if needed).  Boundaries other than periodic and a body force are corrections added to its output."""
+    now if needed).  It adds the body force itself; boundaries other than periodic are corrections added to its
+    output."""
     from . import flux_kernel, fluxes
 
     return (fluxes.FLUX_KERNEL and fluxes.STAGE_KERNEL
@@ -284,8 +285,8 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
     in a ``fori_loop`` so the right-hand side is traced (and compiled) once, not three times.
     Where :func:`stage_kernel_applies`, each stage is the closures (XLA) and one kernel call, or
     only the kernel call where the closures have a cell program (:mod:`.cell_program`, :func:`cell_programs_apply`);
-    with boundaries, the kernel takes the ghost planes of their axis and the boundary planes' corrections and the
-    body force are added to its output.
+    with boundaries, the kernel takes the ghost planes of their axis and the boundary planes' corrections, and it
+    adds the body force.
     """
     coef = jnp.asarray([0.0, 0.75, 1.0 / 3.0], dtype=U[0].dtype)
     when = jnp.asarray([0.0, 1.0, 0.5], dtype=jnp.result_type(t, float))  # stage times / Δt
@@ -302,35 +303,27 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
             g, f = jax.lax.optimization_barrier((ghosts[1], fix[1]))
             return (ghosts[0], g), (fix[0], f)
 
-        def finish(k: Any, out: tuple, W: Any, fix: Any) -> tuple:  # the body force, which the kernel lacks
-            return add_boundary_fluxes(tuple(add_body_force(out, W, phys, (1.0 - coef[k]) * dt)), fix, grid,
-                                       (1.0 - coef[k]) * dt)
-
         program = for_physics(phys, U[0].dtype) if cell_programs_apply(grid) else None
         if program is not None:  # the closures inside the kernel: each stage is one call
             leaf = leaf_values(phys)
 
             def cells_stage(k: int, Uk: tuple, write_over: str) -> tuple:
                 ghosts, fix = before(*cell_boundary_terms(Uk, grid, phys, num, t + when[k] * dt))
-                out = ssprk_stage_cells(U, Uk, program, leaf, coef[k], dt, grid, phys.material_density, num.limiter,
-                                        num.riemann, write_over, ghosts=ghosts)
-                return finish(k, out, primitive_fields(Uk), fix)
+                return ssprk_stage_cells(U, Uk, program, leaf, coef[k], dt, grid, phys.material_density, num.limiter,
+                                         num.riemann, write_over, ghosts=ghosts, fix=fix, gravity=phys.gravity)
 
             U = tuple(U)
-            # The first stage writes new buffers (U is still needed), the later ones over their input — unless XLA
-            # reads their input besides (boundaries, gravity), when it would copy it first (measured: 20 copies of
-            # a whole field per step).
-            later = "uk" if periodic(grid) and phys.gravity is None else "new"
-            return cells_stage(2, cells_stage(1, cells_stage(0, U, "new"), later), later)
+            # The first stage writes new buffers (U is still needed), the later ones over their input (the boundary
+            # terms, read from it, are the kernel's inputs: no copy, measured with walls and Lees–Edwards).
+            return cells_stage(2, cells_stage(1, cells_stage(0, U, "new"), "uk"), "uk")
 
         def kernel_stage(k: Any, Uk: tuple, r: Any) -> tuple:
             W, eos, transport, source = kernel_stage_inputs(Uk, r, phys)
             *fields, ghosts, fix = kernel_fields(W, eos, transport, grid, phys, num.limiter, num.riemann, True,
                                                  t + when[k] * dt)
             ghosts, fix = before(ghosts, fix)
-            out = ssprk_stage(U, Uk, *fields, source, coef[k], dt, grid, phys.material_density, num.limiter,
-                              num.riemann, ghosts)
-            return finish(k, out, W, fix)
+            return ssprk_stage(U, Uk, *fields, source, coef[k], dt, grid, phys.material_density, num.limiter,
+                               num.riemann, ghosts, fix, phys.gravity)
 
         if r0 is None:
             r0 = cell_coefficients(primitive_fields(U), grid, phys, t)
