@@ -295,20 +295,12 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
         from .cell_program import for_physics, leaf_values
         from .flux_kernel import ssprk_stage, ssprk_stage_cells
 
-        def before(ghosts: Any, fix: Any) -> tuple:
-            """The boundary terms, computed before the kernel call: XLA would otherwise compute the correction
-            beside the kernel, whose threads then wait for each other while XLA has a core."""
-            if fix is None:
-                return None, None
-            g, f = jax.lax.optimization_barrier((ghosts[1], fix[1]))
-            return (ghosts[0], g), (fix[0], f)
-
         program = for_physics(phys, U[0].dtype) if cell_programs_apply(grid) else None
         if program is not None:  # the closures inside the kernel: each stage is one call
             leaf = leaf_values(phys)
 
             def cells_stage(k: int, Uk: tuple, write_over: str) -> tuple:
-                ghosts, fix = before(*cell_boundary_terms(Uk, grid, phys, num, t + when[k] * dt))
+                ghosts, fix = cell_boundary_terms(Uk, grid, phys, num, t + when[k] * dt)
                 return ssprk_stage_cells(U, Uk, program, leaf, coef[k], dt, grid, phys.material_density, num.limiter,
                                          num.riemann, write_over, ghosts=ghosts, fix=fix, gravity=phys.gravity)
 
@@ -321,7 +313,6 @@ def ssprk3_step(U: Any, dt: Any, grid: Grid, phys: Physics, num: Numerics, t: An
             W, eos, transport, source = kernel_stage_inputs(Uk, r, phys)
             *fields, ghosts, fix = kernel_fields(W, eos, transport, grid, phys, num.limiter, num.riemann, True,
                                                  t + when[k] * dt)
-            ghosts, fix = before(ghosts, fix)
             return ssprk_stage(U, Uk, *fields, source, coef[k], dt, grid, phys.material_density, num.limiter,
                                num.riemann, ghosts, fix, phys.gravity)
 
