@@ -316,10 +316,7 @@ KTGF_INLINE void stage_row(const Stage<T>& o, int v, long out, const Consts<T>& 
   const long n2 = k.n[2];
   const T* u0 = o.U0[v] + out;
   const T* uk = o.Uk[v] + out;
-  const T* rho = o.Uk[0] + out;
-  const T* m0 = o.Uk[1] + out;
-  const T* m1 = o.Uk[2] + out;
-  const T* m2 = o.Uk[3] + out;
+  const T *rho = o.Uk[0] + out, *m0 = o.Uk[1] + out, *m1 = o.Uk[2] + out, *m2 = o.Uk[3] + out;
   const T gv = G && !SRC ? o.g[v - 1] : T(0);
   T* d = o.U[v] + out;
 #pragma omp simd
@@ -875,24 +872,12 @@ bool sweep_fused(CellsFn<T> fn, const double* leaf, const Consts<T>& kg, const S
   return fits;
 }
 
-// The boundary corrections (Stage::fix) along `axis` that `in` holds as its argument at, checked against the grid n.
-ffi::Error fix_planes(ffi::RemainingArgs in, size_t at, int axis, const long* n, Stage<Real>& o) {
-  auto f = in.get<ffi::AnyBuffer>(at);
-  const long np = axis == 0 ? n[1] * n[2] : axis == 1 ? n[0] * n[2] : n[0] * n[1];
-  if (!f.has_value() || long(f->element_count()) != 2 * 5 * np || f->element_type() != in.get<ffi::AnyBuffer>(0)->element_type())
-    return ffi::Error::InvalidArgument("stage kernel: boundary corrections = 2 ends x 5 fields x the cells of a plane "
-                                       "across the ghost axis, in the fields' precision");
-  o.fix = f->typed_data<Real>();
-  o.fix_axis = axis;
-  return ffi::Error::Success();
-}
-
 constexpr size_t NSTAGE_PARAMS = 9;
 
-// A stage's output (Stage) with params (dx, dy, dz, rho_s, a, dt, g_x, g_y, g_z), U0 and Uk the fields from in[u0], in[uk].
-Stage<Real> stage_output(const double* p, ffi::RemainingArgs in, size_t u0, size_t uk,
-                         std::array<ffi::Result<ffi::AnyBuffer>, 5> out) {
-  Stage<Real> o;
+// A stage's output (Stage) with params (dx, dy, dz, rho_s, a, dt, g_x, g_y, g_z), U0 and Uk the fields from in[u0],
+// in[uk]; with a ghost axis, its boundary corrections (Stage::fix) from in[fix], checked against the grid n.
+ffi::Error stage_output(const double* p, ffi::RemainingArgs in, size_t u0, size_t uk, int axis, size_t fix,
+                        const long* n, std::array<ffi::Result<ffi::AnyBuffer>, 5> out, Stage<Real>& o) {
   for (int v = 0; v < 5; ++v) {
     o.U0[v] = in.get<ffi::AnyBuffer>(u0 + v)->typed_data<Real>();
     o.Uk[v] = in.get<ffi::AnyBuffer>(uk + v)->typed_data<Real>();
@@ -905,8 +890,15 @@ Stage<Real> stage_output(const double* p, ffi::RemainingArgs in, size_t u0, size
   for (int a = 0; a < 3; ++a) o.g[a] = Real(p[6 + a]);
   o.gravity = p[6] != 0 || p[7] != 0 || p[8] != 0;
   o.fix = nullptr;
-  o.fix_axis = -1;
-  return o;
+  o.fix_axis = axis;
+  if (axis < 0) return ffi::Error::Success();
+  auto f = in.get<ffi::AnyBuffer>(fix);
+  const long np = axis == 0 ? n[1] * n[2] : axis == 1 ? n[0] * n[2] : n[0] * n[1];
+  if (!f.has_value() || long(f->element_count()) != 10 * np || f->element_type() != in.get<ffi::AnyBuffer>(0)->element_type())
+    return ffi::Error::InvalidArgument("stage kernel: boundary corrections = 2 ends x 5 fields x the cells of a plane "
+                                       "across the ghost axis, in the fields' precision");
+  o.fix = f->typed_data<Real>();
+  return ffi::Error::Success();
 }
 
 ffi::Error ssprk_stage(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int32_t limiter, int32_t riemann,
@@ -926,14 +918,15 @@ ffi::Error ssprk_stage(ffi::Buffer<ffi::F64> params, ffi::RemainingArgs in, int3
   if (state_type != type) return ffi::Error::InvalidArgument("stage kernel: the fields must be of one precision");
   if (auto err = check_variant("KtgfSsprkStage", type, limiter, riemann, true); err.failure()) return err;
   const double* p = params.typed_data();
-  Stage<Real> o = stage_output(p, in, NFIELD, NFIELD + 5, {u0, u1, u2, u3, u4});
+  long n[3];
+  if (auto err = grid_shape(*in.get<ffi::AnyBuffer>(NFIELD), n); err.failure()) return err;
+  Stage<Real> o;
+  if (auto err = stage_output(p, in, NFIELD, NFIELD + 5, bounded ? int(p[NSTAGE_PARAMS]) : -1, nin + 1, n,
+                              {u0, u1, u2, u3, u4}, o);
+      err.failure())
+    return err;
   o.s0 = in.get<ffi::AnyBuffer>(NFIELD + 10)->typed_data<Real>();
   o.s1 = in.get<ffi::AnyBuffer>(NFIELD + 11)->typed_data<Real>();
-  if (bounded) {
-    long n[3];
-    if (auto err = grid_shape(*in.get<ffi::AnyBuffer>(NFIELD), n); err.failure()) return err;
-    if (auto err = fix_planes(in, nin + 1, int(p[NSTAGE_PARAMS]), n, o); err.failure()) return err;
-  }
   return run(in, nin, *in.get<ffi::AnyBuffer>(NFIELD), p, NSTAGE_PARAMS, work->typed_data<Real>(), o);
 }
 
@@ -998,9 +991,8 @@ ffi::Error ssprk_stage_cells(ffi::Buffer<ffi::F64> params, ffi::Buffer<ffi::F64>
   int axis;
   if (auto err = ghost_planes(state, nstate, par, NSTAGE_PARAMS, NFIELD, n, ghost, axis); err.failure()) return err;
   if (axis == 0) return ffi::Error::InvalidArgument("stage kernel: cell programs take ghost planes along y or z only");
-  Stage<Real> o = stage_output(par, state, 0, 5, {u0, u1, u2, u3, u4});  // s0, s1: the ring's
-  if (bounded)
-    if (auto err = fix_planes(state, nstate + 1, axis, n, o); err.failure()) return err;
+  Stage<Real> o;  // s0, s1: the ring's
+  if (auto err = stage_output(par, state, 0, 5, axis, nstate + 1, n, {u0, u1, u2, u3, u4}, o); err.failure()) return err;
   Consts<Real> k = consts(n, par);
   k.wrap2 = axis != 2;
   if (!sweep_fused<Real, KTGF_LIMITER, KTGF_RIEMANN>(reinterpret_cast<CellsFn<Real>>(p.fn), leaf.typed_data(), k, o,
