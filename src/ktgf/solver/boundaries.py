@@ -385,6 +385,7 @@ def pad(fields: Sequence[Any], grid: Any, G: int, t: Any = 0.0, velocity: int | 
             f = _wall_ghosts(f, grid, a, G, role, walls, affine)
         if bc.shear_axis is not None:
             f = _lees_edwards(f, grid, t, 1.0 if (is_velocity and affine and i == velocity + bc.flow) else None, G)
-        widths = [(0, 0) if b == bc.shear_axis or bc.kinds[b] == WALL else (G, G) for b in range(ndim)]
+        wrapped = getattr(grid, "wrapped", False)  # the periodic axes' ghost cells already there (fluxes.grid_ends)
+        widths = [(0, 0) if wrapped or b == bc.shear_axis or bc.kinds[b] == WALL else (G, G) for b in range(ndim)]
         out.append(jnp.pad(f, widths, mode="wrap"))
     return tuple(out)
