@@ -251,9 +251,9 @@ def test_kernel_rhs_between_walls_matches_jax(case: str, axis: str) -> None:
 
 @pytest.mark.contract
 @pytest.mark.parametrize("case, axis, scheme", _some_slow([(*w, m) for w in WALLS for m in ("ssprk3", "imex")],
-                                                          {("couette", "y", "ssprk3"), ("chute", "z", "imex")}))
+                                                          {("chute", "y", "ssprk3"), ("chute", "z", "imex")}))
 def test_kernel_steps_between_walls_match_jax(case: str, axis: str, scheme: str) -> None:
-    """Three steps; the stage kernel adds the chute's gravity."""
+    """Three steps; the stage kernel adds the chute's gravity (also where it writes the new state over the old)."""
     sim = _walled(case, axis)
     with sim.precision():
         U = tuple(sim.initial_state())

@@ -328,13 +328,15 @@ KTGF_INLINE void stage_row(const Stage<T>& o, int v, long out, const Consts<T>& 
   }
 }
 
+// The five output rows, energy first and density last: U' may be written over Uk, and the body force reads the
+// momentum (energy row) and the density (momentum rows) of Uk.
 template <class T, bool G>
 KTGF_INLINE void stage_rows(const Stage<T>& o, long out, const Consts<T>& k, const T* const* lo, const T* const* hi,
                             const T* z, long zld, const T* divu, const T* s0, const T* s1) {
-  stage_row<T, false, false>(o, 0, out, k, lo[0], hi[0], lo[5], hi[5], z, divu, s0, s1);
+  stage_row<T, true, G>(o, 4, out, k, lo[4], hi[4], lo[9], hi[9], z + 4 * zld, divu, s0, s1);
   for (int v = 1; v < 4; ++v)
     stage_row<T, false, G>(o, v, out, k, lo[v], hi[v], lo[5 + v], hi[5 + v], z + v * zld, divu, s0, s1);
-  stage_row<T, true, G>(o, 4, out, k, lo[4], hi[4], lo[9], hi[9], z + 4 * zld, divu, s0, s1);
+  stage_row<T, false, false>(o, 0, out, k, lo[0], hi[0], lo[5], hi[5], z, divu, s0, s1);
 }
 
 // Adds b dt x the boundary corrections o.fix to the output row at offset `out`, after it is written, as the JAX
