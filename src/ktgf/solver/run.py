@@ -86,14 +86,6 @@ def check_memory(cells: tuple[int, ...], precision: str, available: int | None =
     return need
 
 
-def _x64(enabled: bool) -> Any:
-    """Context in which JAX uses 64-bit types (``jax.enable_x64``; older JAX: ``jax.experimental``)."""
-    ctx = getattr(jax, "enable_x64", None)
-    if ctx is None or not callable(ctx):  # pragma: no cover - JAX < 0.5
-        from jax.experimental import enable_x64 as ctx
-    return ctx(enabled)
-
-
 def _in_precision(method: Callable[..., Any]) -> Callable[..., Any]:
     """Run a :class:`Simulation` method in the precision of its config (not the process-wide setting)."""
 
@@ -110,8 +102,12 @@ class Simulation:
 
     def precision(self) -> Any:
         """Context manager of the run: JAX's x64 mode on inside it only (the state's dtype follows numerics.precision:
-        the clock t, dt is float64 even when the state is float32, as the step loop of :func:`advance` expects)."""
-        return _x64(True)
+        the clock t, dt is float64 even when the state is float32, as the step loop of :func:`advance` expects;
+        ``jax.enable_x64``, older JAX: ``jax.experimental``)."""
+        ctx = getattr(jax, "enable_x64", None)
+        if ctx is None or not callable(ctx):  # pragma: no cover - JAX < 0.5
+            from jax.experimental import enable_x64 as ctx
+        return ctx(True)
 
     @_in_precision  # the Haff time and output times are computed with JAX too
     def __init__(self, cfg: Config, directory: str | Path | None = None) -> None:
@@ -145,9 +141,8 @@ class Simulation:
                 self.output_times = np.asarray(t_of_tau(np.linspace(0.0, end, n_out + 1), self.phys, self.phi0,
                                                         self.theta0))
         else:
-            t_end = {"s": end, "haff": end * self.t_haff}.get(cfg.time.unit)
-            if cfg.time.unit == "strain":
-                t_end = end / shear_rate(self.grid)
+            unit = cfg.time.unit
+            t_end = end / shear_rate(self.grid) if unit == "strain" else end * (self.t_haff if unit == "haff" else 1.0)
             self.output_times = np.linspace(0.0, t_end, n_out + 1)
         self.output_times[0] = 0.0
         t = self.output_times
@@ -160,9 +155,7 @@ class Simulation:
                 f"time.outputs = {n_out} distinct outputs"
             )
         self.sharding = self._sharding(cfg.parallel.devices)
-        scheme = cfg.time.scheme
-        if n.acoustics == "implicit" or n.sink == "implicit":  # IMEX options
-            scheme = "imex"
+        scheme = "imex" if "implicit" in (n.acoustics, n.sink) else cfg.time.scheme  # IMEX options
         if scheme == "auto":  # from the config alone (the uniform initial state), so a resume agrees
             uniform = conservative(*uniform_fields(self.grid, self.phys, self.phi0, self.theta0))
             scheme = choose_scheme(uniform, self.grid, self.phys, self.num)
@@ -246,8 +239,7 @@ class Simulation:
             if write_files:
                 self._claim_folder(overwrite)
             U, t, steps, k = self.initial_state(), 0.0, 0, 0
-            status = int(state_status(tuple(U), self.phys))
-            if status:
+            if status := int(state_status(tuple(U), self.phys)):
                 raise InputError(f"initial state: {STATUS_MESSAGES[status]} (phi_stop = {self.phys.phi_stop:g}); "
                                  "reduce initial.amplitude or raise numerics.phi_stop")
             history = {name: [] for name in self.history_keys}
@@ -265,9 +257,8 @@ class Simulation:
                         if chunks == 0:
                             fault_hook("compile")
                         wall = _time.perf_counter()
-                        U_new, t_new, n, status, dt = advance(
-                            U, t, target, self.cfg.time.max_steps_per_call, self.grid, self.phys, self.num
-                        )
+                        U_new, t_new, n, status, dt = advance(U, t, target, self.cfg.time.max_steps_per_call,
+                                                              self.grid, self.phys, self.num)
                         n, status = int(n), int(status)
                         U, t, steps = U_new, float(t_new), steps + n
                         if status != 0:
@@ -359,10 +350,9 @@ class Simulation:
     def _claim_folder(self, overwrite: bool) -> None:
         """Refuse to start afresh over another run's files (or delete them with ``overwrite``)."""
         files = run_files(self.directory)
-        if overwrite:
+        if overwrite or not files:
             for p in files:
                 p.unlink(missing_ok=True)
-        if overwrite or not files:
             return
         where = repr(str(self.directory))
         ckpt = self.directory / CHECKPOINT
@@ -455,8 +445,7 @@ class Simulation:
     def _write_fields(self, U: Any, t: float, k: int) -> None:
         out = self.cfg.output
         last = k == len(self.output_times) - 1
-        every = out.vtk_every
-        if not (k == 0 or last or (every and k % every == 0)):
+        if not (k == 0 or last or (out.vtk_every and k % out.vtk_every == 0)):
             return
         W = np.asarray(primitive(U))
         phi = W[0] / self.phys.material_density
@@ -573,8 +562,7 @@ class _Progress:
 
     def __init__(self, enabled: bool, t_end: float, phys: Physics, phi0: float, theta0: float,
                  clock: Callable[[], float] = _time.perf_counter, case: str = "cooling", shear_rate: float = 0.0) -> None:
-        self.enabled, self.t_end = enabled, t_end
-        self.clock = clock
+        self.enabled, self.t_end, self.clock = enabled, t_end, clock
         self.case, self.shear_rate = get_case(case), shear_rate
         # A sheared case has no Haff clock; its steps are about equally long in t.
         self._tau = (lambda t: float(tau_of_t(t, phys, phi0, theta0))) if self.case.hcs else float
