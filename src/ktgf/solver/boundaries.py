@@ -341,24 +341,19 @@ def _wall_ghosts(f: Any, grid: Any, a: int, G: int, role: Any, terms: dict | Non
             ghost = _extrapolated(layers, G, positive=not isinstance(role, tuple))
         elif role == "even":
             ghost = layers
-        elif role == "theta":
-            T = terms[a, side]
-            kind = bc.walls[a][side].wall.energy
-            t0, t1 = layers[0], layers[1]
-            if kind == "johnson-jackson":
-                d_over_theta, work = T["heat"]
-                theta_w = 1.5 * t0 - 0.5 * t1
-                g0 = t0 - h * (d_over_theta * theta_w - (work if affine else 0.0)) / T["kappa"]
-            elif kind == "prescribed":
-                g0 = -t0 + (2.0 * T["heat"][0] if affine else 0.0)
-            else:
-                g0 = t0
-            ghost = [g0] + [t0 + g0 - layers[g] for g in range(1, G)]
         else:
-            T = terms[a, side]
-            j = role[1]
-            g0 = T["ratio"][j] * layers[0] + (T["offset"][j] if affine else 0.0)
-            ghost = [g0] + [layers[0] + g0 - layers[g] for g in range(1, G)]
+            T, kind, f0 = terms[a, side], bc.walls[a][side].wall.energy, layers[0]
+            if role != "theta":
+                g0 = T["ratio"][role[1]] * f0 + (T["offset"][role[1]] if affine else 0.0)
+            elif kind == "johnson-jackson":
+                d_over_theta, work = T["heat"]
+                theta_w = 1.5 * f0 - 0.5 * layers[1]
+                g0 = f0 - h * (d_over_theta * theta_w - (work if affine else 0.0)) / T["kappa"]
+            elif kind == "prescribed":
+                g0 = -f0 + (2.0 * T["heat"][0] if affine else 0.0)
+            else:
+                g0 = f0
+            ghost = [g0] + [f0 + g0 - layers[g] for g in range(1, G)]  # reflected through the face value (f0 + g0)/2
         slabs.append(ghost[::-1] if side == 0 else ghost)  # ghost[0] is next to the wall: outermost first below
     return jnp.concatenate([*slabs[0], f, *slabs[1]], axis=a)
 

@@ -106,9 +106,7 @@ def momentum_preconditioner(grid: Grid, rho: Any, eta: Any, lam: Any, adt: Any, 
     Symbol of −∇·τ: η|s|² I + c(diag(s²) − diag(t²)) + c t tᵀ, c = η/3 + λ_b; the matrix
     D + c' t tᵀ is inverted by the Sherman–Morrison formula (D > 0 since t² ≤ s²).
     """
-    s2, t = _symbols(grid, dtype)
-    s2 = s2 + [0.0] * (3 - grid.ndim)
-    t = t + [0.0] * (3 - grid.ndim)
+    s2, t = (x + [0.0] * (3 - grid.ndim) for x in _symbols(grid, dtype))
     s2sum = sum(s2)
     c = adt * (eta / 3.0 + lam)
     D = [rho + adt * eta * s2sum + c * (s2[j] - t[j] * t[j]) for j in range(3)]

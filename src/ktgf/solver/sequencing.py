@@ -185,9 +185,7 @@ def map_state(U: np.ndarray, old_cells: tuple[int, ...], old_lengths: tuple[floa
     for ax, (lo, ln) in enumerate(zip(old_lengths, new_lengths)):
         m = int(round(ln / lo))
         if kinds[ax] == PERIODIC and m > 1:
-            reps = [1] * U.ndim
-            reps[1 + ax] = m
-            U = np.tile(U, reps)
+            U = np.tile(U, [m if b == 1 + ax else 1 for b in range(U.ndim)])
     for order in (2, 1):
         out = U
         for ax, n in enumerate(new_cells):
