@@ -78,11 +78,9 @@ def check_memory(cells: tuple[int, ...], precision: str, available: int | None =
         with contextlib.suppress(ValueError, OSError, AttributeError):
             have = int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
     if have is not None and need > have:
-        raise InputError(
-            f"field grid.cells = {list(cells)} needs about {_bytes(need)} of memory ({MEMORY_FACTOR} x the "
-            f"{_bytes(state)} state in {precision}); this machine has {_bytes(have)}: use fewer cells"
-            + (" or numerics.precision = 'float32'" if precision == "float64" else "")
-        )
+        raise InputError(f"field grid.cells = {list(cells)} needs about {_bytes(need)} of memory ({MEMORY_FACTOR} x "
+                         f"the {_bytes(state)} state in {precision}); this machine has {_bytes(have)}: use fewer cells"
+                         + (" or numerics.precision = 'float32'" if precision == "float64" else ""))
     return need
 
 
@@ -149,11 +147,9 @@ class Simulation:
         if not (np.isfinite(t).all() and np.all(np.diff(t) > 0)):
             limit = float(tau_of_t(1e300, self.phys, self.phi0, self.theta0)) if cfg.time.unit == "tau" else (
                 1e300 / self.t_haff if cfg.time.unit == "haff" else 1e300)
-            raise InputError(
-                f"field time.end = {end:g} ({cfg.time.unit}) gives output times that overflow or coincide "
-                f"(t_end = {t[-1]:g} s): valid time.end <= {limit:.4g} {cfg.time.unit} and enough room for "
-                f"time.outputs = {n_out} distinct outputs"
-            )
+            raise InputError(f"field time.end = {end:g} ({cfg.time.unit}) gives output times that overflow or coincide "
+                             f"(t_end = {t[-1]:g} s): valid time.end <= {limit:.4g} {cfg.time.unit} and enough room "
+                             f"for time.outputs = {n_out} distinct outputs")
         self.sharding = self._sharding(cfg.parallel.devices)
         scheme = "imex" if "implicit" in (n.acoustics, n.sink) else cfg.time.scheme  # IMEX options
         if scheme == "auto":  # from the config alone (the uniform initial state), so a resume agrees
@@ -187,9 +183,8 @@ class Simulation:
         if ini.perturbation == "random":
             U = random_velocity(self.grid, self.phys, self.phi0, self.theta0, ini.amplitude, ini.seed, ini.max_mode)
         elif ini.perturbation == "mode":
-            U, _, _ = single_mode(
-                self.grid, self.phys, self.phi0, self.theta0, tuple(ini.mode), ini.kind, ini.amplitude, ini.branch
-            )
+            U = single_mode(self.grid, self.phys, self.phi0, self.theta0, tuple(ini.mode), ini.kind, ini.amplitude,
+                            ini.branch)[0]
         elif ini.perturbation == "shear-mode":  # about the steady state: θ of the closed form, not θ0
             U, _ = shear_mode(self.grid, self.phys, self.phi0, tuple(ini.mode), ini.amplitude, ini.branch)
         else:
@@ -380,13 +375,11 @@ class Simulation:
         except ValueError:
             raise InputError(f"{name}: field config is not JSON") from None
         new = self.cfg.model_dump(mode="json")
-        changed = [f for f in changed_fields(old, new) if f not in RESUMABLE_CHANGES]
-        if changed:
+        if changed := [f for f in changed_fields(old, new) if f not in RESUMABLE_CHANGES]:
             f = changed[0]
-            raise InputError(
-                f"{name} was written by a different configuration: field {f} = {config_value(old, f)!r} in the checkpoint, "
-                f"{config_value(new, f)!r} now (on resume only {', '.join(RESUMABLE_CHANGES)} may change)"
-            )
+            raise InputError(f"{name} was written by a different configuration: field {f} = {config_value(old, f)!r} "
+                             f"in the checkpoint, {config_value(new, f)!r} now (on resume only "
+                             f"{', '.join(RESUMABLE_CHANGES)} may change)")
         U, t, steps, k, history = ck["U"], ck["t"], ck["steps"], ck["output_index"], ck["history"]
         shape = (5, *self.grid.cells)
         if U.shape != shape:
@@ -406,8 +399,7 @@ class Simulation:
         keys = self.history_keys
         if sorted(history) != sorted(keys):
             raise InputError(f"{name}: field history has the columns {sorted(history)}; expected {sorted(keys)}")
-        bad = [c for c in keys if len(history[c]) != k]
-        if bad:
+        if bad := [c for c in keys if len(history[c]) != k]:
             raise InputError(f"{name}: field history.{bad[0]} has {len(history[bad[0]])} rows; output_index = {k}")
         try:
             rows = {c: np.asarray(history[c], dtype=float) for c in keys}
@@ -484,10 +476,8 @@ class Simulation:
         pos = ", ".join(f"{(i + 0.5) * h:.4g}" for i, h in zip(where, self.grid.spacing))
         tau = float(tau_of_t(t, self.phys, self.phi0, self.theta0)) if self.case.hcs else float("nan")
         saved = f"; last good state saved to {ckpt}" if write_files else ""
-        err = DivergenceError(
-            f"run stopped at t = {t:.6g} s (tau = {tau:.4g}, step {steps + 1}): {STATUS_MESSAGES[status]}: "
-            f"{field} = {value:.6g} at cell {where} (x = ({pos}) m){saved}"
-        )
+        stopped = f"run stopped at t = {t:.6g} s (tau = {tau:.4g}, step {steps + 1}): {STATUS_MESSAGES[status]}"
+        err = DivergenceError(f"{stopped}: {field} = {value:.6g} at cell {where} (x = ({pos}) m){saved}")
         err.field, err.cell, err.time, err.status, err.value = field, where, t, status, float(value)
         raise err
 
@@ -513,8 +503,7 @@ class Simulation:
             else:
                 data[name] = ("time", values)
         limit_names = [n for n in LIMIT_NAMES if len(history.get(f"dt_{n}", [])) == len(t)]
-        for name in limit_names:
-            data[f"dt_{name}"] = ("time", np.asarray(history[f"dt_{name}"], dtype=float))
+        data.update({f"dt_{n}": ("time", np.asarray(history[f"dt_{n}"], dtype=float)) for n in limit_names})
         if cooling:
             data["tau"] = ("time", np.asarray(tau_of_t(t, self.phys, self.phi0, self.theta0), dtype=float))
         ds = xr.Dataset(data, coords=coords)
@@ -575,11 +564,9 @@ class _Progress:
         if self.enabled:
             from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-            self.bar = Progress(
-                TextColumn(f"[bold]{self.case.label}"), BarColumn(),
-                TextColumn("{task.fields[clock]}"), TextColumn("{task.fields[rate]} steps/s"), TimeElapsedColumn(),
-                TextColumn("left {task.fields[eta]}"),
-            )
+            self.bar = Progress(TextColumn(f"[bold]{self.case.label}"), BarColumn(), TextColumn("{task.fields[clock]}"),
+                                TextColumn("{task.fields[rate]} steps/s"), TimeElapsedColumn(),
+                                TextColumn("left {task.fields[eta]}"))
             self.bar.__enter__()
             self.task = self.bar.add_task("run", total=self.t_end, clock=self.clock_text(0.0), rate="-", eta="-")
         return self
