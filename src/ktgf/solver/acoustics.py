@@ -107,8 +107,7 @@ def advective_divergence(W: tuple, eos: tuple, h0: Any, grid: Grid, limiter: str
     for a in range(grid.ndim):
         WL, WR = materialise(reconstruct(P[:5], grid.cells, a, limiter))
         ubar = face_mean(P[1 + a], grid.cells, a)
-        UL, UR = conservative_fields(WL), conservative_fields(WR)
-        up = [jnp.where(ubar > 0.0, l, r) for l, r in zip(UL, UR)]
+        up = [jnp.where(ubar > 0.0, l, r) for l, r in zip(conservative_fields(WL), conservative_fields(WR))]
         rho_bar = face_mean(P[0], grid.cells, a)
         m_bar = rho_bar * ubar
         F = [ubar * up[0] - m_bar, ubar * up[1], ubar * up[2], ubar * up[3],

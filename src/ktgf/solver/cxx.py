@@ -106,8 +106,7 @@ def _last_line(proc: subprocess.CompletedProcess) -> str:
 def _builds(cxx: str, flags: Sequence[str], source: str, folder: str) -> subprocess.CompletedProcess:
     """Compiles and links ``source`` as a shared library with ``flags`` (the probe of a flag)."""
     src = os.path.join(folder, "probe.cc")
-    with open(src, "w") as f:
-        f.write(source)
+    Path(src).write_text(source)
     return _run([cxx, *COMMON_FLAGS, *flags, src, "-o", os.path.join(folder, "probe.so")], folder)
 
 

@@ -42,8 +42,7 @@ def velocity_split(u: Any, grid: Grid) -> tuple[Any, Any]:
     kdotu = sum(k[j] * uh[j] for j in range(3))
     proj = kdotu / jnp.where(k2 > 0, k2, 1.0)
     upar = jnp.stack([k[j] * proj for j in range(3)])
-    uperp = (uh - upar) * (k2 > 0)
-    return upar, uperp
+    return upar, (uh - upar) * (k2 > 0)
 
 
 @jax.jit

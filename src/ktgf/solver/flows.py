@@ -35,8 +35,7 @@ VERIFICATION_FILE = "verification.json"
 
 def boundaries(cfg: Any) -> Boundaries:
     """The :class:`Boundaries` of a config's ``[boundaries]`` section (grid axes only)."""
-    ndim = len(cfg.grid.cells)
-    sections = [getattr(cfg.boundaries, a) for a in AXES[:ndim]]
+    sections = [getattr(cfg.boundaries, a) for a in AXES[:len(cfg.grid.cells)]]
     kinds = tuple(s.kind for s in sections)
     le = next((s for s in sections if s.kind == LEES_EDWARDS), None)
     wall = next((s for s in sections if s.kind == WALL), None)

@@ -112,8 +112,7 @@ def momentum_preconditioner(grid: Grid, rho: Any, eta: Any, lam: Any, adt: Any, 
     D = [rho + adt * eta * s2sum + c * (s2[j] - t[j] * t[j]) for j in range(3)]
 
     def apply(r: tuple) -> tuple:
-        rh = [_fft(x, grid) for x in r]
-        y = [rh[j] / D[j] for j in range(3)]
+        y = [_fft(x, grid) / d for x, d in zip(r, D)]
         num = sum(t[j] * y[j] for j in range(3))
         den = 1.0 + c * sum(t[j] * t[j] / D[j] for j in range(3))
         coef = c * num / den
@@ -302,8 +301,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         transport = phys.transport(rho, theta, r)
         Pk = pad_fields(transport, grid, t)
         faces = [face_coefficients(Pk, grid.cells, a) for a in range(grid.ndim)]
-        eta_f = [f[0] for f in faces]
-        lam_f = [f[1] for f in faces]
+        eta_f, lam_f, kap_f = ([f[i] for f in faces] for i in range(3))
         lam_ac_m = 0.0
         if acoustic is not None:
             lam_ac = adt * rho * phys.sound_speed(theta, r) ** 2
@@ -312,8 +310,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
             lam_ac_f = [face_mean(Pac[0], grid.cells, a) for a in range(grid.ndim)]
             p_ref_f = [face_mean(Pac[1], grid.cells, a) for a in range(grid.ndim)]
             lam_f = [lb + la for lb, la in zip(lam_f, lam_ac_f)]
-        c_f = [f[0] / 3.0 + lb for f, lb in zip(faces, lam_f)]
-        kap_f = [f[2] for f in faces]
+        c_f = [e / 3.0 + lb for e, lb in zip(eta_f, lam_f)]
 
         # Wall coefficients frozen with the transport ones (a frictional wall's momentum part at the sweep's u).
         walls = wall_terms(rho, u, theta, transport, grid, phys) if has_walls(grid) else None
@@ -380,9 +377,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         s_const = s_k - ds_k * theta
         mass = 1.5 * rho + adt * ds_k
 
-        def B_sink(th: Any) -> Any:
-            return B(th) + adt * ds_k * th if sink else B(th)
-
+        B_sink = (lambda th: B(th) + adt * ds_k * th) if sink else B
         # Right-hand side: Ê − ρ̂|u|²/2 + aΔt∇·(τ·u + ω∇φ), i.e. the stage equation with κ = 0.
         fI0 = viscous_divergence((rho, *u, jnp.zeros_like(theta)), transport, grid, phys, t, walls)
         rhs_E = E_base - 0.5 * rho * sum(x * x for x in u) + adt * (fI0[4] - friction_sink - s_const)

@@ -85,9 +85,8 @@ def start_from_run(cfg: Any, cells: tuple[int, ...], lengths: tuple[float, ...])
     old_lengths = box_lengths(old)
     check_compatible(old, cfg, old_lengths, lengths, source)
     U, order = map_state(U_old, tuple(old.grid.cells), old_lengths, cells, lengths, boundaries(cfg).kinds)
-    info = {"from_run": source, "cells": list(old.grid.cells), "lengths_m": list(old_lengths), "remap_order": order,
-            "earlier_run": _earlier_cost(source, steps)}
-    return U, info
+    return U, {"from_run": source, "cells": list(old.grid.cells), "lengths_m": list(old_lengths), "remap_order": order,
+               "earlier_run": _earlier_cost(source, steps)}
 
 
 def mean_temperature(U: np.ndarray) -> float:
@@ -102,9 +101,8 @@ def check_compatible(old: Any, new: Any, old_lengths: tuple[float, ...], new_len
     """Refuse (one line naming the field) an earlier run that is not the same flow on a mappable box."""
     a, b = old.model_dump(mode="json"), new.model_dump(mode="json")
     where = f"(initial.from_run = {source!r})"
-    changed = [f for name in SAME_FIELDS
-               for f in changed_fields(config_value(a, name), config_value(b, name), name + ".")]
-    if changed:
+    if changed := [f for name in SAME_FIELDS
+                   for f in changed_fields(config_value(a, name), config_value(b, name), name + ".")]:
         key = changed[0]
         raise InputError(f"field {key} = {config_value(b, key)!r} differs from the earlier run's "
                          f"{config_value(a, key)!r} {where}: a run maps only onto the same flow")

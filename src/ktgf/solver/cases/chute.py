@@ -69,8 +69,7 @@ class Chute(WallCase):
         a, f = AXES.index(axis), AXES.index(getattr(cfg.boundaries, axis).flow)
         z = math.radians(cfg.case.inclination_deg)
         g = [0.0, 0.0, 0.0]
-        g[f] = cfg.case.gravity * math.sin(z)
-        g[a] = -cfg.case.gravity * math.cos(z)
+        g[f], g[a] = cfg.case.gravity * math.sin(z), -cfg.case.gravity * math.cos(z)
         return tuple(g)
 
     def verification(self, history: dict[str, list], phys: Physics, grid: Grid, phi0: float) -> dict[str, Any]:
