@@ -75,8 +75,7 @@ def stress_tensor(U: Any, t: Any, grid: Grid, phys: Physics) -> Any:
     rho, theta = W[0], W[4]
     r = cell_coefficients(W, grid, phys, t)  # with a frictional stress: p_f and μ_f too
     p = phys.pressure(rho, theta, r)
-    transport = phys.transport(rho, theta, r)
-    eta, lam, _, _ = transport
+    eta, lam, _, _ = transport = phys.transport(rho, theta, r)
     # the velocities padded as the viscous fluxes see them (with walls: their ghost cells)
     Pu = pad_viscous(W, transport, grid, phys, t)[1:4] if has_walls(grid) else pad_fields(W[1:4], grid, t, velocity=0)
     g = velocity_gradients(Pu, grid)

@@ -70,8 +70,7 @@ def cell_coefficients(W: Any, grid: Grid, phys: Physics, t: Any = 0.0) -> Any:
     if not needs_rate(phys):
         return phys.reduced(W[0])
     rho, theta = W[0], W[4]
-    ss, _ = strain_invariants(W[1:4], grid, t)
-    ss = jnp.maximum(ss, 0.0)  # round-off
+    ss = jnp.maximum(strain_invariants(W[1:4], grid, t)[0], 0.0)  # max: round-off
     model = phys.model
     shear = phys.diameter * jnp.sqrt(2.0 * ss / theta) if model.dissipation.key != "none" and not phys.hcs else None
     r = phys.reduced(rho, shear)

@@ -84,8 +84,7 @@ def _symbols(grid: Grid, dtype: Any) -> tuple[list[Any], list[Any]]:
     s2, t = [], []
     for a, n in enumerate(grid.cells):
         m = np.fft.rfftfreq(n) * n if a == grid.ndim - 1 else np.fft.fftfreq(n) * n
-        shape = [1] * grid.ndim
-        shape[a] = m.size
+        shape = [m.size if b == a else 1 for b in range(grid.ndim)]
         h = grid.spacing[a]
         s2.append(jnp.asarray((2.0 * np.sin(np.pi * m / n)) ** 2, dtype).reshape(shape) / (h * h))
         t.append(jnp.asarray(np.sin(2.0 * np.pi * m / n), dtype).reshape(shape) / h)
@@ -123,8 +122,7 @@ def momentum_preconditioner(grid: Grid, rho: Any, eta: Any, lam: Any, adt: Any, 
 
 def heat_preconditioner(grid: Grid, mass: Any, kappa: Any, adt: Any, dtype: Any):
     """Exact inverse of m − aΔt∇·(κ∇) for constant m (= (3/2)ρ, plus aΔt S' with an implicit sink) and κ."""
-    s2, _ = _symbols(grid, dtype)
-    D = mass + adt * kappa * sum(s2)
+    D = mass + adt * kappa * sum(_symbols(grid, dtype)[0])
     return lambda r: _ifft(_fft(r, grid) / D, grid, dtype)
 
 
@@ -134,13 +132,12 @@ def viscous_divergence(W: tuple, transport: tuple, grid: Grid, phys: Physics, t:
     ``walls``: frozen wall coefficients, else from W)."""
     P = pad_viscous(W, transport, grid, phys, t, walls)
     Pk = pad_fields(transport, grid, t)
-    out: list[Any] = [0.0] * 5
+    out: list[Any] = [0.0] * 4
     for a in range(grid.ndim):
         F = lees_edwards_faces(viscous_flux(P, Pk, a, grid, phys.material_density), grid, a, t)
         dF = face_divergence(jnp.stack([jnp.broadcast_to(f, F[1].shape) for f in F[1:]]), grid, a)
-        out = [out[0]] + [o + dF[i] for i, o in enumerate(out[1:])]
-    out[0] = jnp.zeros_like(W[0])
-    return out
+        out = [o + dF[i] for i, o in enumerate(out)]
+    return [jnp.zeros_like(W[0]), *out]
 
 
 def _face_sum(faces: list[Any], grid: Grid, axis: int) -> Any:
@@ -211,8 +208,7 @@ def _bicgstab64(A: Any, b: Any, tol: Any, atol: Any, maxiter: int, M: Any) -> An
         r = jax.tree_util.tree_map(lambda a, b_: jnp.where(done, a, b_), s, _axpy(s, -omega, tv))
         return x, r, rhat, p, v, rho, alpha, omega, k + 1
 
-    x, *_ = jax.lax.while_loop(cond, body, (zero, b, b, zero, zero, one, one, one, 0))
-    return x
+    return jax.lax.while_loop(cond, body, (zero, b, b, zero, zero, one, one, one, 0))[0]
 
 
 def _cg64(A: Any, b: Any, tol: Any, atol: Any, maxiter: int, M: Any) -> Any:
@@ -232,8 +228,7 @@ def _cg64(A: Any, b: Any, tol: Any, atol: Any, maxiter: int, M: Any) -> Any:
         p = _axpy(z, gamma_new / gamma, p)
         return x, r, p, gamma_new, k + 1
 
-    x, *_ = jax.lax.while_loop(cond, body, (jnp.zeros_like(b), b, z, _dot(b, z, f8), 0))
-    return x
+    return jax.lax.while_loop(cond, body, (jnp.zeros_like(b), b, z, _dot(b, z, f8), 0))[0]
 
 
 def _unit(x: Any, acc: Any = None) -> Any:

@@ -200,14 +200,9 @@ class Simulation:
         return json.dumps(self.cfg.model_dump(mode="json"), sort_keys=True)
 
     @_in_precision
-    def run(
-        self,
-        resume: str | Path | None = None,
-        progress: bool = True,
-        on_chunk: Callable[[dict[str, Any]], None] | None = None,
-        write_files: bool = True,
-        overwrite: bool = False,
-    ) -> Any:
+    def run(self, resume: str | Path | None = None, progress: bool = True,
+            on_chunk: Callable[[dict[str, Any]], None] | None = None, write_files: bool = True,
+            overwrite: bool = False) -> Any:
         """Integrate to the end time; return the diagnostics as an xarray Dataset.
 
         ``on_chunk`` is called after every compiled chunk with the loop's counters (tests use
@@ -428,16 +423,14 @@ class Simulation:
             history[name].append(float(d[name]))
         for name in PER_AXIS:
             history[name].append([float(v) for v in np.asarray(d[name])])
-        lim = np.asarray(limits(U, self.grid, self.phys, self.num))
-        for name, v in zip(LIMIT_NAMES, lim):
+        for name, v in zip(LIMIT_NAMES, np.asarray(limits(U, self.grid, self.phys, self.num))):
             history.setdefault(f"dt_{name}", []).append(float(v))
         for name, v in self.case.diagnostics(U, t, self.grid, self.phys).items():
             history[name].append(v)
 
     def _write_fields(self, U: Any, t: float, k: int) -> None:
         out = self.cfg.output
-        last = k == len(self.output_times) - 1
-        if not (k == 0 or last or (out.vtk_every and k % out.vtk_every == 0)):
+        if not (k == 0 or k == len(self.output_times) - 1 or (out.vtk_every and k % out.vtk_every == 0)):
             return
         W = np.asarray(primitive(U))
         phi = W[0] / self.phys.material_density

@@ -158,8 +158,7 @@ def remap_axis(f: np.ndarray, axis: int, n_new: int, periodic: bool, order: int 
     xi = (edges - i - 0.5).reshape((-1,) + (1,) * (f.ndim - 1))
     before = np.concatenate([np.zeros_like(f[:1]), np.cumsum(f, axis=0)[:-1]], axis=0)
     C = before[i] + f[i] * (xi + 0.5) + s[i] * (xi * xi - 0.25) * 0.5
-    out = np.diff(C, axis=0) * (n_new / n_old)
-    return np.moveaxis(out, 0, axis)
+    return np.moveaxis(np.diff(C, axis=0) * (n_new / n_old), 0, axis)
 
 
 def _physical(U: np.ndarray) -> bool:
