@@ -43,9 +43,8 @@ def boundaries(cfg: Any) -> Boundaries:
         return Boundaries(kinds, shear_rate=float(le.shear_rate), flow=AXES.index(le.flow))
     if wall is not None:
         f = AXES.index(wall.flow)
-        lower, upper = wall.walls.build_pair()
         sides = tuple(WallSide(w, tuple(sign * 0.5 * float(wall.wall_speed) if j == f else 0.0 for j in range(3)))
-                      for w, sign in ((lower, -1.0), (upper, 1.0)))
+                      for w, sign in zip(wall.walls.build_pair(), (-1.0, 1.0)))  # lower, upper
         return Boundaries(kinds, flow=f, walls=tuple(sides if s.kind == WALL else None for s in sections))
     return Boundaries(kinds)
 
