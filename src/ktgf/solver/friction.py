@@ -78,10 +78,8 @@ def cell_coefficients(W: Any, grid: Grid, phys: Physics, t: Any = 0.0) -> Any:
         return r
     friction = model.friction
 
-    def pressure(rho_: Any) -> Any:
-        return friction.frictional_pressure(rho_ / phys.material_density, model.phi_max)
-
-    p_f, dp = jax.jvp(pressure, (rho,), (jnp.ones_like(rho),))
+    p_f, dp = jax.jvp(lambda rho_: friction.frictional_pressure(rho_ / phys.material_density, model.phi_max),
+                      (rho,), (jnp.ones_like(rho),))  # w p_f and d(w p_f)/dρ
     reg2 = (friction.regularisation * phys.shear_rate_scale) ** 2
     mu_f = friction.frictional_viscosity(p_f, ss, theta / phys.diameter**2, reg2)
     heat = 1.5 * rho * theta

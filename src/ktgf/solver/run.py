@@ -84,6 +84,14 @@ def check_memory(cells: tuple[int, ...], precision: str, available: int | None =
     return need
 
 
+def _x64(enabled: bool) -> Any:
+    """Context in which JAX uses 64-bit types (``jax.enable_x64``; older JAX: ``jax.experimental``)."""
+    ctx = getattr(jax, "enable_x64", None)
+    if ctx is None or not callable(ctx):  # pragma: no cover - JAX < 0.5
+        from jax.experimental import enable_x64 as ctx
+    return ctx(enabled)
+
+
 def _in_precision(method: Callable[..., Any]) -> Callable[..., Any]:
     """Run a :class:`Simulation` method in the precision of its config (not the process-wide setting)."""
 
@@ -100,12 +108,8 @@ class Simulation:
 
     def precision(self) -> Any:
         """Context manager of the run: JAX's x64 mode on inside it only (the state's dtype follows numerics.precision:
-        the clock t, dt is float64 even when the state is float32, as the step loop of :func:`advance` expects;
-        ``jax.enable_x64``, older JAX: ``jax.experimental``)."""
-        ctx = getattr(jax, "enable_x64", None)
-        if ctx is None or not callable(ctx):  # pragma: no cover - JAX < 0.5
-            from jax.experimental import enable_x64 as ctx
-        return ctx(True)
+        the clock t, dt is float64 even when the state is float32, as the step loop of :func:`advance` expects)."""
+        return _x64(True)
 
     @_in_precision  # the Haff time and output times are computed with JAX too
     def __init__(self, cfg: Config, directory: str | Path | None = None) -> None:
