@@ -107,10 +107,8 @@ def advective_divergence(W: tuple, eos: tuple, h0: Any, grid: Grid, limiter: str
     for a in range(grid.ndim):
         WL, WR = materialise(reconstruct(P[:5], grid.cells, a, limiter))
         ubar = face_mean(P[1 + a], grid.cells, a)
-        UL, UR = conservative_fields(WL), conservative_fields(WR)
-        up = [jnp.where(ubar > 0.0, l, r) for l, r in zip(UL, UR)]
-        rho_bar = face_mean(P[0], grid.cells, a)
-        m_bar = rho_bar * ubar
+        up = [jnp.where(ubar > 0.0, l, r) for l, r in zip(conservative_fields(WL), conservative_fields(WR))]
+        m_bar = face_mean(P[0], grid.cells, a) * ubar  # ρ̄ū
         F = [ubar * up[0] - m_bar, ubar * up[1], ubar * up[2], ubar * up[3],
              ubar * (up[4] + face_mean(P[5], grid.cells, a)) - face_mean(P[6], grid.cells, a) * m_bar]
         F = lees_edwards_faces(_wall_faces(F, grid, a), grid, a, t)

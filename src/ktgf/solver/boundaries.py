@@ -161,12 +161,11 @@ def _shifted(f: Any, s: Any, axis: int) -> Any:
 def _lees_edwards(f: Any, grid: Any, t: Any, jump: Any, G: int) -> Any:
     """f with G Lees–Edwards ghost layers on each side of the gradient axis (others not yet padded)."""
     bc = grid.boundaries
-    a = bc.shear_axis
+    a, fl = bc.shear_axis, bc.flow
     n = grid.cells[a]
     U = bc.shear_rate * grid.lengths[a]
     low = jax.lax.slice_in_dim(f, n - G, n, axis=a)  # images of the top cells below the box
     high = jax.lax.slice_in_dim(f, 0, G, axis=a)     # images of the bottom cells above the box
-    fl = bc.flow
     if fl < grid.ndim:
         # Δ/Δx_f in cells, reduced modulo the period in float64 (t can be large).
         s = jnp.mod(jnp.asarray(U, jnp.float64) * jnp.asarray(t, jnp.float64) / grid.lengths[fl], 1.0) * grid.cells[fl]
@@ -305,15 +304,13 @@ def wall_terms(rho: Any, u: Sequence[Any], theta: Any, transport: Sequence[Any],
             offset = tuple(jnp.zeros_like(beta) if j == a else weight * ws.velocity[j] for j in range(3))
             u_face = [0.5 * (uc[j] * (1.0 + ratio[j]) + offset[j]) for j in range(3)]
             slip = tuple(jnp.zeros_like(beta) if j == a else u_face[j] - ws.velocity[j] for j in range(3))
-            if c is None:  # no slip: the stress is the viscous one, η(u_c − u_f)/(Δ/2) toward the medium
-                stress = tuple(beta * (uc[j] - u_face[j]) if j != a else jnp.zeros_like(beta) for j in range(3))
-            else:
-                stress = tuple(c * s_ for s_ in slip)
+            # c None (no slip): the stress is the viscous one, η(u_c − u_f)/(Δ/2) toward the medium
+            stress = tuple(c * s_ for s_ in slip) if c is not None else tuple(
+                beta * (uc[j] - u_face[j]) if j != a else jnp.zeros_like(beta) for j in range(3))
             if wall.energy == "johnson-jackson":
                 d_over_theta = rho_s * jj_dissipation(wall, phi_w, chi, theta_w) / theta_w
                 # the slip work of the collisions only: the frictional traction's is dissipated at the wall contacts
-                work = (sum(c_collision * sl * sl for sl in slip) if c is not None else jnp.zeros_like(beta))
-                heat = (d_over_theta, work)
+                heat = (d_over_theta, jnp.zeros_like(beta) if c is None else sum(c_collision * sl * sl for sl in slip))
             elif wall.energy == "prescribed":
                 heat = (jnp.full_like(beta, wall.temperature), jnp.zeros_like(beta))
             else:
@@ -341,24 +338,19 @@ def _wall_ghosts(f: Any, grid: Any, a: int, G: int, role: Any, terms: dict | Non
             ghost = _extrapolated(layers, G, positive=not isinstance(role, tuple))
         elif role == "even":
             ghost = layers
-        elif role == "theta":
-            T = terms[a, side]
-            kind = bc.walls[a][side].wall.energy
-            t0, t1 = layers[0], layers[1]
-            if kind == "johnson-jackson":
-                d_over_theta, work = T["heat"]
-                theta_w = 1.5 * t0 - 0.5 * t1
-                g0 = t0 - h * (d_over_theta * theta_w - (work if affine else 0.0)) / T["kappa"]
-            elif kind == "prescribed":
-                g0 = -t0 + (2.0 * T["heat"][0] if affine else 0.0)
-            else:
-                g0 = t0
-            ghost = [g0] + [t0 + g0 - layers[g] for g in range(1, G)]
         else:
-            T = terms[a, side]
-            j = role[1]
-            g0 = T["ratio"][j] * layers[0] + (T["offset"][j] if affine else 0.0)
-            ghost = [g0] + [layers[0] + g0 - layers[g] for g in range(1, G)]
+            T, kind, f0 = terms[a, side], bc.walls[a][side].wall.energy, layers[0]
+            if role != "theta":
+                g0 = T["ratio"][role[1]] * f0 + (T["offset"][role[1]] if affine else 0.0)
+            elif kind == "johnson-jackson":
+                d_over_theta, work = T["heat"]
+                theta_w = 1.5 * f0 - 0.5 * layers[1]
+                g0 = f0 - h * (d_over_theta * theta_w - (work if affine else 0.0)) / T["kappa"]
+            elif kind == "prescribed":
+                g0 = -f0 + (2.0 * T["heat"][0] if affine else 0.0)
+            else:
+                g0 = f0
+            ghost = [g0] + [f0 + g0 - layers[g] for g in range(1, G)]  # reflected through the face value (f0 + g0)/2
         slabs.append(ghost[::-1] if side == 0 else ghost)  # ghost[0] is next to the wall: outermost first below
     return jnp.concatenate([*slabs[0], f, *slabs[1]], axis=a)
 

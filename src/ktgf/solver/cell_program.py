@@ -152,9 +152,7 @@ class _Printer:
         env: dict[Any, str] = {}
 
         def read(atom: Any) -> str:
-            if isinstance(atom, Literal):
-                return _literal(atom.val, atom.aval.dtype)
-            return env[atom]
+            return _literal(atom.val, atom.aval.dtype) if isinstance(atom, Literal) else env[atom]
 
         for var, c in zip(jaxpr.constvars, consts):
             env[var] = _literal(c, var.aval.dtype)

@@ -167,8 +167,7 @@ class BoundarySection(_Section):
                              "flow ('x', 'y' or 'z') and wall_speed (>= 0, m/s)")
         extra = {"shear_rate": self.kind != "lees-edwards", "flow": self.kind == "periodic",
                  "wall_speed": self.kind != "wall", "walls": self.kind != "wall"}
-        bad = [k for k, refused in extra.items() if refused and getattr(self, k) is not None]
-        if bad:
+        if bad := [k for k, refused in extra.items() if refused and getattr(self, k) is not None]:
             raise ValueError(f"a {self.kind} boundary takes no {', '.join(bad)}")
         return self
 
@@ -404,10 +403,7 @@ def config_value(d: Any, dotted: str) -> Any:
 def changed_fields(a: Any, b: Any, prefix: str = "") -> list[str]:
     """Dotted names of the leaves that differ between two configuration dicts (sorted)."""
     if isinstance(a, dict) and isinstance(b, dict):
-        out = []
-        for key in sorted(set(a) | set(b)):
-            out += changed_fields(a.get(key), b.get(key), f"{prefix}{key}.")
-        return out
+        return [f for key in sorted(set(a) | set(b)) for f in changed_fields(a.get(key), b.get(key), f"{prefix}{key}.")]
     return [] if a == b else [prefix.rstrip(".") or "config"]
 
 

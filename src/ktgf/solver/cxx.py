@@ -53,16 +53,11 @@ _said: set[str] = set()
 def compiler() -> str:
     """Path of the C++ compiler (see the module docstring); raises RuntimeError if there is none."""
     name = os.environ.get("CXX")
-    if name:
-        path = shutil.which(name)
-        if path is None:
-            raise RuntimeError(f"no C++ compiler (CXX = {name!r} is not found)")
-        return path
-    for name in DEFAULT_COMPILERS:
-        path = shutil.which(name)
-        if path is not None:
-            return path
-    raise RuntimeError(f"no C++ compiler (none of {', '.join(DEFAULT_COMPILERS)} on PATH; set CXX)")
+    path = next(filter(None, map(shutil.which, (name,) if name else DEFAULT_COMPILERS)), None)
+    if path is None:
+        raise RuntimeError(f"no C++ compiler (CXX = {name!r} is not found)" if name else
+                           f"no C++ compiler (none of {', '.join(DEFAULT_COMPILERS)} on PATH; set CXX)")
+    return path
 
 
 def warn_once(logger: logging.Logger, message: str, key: str | None = None) -> None:
@@ -111,8 +106,7 @@ def _last_line(proc: subprocess.CompletedProcess) -> str:
 def _builds(cxx: str, flags: Sequence[str], source: str, folder: str) -> subprocess.CompletedProcess:
     """Compiles and links ``source`` as a shared library with ``flags`` (the probe of a flag)."""
     src = os.path.join(folder, "probe.cc")
-    with open(src, "w") as f:
-        f.write(source)
+    Path(src).write_text(source)
     return _run([cxx, *COMMON_FLAGS, *flags, src, "-o", os.path.join(folder, "probe.so")], folder)
 
 
@@ -150,11 +144,7 @@ def toolchain(cxx: str) -> Toolchain:
         version = _run([cxx, "--version"], folder)
         machine = _run([cxx, "-dumpmachine"], folder)
         identity = f"{(version.stdout.strip().splitlines() or ['?'])[0]} | target {machine.stdout.strip()}"
-        arch: tuple[str, ...] = ()
-        for flags in ARCH_FLAGS:
-            if _builds(cxx, flags, _PLAIN_PROBE, folder).returncode == 0:
-                arch = flags
-                break
+        arch = next((f for f in ARCH_FLAGS if _builds(cxx, f, _PLAIN_PROBE, folder).returncode == 0), ())
         omp = _builds(cxx, (*arch, "-fopenmp"), _OPENMP_PROBE, folder)
         simd = _builds(cxx, (*arch, "-fopenmp-simd"), _SIMD_PROBE, folder)
         target = _expansion(cxx, arch, folder) + (f" | {cpu_features()}" if arch else "")

@@ -39,11 +39,9 @@ def velocity_split(u: Any, grid: Grid) -> tuple[Any, Any]:
     ks = jnp.meshgrid(*(2.0 * np.pi * jnp.fft.fftfreq(n, d=h) for n, h in zip(grid.cells, grid.spacing)), indexing="ij")
     k = ks + [jnp.zeros(grid.cells)] * (3 - grid.ndim)
     k2 = sum(ki * ki for ki in k)
-    kdotu = sum(k[j] * uh[j] for j in range(3))
-    proj = kdotu / jnp.where(k2 > 0, k2, 1.0)
+    proj = sum(k[j] * uh[j] for j in range(3)) / jnp.where(k2 > 0, k2, 1.0)  # k·û/|k|²
     upar = jnp.stack([k[j] * proj for j in range(3)])
-    uperp = (uh - upar) * (k2 > 0)
-    return upar, uperp
+    return upar, (uh - upar) * (k2 > 0)
 
 
 @jax.jit

@@ -35,8 +35,7 @@ VERIFICATION_FILE = "verification.json"
 
 def boundaries(cfg: Any) -> Boundaries:
     """The :class:`Boundaries` of a config's ``[boundaries]`` section (grid axes only)."""
-    ndim = len(cfg.grid.cells)
-    sections = [getattr(cfg.boundaries, a) for a in AXES[:ndim]]
+    sections = [getattr(cfg.boundaries, a) for a in AXES[:len(cfg.grid.cells)]]
     kinds = tuple(s.kind for s in sections)
     le = next((s for s in sections if s.kind == LEES_EDWARDS), None)
     wall = next((s for s in sections if s.kind == WALL), None)
@@ -44,9 +43,8 @@ def boundaries(cfg: Any) -> Boundaries:
         return Boundaries(kinds, shear_rate=float(le.shear_rate), flow=AXES.index(le.flow))
     if wall is not None:
         f = AXES.index(wall.flow)
-        lower, upper = wall.walls.build_pair()
         sides = tuple(WallSide(w, tuple(sign * 0.5 * float(wall.wall_speed) if j == f else 0.0 for j in range(3)))
-                      for w, sign in ((lower, -1.0), (upper, 1.0)))
+                      for w, sign in zip(wall.walls.build_pair(), (-1.0, 1.0)))  # lower, upper
         return Boundaries(kinds, flow=f, walls=tuple(sides if s.kind == WALL else None for s in sections))
     return Boundaries(kinds)
 
@@ -76,8 +74,7 @@ def stress_tensor(U: Any, t: Any, grid: Grid, phys: Physics) -> Any:
     rho, theta = W[0], W[4]
     r = cell_coefficients(W, grid, phys, t)  # with a frictional stress: p_f and μ_f too
     p = phys.pressure(rho, theta, r)
-    transport = phys.transport(rho, theta, r)
-    eta, lam, _, _ = transport
+    eta, lam, _, _ = transport = phys.transport(rho, theta, r)
     # the velocities padded as the viscous fluxes see them (with walls: their ghost cells)
     Pu = pad_viscous(W, transport, grid, phys, t)[1:4] if has_walls(grid) else pad_fields(W[1:4], grid, t, velocity=0)
     g = velocity_gradients(Pu, grid)

@@ -70,8 +70,7 @@ def cell_coefficients(W: Any, grid: Grid, phys: Physics, t: Any = 0.0) -> Any:
     if not needs_rate(phys):
         return phys.reduced(W[0])
     rho, theta = W[0], W[4]
-    ss, _ = strain_invariants(W[1:4], grid, t)
-    ss = jnp.maximum(ss, 0.0)  # round-off
+    ss = jnp.maximum(strain_invariants(W[1:4], grid, t)[0], 0.0)  # max: round-off
     model = phys.model
     shear = phys.diameter * jnp.sqrt(2.0 * ss / theta) if model.dissipation.key != "none" and not phys.hcs else None
     r = phys.reduced(rho, shear)
@@ -79,10 +78,8 @@ def cell_coefficients(W: Any, grid: Grid, phys: Physics, t: Any = 0.0) -> Any:
         return r
     friction = model.friction
 
-    def pressure(rho_: Any) -> Any:
-        return friction.frictional_pressure(rho_ / phys.material_density, model.phi_max)
-
-    p_f, dp = jax.jvp(pressure, (rho,), (jnp.ones_like(rho),))
+    p_f, dp = jax.jvp(lambda rho_: friction.frictional_pressure(rho_ / phys.material_density, model.phi_max),
+                      (rho,), (jnp.ones_like(rho),))  # w p_f and d(w p_f)/dρ
     reg2 = (friction.regularisation * phys.shear_rate_scale) ** 2
     mu_f = friction.frictional_viscosity(p_f, ss, theta / phys.diameter**2, reg2)
     heat = 1.5 * rho * theta

@@ -97,8 +97,7 @@ class Grid:
     def wavevector(self, mode: tuple[int, ...]) -> np.ndarray:
         """Wavevector k = 2π n_a/L_a (3 components, zero along missing axes) of integer mode ``n``."""
         k = np.zeros(3)
-        for a, n in enumerate(mode):
-            k[a] = 2.0 * math.pi * n / self.lengths[a]
+        k[:len(mode)] = [2.0 * math.pi * n / L for n, L in zip(mode, self.lengths)]
         return k
 
 

@@ -84,8 +84,7 @@ def _symbols(grid: Grid, dtype: Any) -> tuple[list[Any], list[Any]]:
     s2, t = [], []
     for a, n in enumerate(grid.cells):
         m = np.fft.rfftfreq(n) * n if a == grid.ndim - 1 else np.fft.fftfreq(n) * n
-        shape = [1] * grid.ndim
-        shape[a] = m.size
+        shape = [m.size if b == a else 1 for b in range(grid.ndim)]
         h = grid.spacing[a]
         s2.append(jnp.asarray((2.0 * np.sin(np.pi * m / n)) ** 2, dtype).reshape(shape) / (h * h))
         t.append(jnp.asarray(np.sin(2.0 * np.pi * m / n), dtype).reshape(shape) / h)
@@ -106,16 +105,13 @@ def momentum_preconditioner(grid: Grid, rho: Any, eta: Any, lam: Any, adt: Any, 
     Symbol of −∇·τ: η|s|² I + c(diag(s²) − diag(t²)) + c t tᵀ, c = η/3 + λ_b; the matrix
     D + c' t tᵀ is inverted by the Sherman–Morrison formula (D > 0 since t² ≤ s²).
     """
-    s2, t = _symbols(grid, dtype)
-    s2 = s2 + [0.0] * (3 - grid.ndim)
-    t = t + [0.0] * (3 - grid.ndim)
+    s2, t = (x + [0.0] * (3 - grid.ndim) for x in _symbols(grid, dtype))
     s2sum = sum(s2)
     c = adt * (eta / 3.0 + lam)
     D = [rho + adt * eta * s2sum + c * (s2[j] - t[j] * t[j]) for j in range(3)]
 
     def apply(r: tuple) -> tuple:
-        rh = [_fft(x, grid) for x in r]
-        y = [rh[j] / D[j] for j in range(3)]
+        y = [_fft(x, grid) / d for x, d in zip(r, D)]
         num = sum(t[j] * y[j] for j in range(3))
         den = 1.0 + c * sum(t[j] * t[j] / D[j] for j in range(3))
         coef = c * num / den
@@ -126,8 +122,7 @@ def momentum_preconditioner(grid: Grid, rho: Any, eta: Any, lam: Any, adt: Any, 
 
 def heat_preconditioner(grid: Grid, mass: Any, kappa: Any, adt: Any, dtype: Any):
     """Exact inverse of m − aΔt∇·(κ∇) for constant m (= (3/2)ρ, plus aΔt S' with an implicit sink) and κ."""
-    s2, _ = _symbols(grid, dtype)
-    D = mass + adt * kappa * sum(s2)
+    D = mass + adt * kappa * sum(_symbols(grid, dtype)[0])
     return lambda r: _ifft(_fft(r, grid) / D, grid, dtype)
 
 
@@ -137,13 +132,12 @@ def viscous_divergence(W: tuple, transport: tuple, grid: Grid, phys: Physics, t:
     ``walls``: frozen wall coefficients, else from W)."""
     P = pad_viscous(W, transport, grid, phys, t, walls)
     Pk = pad_fields(transport, grid, t)
-    out: list[Any] = [0.0] * 5
+    out: list[Any] = [0.0] * 4
     for a in range(grid.ndim):
         F = lees_edwards_faces(viscous_flux(P, Pk, a, grid, phys.material_density), grid, a, t)
         dF = face_divergence(jnp.stack([jnp.broadcast_to(f, F[1].shape) for f in F[1:]]), grid, a)
-        out = [out[0]] + [o + dF[i] for i, o in enumerate(out[1:])]
-    out[0] = jnp.zeros_like(W[0])
-    return out
+        out = [o + dF[i] for i, o in enumerate(out)]
+    return [jnp.zeros_like(W[0]), *out]
 
 
 def _face_sum(faces: list[Any], grid: Grid, axis: int) -> Any:
@@ -214,8 +208,7 @@ def _bicgstab64(A: Any, b: Any, tol: Any, atol: Any, maxiter: int, M: Any) -> An
         r = jax.tree_util.tree_map(lambda a, b_: jnp.where(done, a, b_), s, _axpy(s, -omega, tv))
         return x, r, rhat, p, v, rho, alpha, omega, k + 1
 
-    x, *_ = jax.lax.while_loop(cond, body, (zero, b, b, zero, zero, one, one, one, 0))
-    return x
+    return jax.lax.while_loop(cond, body, (zero, b, b, zero, zero, one, one, one, 0))[0]
 
 
 def _cg64(A: Any, b: Any, tol: Any, atol: Any, maxiter: int, M: Any) -> Any:
@@ -235,8 +228,7 @@ def _cg64(A: Any, b: Any, tol: Any, atol: Any, maxiter: int, M: Any) -> Any:
         p = _axpy(z, gamma_new / gamma, p)
         return x, r, p, gamma_new, k + 1
 
-    x, *_ = jax.lax.while_loop(cond, body, (jnp.zeros_like(b), b, z, _dot(b, z, f8), 0))
-    return x
+    return jax.lax.while_loop(cond, body, (jnp.zeros_like(b), b, z, _dot(b, z, f8), 0))[0]
 
 
 def _unit(x: Any, acc: Any = None) -> Any:
@@ -304,8 +296,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         transport = phys.transport(rho, theta, r)
         Pk = pad_fields(transport, grid, t)
         faces = [face_coefficients(Pk, grid.cells, a) for a in range(grid.ndim)]
-        eta_f = [f[0] for f in faces]
-        lam_f = [f[1] for f in faces]
+        eta_f, lam_f, kap_f = ([f[i] for f in faces] for i in range(3))
         lam_ac_m = 0.0
         if acoustic is not None:
             lam_ac = adt * rho * phys.sound_speed(theta, r) ** 2
@@ -314,8 +305,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
             lam_ac_f = [face_mean(Pac[0], grid.cells, a) for a in range(grid.ndim)]
             p_ref_f = [face_mean(Pac[1], grid.cells, a) for a in range(grid.ndim)]
             lam_f = [lb + la for lb, la in zip(lam_f, lam_ac_f)]
-        c_f = [f[0] / 3.0 + lb for f, lb in zip(faces, lam_f)]
-        kap_f = [f[2] for f in faces]
+        c_f = [e / 3.0 + lb for e, lb in zip(eta_f, lam_f)]
 
         # Wall coefficients frozen with the transport ones (a frictional wall's momentum part at the sweep's u).
         walls = wall_terms(rho, u, theta, transport, grid, phys) if has_walls(grid) else None
@@ -382,9 +372,7 @@ def implicit_stage(Uhat: tuple, adt: Any, grid: Grid, phys: Physics, r: Reduced,
         s_const = s_k - ds_k * theta
         mass = 1.5 * rho + adt * ds_k
 
-        def B_sink(th: Any) -> Any:
-            return B(th) + adt * ds_k * th if sink else B(th)
-
+        B_sink = (lambda th: B(th) + adt * ds_k * th) if sink else B
         # Right-hand side: Ê − ρ̂|u|²/2 + aΔt∇·(τ·u + ω∇φ), i.e. the stage equation with κ = 0.
         fI0 = viscous_divergence((rho, *u, jnp.zeros_like(theta)), transport, grid, phys, t, walls)
         rhs_E = E_base - 0.5 * rho * sum(x * x for x in u) + adt * (fI0[4] - friction_sink - s_const)

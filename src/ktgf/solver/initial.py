@@ -57,10 +57,8 @@ def _plane_wave(grid: Grid, mode: tuple[int, ...]) -> tuple[np.ndarray, np.ndarr
     return k, np.exp(1j * sum(k[a] * x[a] for a in range(grid.ndim)))
 
 
-def single_mode(
-    grid: Grid, phys: Physics, phi0: float, theta0: float, mode: tuple[int, ...], kind: str,
-    amplitude: float, branch: int = 0,
-) -> tuple[Any, complex, np.ndarray]:
+def single_mode(grid: Grid, phys: Physics, phi0: float, theta0: float, mode: tuple[int, ...], kind: str,
+                amplitude: float, branch: int = 0) -> tuple[Any, complex, np.ndarray]:
     """HCS plus one eigenmode of wave vector 2π n/L (``kind`` ``transverse`` or ``longitudinal``).
 
     Returns the conservative state, the linear growth rate s (units of ν0, per τ) and the
@@ -105,9 +103,8 @@ def shear_axes(grid: Grid) -> tuple[int, int, int]:
     return f, a, 3 - f - a
 
 
-def shear_mode(
-    grid: Grid, phys: Physics, phi0: float, mode: tuple[int, ...], amplitude: float, branch: int = 0,
-) -> tuple[Any, ShearModes]:
+def shear_mode(grid: Grid, phys: Physics, phi0: float, mode: tuple[int, ...], amplitude: float,
+               branch: int = 0) -> tuple[Any, ShearModes]:
     """Steady uniform shear (without its base flow) plus one normal mode of :func:`ktgf.shear.stability.shear_modes`.
 
     The wave vector k = 2πn/L must have no component along the flow direction (k_x = 0 of the
@@ -156,9 +153,8 @@ def _random_modes(grid: Grid, seed: int, max_mode: int, amplitude: float, theta:
             f[3] * (amplitude / np.sqrt(np.mean(f[3] ** 2))))
 
 
-def random_velocity(
-    grid: Grid, phys: Physics, phi0: float, theta0: float, amplitude: float, seed: int, max_mode: int = 2,
-) -> Any:
+def random_velocity(grid: Grid, phys: Physics, phi0: float, theta0: float, amplitude: float, seed: int,
+                    max_mode: int = 2) -> Any:
     """HCS plus seeded random velocity and density fields of the Fourier modes |n_a| ≤ ``max_mode``.
 
     The velocity has zero mean and root-mean-square amplitude ``amplitude``·√θ0 per

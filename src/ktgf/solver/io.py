@@ -120,8 +120,7 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
                                  "start the run again with --overwrite")
             if missing:
                 raise InputError(f"checkpoint {name} lacks the field(s) {', '.join(missing)}: not a ktgf checkpoint")
-            fmt = int(z["format"])
-            if fmt != CHECKPOINT_FORMAT:
+            if (fmt := int(z["format"])) != CHECKPOINT_FORMAT:
                 raise InputError(f"checkpoint {name} has format version {fmt}; this ktgf reads version {CHECKPOINT_FORMAT}")
             raw = {k: z[k] for k in _CHECKPOINT_KEYS}
     except InputError:

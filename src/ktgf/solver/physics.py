@@ -134,8 +134,7 @@ class Physics:
         With a frictional stress also its work, −σ_f:∇u/((3/2)ρθ) (``r.zeta_f`` and the p_f part
         of ``r.zeta_u``, :class:`~ktgf.solver.friction.FrictionalReduced`): dissipated at the contacts.
         """
-        phi = rho / self.material_density
-        zeta = nu0(phi, theta, self.diameter) * r.zeta0 + r.zeta_u * divu
+        zeta = nu0(rho / self.material_density, theta, self.diameter) * r.zeta0 + r.zeta_u * divu
         return zeta + r.zeta_f if is_frictional(r) else zeta
 
 

@@ -78,11 +78,9 @@ def check_memory(cells: tuple[int, ...], precision: str, available: int | None =
         with contextlib.suppress(ValueError, OSError, AttributeError):
             have = int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
     if have is not None and need > have:
-        raise InputError(
-            f"field grid.cells = {list(cells)} needs about {_bytes(need)} of memory ({MEMORY_FACTOR} x the "
-            f"{_bytes(state)} state in {precision}); this machine has {_bytes(have)}: use fewer cells"
-            + (" or numerics.precision = 'float32'" if precision == "float64" else "")
-        )
+        raise InputError(f"field grid.cells = {list(cells)} needs about {_bytes(need)} of memory ({MEMORY_FACTOR} x "
+                         f"the {_bytes(state)} state in {precision}); this machine has {_bytes(have)}: use fewer cells"
+                         + (" or numerics.precision = 'float32'" if precision == "float64" else ""))
     return need
 
 
@@ -145,24 +143,19 @@ class Simulation:
                 self.output_times = np.asarray(t_of_tau(np.linspace(0.0, end, n_out + 1), self.phys, self.phi0,
                                                         self.theta0))
         else:
-            t_end = {"s": end, "haff": end * self.t_haff}.get(cfg.time.unit)
-            if cfg.time.unit == "strain":
-                t_end = end / shear_rate(self.grid)
+            unit = cfg.time.unit
+            t_end = end / shear_rate(self.grid) if unit == "strain" else end * (self.t_haff if unit == "haff" else 1.0)
             self.output_times = np.linspace(0.0, t_end, n_out + 1)
         self.output_times[0] = 0.0
         t = self.output_times
         if not (np.isfinite(t).all() and np.all(np.diff(t) > 0)):
             limit = float(tau_of_t(1e300, self.phys, self.phi0, self.theta0)) if cfg.time.unit == "tau" else (
                 1e300 / self.t_haff if cfg.time.unit == "haff" else 1e300)
-            raise InputError(
-                f"field time.end = {end:g} ({cfg.time.unit}) gives output times that overflow or coincide "
-                f"(t_end = {t[-1]:g} s): valid time.end <= {limit:.4g} {cfg.time.unit} and enough room for "
-                f"time.outputs = {n_out} distinct outputs"
-            )
+            raise InputError(f"field time.end = {end:g} ({cfg.time.unit}) gives output times that overflow or coincide "
+                             f"(t_end = {t[-1]:g} s): valid time.end <= {limit:.4g} {cfg.time.unit} and enough room "
+                             f"for time.outputs = {n_out} distinct outputs")
         self.sharding = self._sharding(cfg.parallel.devices)
-        scheme = cfg.time.scheme
-        if n.acoustics == "implicit" or n.sink == "implicit":  # IMEX options
-            scheme = "imex"
+        scheme = "imex" if "implicit" in (n.acoustics, n.sink) else cfg.time.scheme  # IMEX options
         if scheme == "auto":  # from the config alone (the uniform initial state), so a resume agrees
             uniform = conservative(*uniform_fields(self.grid, self.phys, self.phi0, self.theta0))
             scheme = choose_scheme(uniform, self.grid, self.phys, self.num)
@@ -194,9 +187,8 @@ class Simulation:
         if ini.perturbation == "random":
             U = random_velocity(self.grid, self.phys, self.phi0, self.theta0, ini.amplitude, ini.seed, ini.max_mode)
         elif ini.perturbation == "mode":
-            U, _, _ = single_mode(
-                self.grid, self.phys, self.phi0, self.theta0, tuple(ini.mode), ini.kind, ini.amplitude, ini.branch
-            )
+            U = single_mode(self.grid, self.phys, self.phi0, self.theta0, tuple(ini.mode), ini.kind, ini.amplitude,
+                            ini.branch)[0]
         elif ini.perturbation == "shear-mode":  # about the steady state: θ of the closed form, not θ0
             U, _ = shear_mode(self.grid, self.phys, self.phi0, tuple(ini.mode), ini.amplitude, ini.branch)
         else:
@@ -212,14 +204,9 @@ class Simulation:
         return json.dumps(self.cfg.model_dump(mode="json"), sort_keys=True)
 
     @_in_precision
-    def run(
-        self,
-        resume: str | Path | None = None,
-        progress: bool = True,
-        on_chunk: Callable[[dict[str, Any]], None] | None = None,
-        write_files: bool = True,
-        overwrite: bool = False,
-    ) -> Any:
+    def run(self, resume: str | Path | None = None, progress: bool = True,
+            on_chunk: Callable[[dict[str, Any]], None] | None = None, write_files: bool = True,
+            overwrite: bool = False) -> Any:
         """Integrate to the end time; return the diagnostics as an xarray Dataset.
 
         ``on_chunk`` is called after every compiled chunk with the loop's counters (tests use
@@ -246,8 +233,7 @@ class Simulation:
             if write_files:
                 self._claim_folder(overwrite)
             U, t, steps, k = self.initial_state(), 0.0, 0, 0
-            status = int(state_status(tuple(U), self.phys))
-            if status:
+            if status := int(state_status(tuple(U), self.phys)):
                 raise InputError(f"initial state: {STATUS_MESSAGES[status]} (phi_stop = {self.phys.phi_stop:g}); "
                                  "reduce initial.amplitude or raise numerics.phi_stop")
             history = {name: [] for name in self.history_keys}
@@ -265,9 +251,8 @@ class Simulation:
                         if chunks == 0:
                             fault_hook("compile")
                         wall = _time.perf_counter()
-                        U_new, t_new, n, status, dt = advance(
-                            U, t, target, self.cfg.time.max_steps_per_call, self.grid, self.phys, self.num
-                        )
+                        U_new, t_new, n, status, dt = advance(U, t, target, self.cfg.time.max_steps_per_call,
+                                                              self.grid, self.phys, self.num)
                         n, status = int(n), int(status)
                         U, t, steps = U_new, float(t_new), steps + n
                         if status != 0:
@@ -359,10 +344,9 @@ class Simulation:
     def _claim_folder(self, overwrite: bool) -> None:
         """Refuse to start afresh over another run's files (or delete them with ``overwrite``)."""
         files = run_files(self.directory)
-        if overwrite:
+        if overwrite or not files:
             for p in files:
                 p.unlink(missing_ok=True)
-        if overwrite or not files:
             return
         where = repr(str(self.directory))
         ckpt = self.directory / CHECKPOINT
@@ -390,13 +374,11 @@ class Simulation:
         except ValueError:
             raise InputError(f"{name}: field config is not JSON") from None
         new = self.cfg.model_dump(mode="json")
-        changed = [f for f in changed_fields(old, new) if f not in RESUMABLE_CHANGES]
-        if changed:
+        if changed := [f for f in changed_fields(old, new) if f not in RESUMABLE_CHANGES]:
             f = changed[0]
-            raise InputError(
-                f"{name} was written by a different configuration: field {f} = {config_value(old, f)!r} in the checkpoint, "
-                f"{config_value(new, f)!r} now (on resume only {', '.join(RESUMABLE_CHANGES)} may change)"
-            )
+            raise InputError(f"{name} was written by a different configuration: field {f} = {config_value(old, f)!r} "
+                             f"in the checkpoint, {config_value(new, f)!r} now (on resume only "
+                             f"{', '.join(RESUMABLE_CHANGES)} may change)")
         U, t, steps, k, history = ck["U"], ck["t"], ck["steps"], ck["output_index"], ck["history"]
         shape = (5, *self.grid.cells)
         if U.shape != shape:
@@ -416,8 +398,7 @@ class Simulation:
         keys = self.history_keys
         if sorted(history) != sorted(keys):
             raise InputError(f"{name}: field history has the columns {sorted(history)}; expected {sorted(keys)}")
-        bad = [c for c in keys if len(history[c]) != k]
-        if bad:
+        if bad := [c for c in keys if len(history[c]) != k]:
             raise InputError(f"{name}: field history.{bad[0]} has {len(history[bad[0]])} rows; output_index = {k}")
         try:
             rows = {c: np.asarray(history[c], dtype=float) for c in keys}
@@ -446,17 +427,14 @@ class Simulation:
             history[name].append(float(d[name]))
         for name in PER_AXIS:
             history[name].append([float(v) for v in np.asarray(d[name])])
-        lim = np.asarray(limits(U, self.grid, self.phys, self.num))
-        for name, v in zip(LIMIT_NAMES, lim):
+        for name, v in zip(LIMIT_NAMES, np.asarray(limits(U, self.grid, self.phys, self.num))):
             history.setdefault(f"dt_{name}", []).append(float(v))
         for name, v in self.case.diagnostics(U, t, self.grid, self.phys).items():
             history[name].append(v)
 
     def _write_fields(self, U: Any, t: float, k: int) -> None:
         out = self.cfg.output
-        last = k == len(self.output_times) - 1
-        every = out.vtk_every
-        if not (k == 0 or last or (every and k % every == 0)):
+        if not (k == 0 or k == len(self.output_times) - 1 or (out.vtk_every and k % out.vtk_every == 0)):
             return
         W = np.asarray(primitive(U))
         phi = W[0] / self.phys.material_density
@@ -495,10 +473,8 @@ class Simulation:
         pos = ", ".join(f"{(i + 0.5) * h:.4g}" for i, h in zip(where, self.grid.spacing))
         tau = float(tau_of_t(t, self.phys, self.phi0, self.theta0)) if self.case.hcs else float("nan")
         saved = f"; last good state saved to {ckpt}" if write_files else ""
-        err = DivergenceError(
-            f"run stopped at t = {t:.6g} s (tau = {tau:.4g}, step {steps + 1}): {STATUS_MESSAGES[status]}: "
-            f"{field} = {value:.6g} at cell {where} (x = ({pos}) m){saved}"
-        )
+        stopped = f"run stopped at t = {t:.6g} s (tau = {tau:.4g}, step {steps + 1}): {STATUS_MESSAGES[status]}"
+        err = DivergenceError(f"{stopped}: {field} = {value:.6g} at cell {where} (x = ({pos}) m){saved}")
         err.field, err.cell, err.time, err.status, err.value = field, where, t, status, float(value)
         raise err
 
@@ -524,8 +500,7 @@ class Simulation:
             else:
                 data[name] = ("time", values)
         limit_names = [n for n in LIMIT_NAMES if len(history.get(f"dt_{n}", [])) == len(t)]
-        for name in limit_names:
-            data[f"dt_{name}"] = ("time", np.asarray(history[f"dt_{name}"], dtype=float))
+        data.update({f"dt_{n}": ("time", np.asarray(history[f"dt_{n}"], dtype=float)) for n in limit_names})
         if cooling:
             data["tau"] = ("time", np.asarray(tau_of_t(t, self.phys, self.phi0, self.theta0), dtype=float))
         ds = xr.Dataset(data, coords=coords)
@@ -573,8 +548,7 @@ class _Progress:
 
     def __init__(self, enabled: bool, t_end: float, phys: Physics, phi0: float, theta0: float,
                  clock: Callable[[], float] = _time.perf_counter, case: str = "cooling", shear_rate: float = 0.0) -> None:
-        self.enabled, self.t_end = enabled, t_end
-        self.clock = clock
+        self.enabled, self.t_end, self.clock = enabled, t_end, clock
         self.case, self.shear_rate = get_case(case), shear_rate
         # A sheared case has no Haff clock; its steps are about equally long in t.
         self._tau = (lambda t: float(tau_of_t(t, phys, phi0, theta0))) if self.case.hcs else float
@@ -587,11 +561,9 @@ class _Progress:
         if self.enabled:
             from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-            self.bar = Progress(
-                TextColumn(f"[bold]{self.case.label}"), BarColumn(),
-                TextColumn("{task.fields[clock]}"), TextColumn("{task.fields[rate]} steps/s"), TimeElapsedColumn(),
-                TextColumn("left {task.fields[eta]}"),
-            )
+            self.bar = Progress(TextColumn(f"[bold]{self.case.label}"), BarColumn(), TextColumn("{task.fields[clock]}"),
+                                TextColumn("{task.fields[rate]} steps/s"), TimeElapsedColumn(),
+                                TextColumn("left {task.fields[eta]}"))
             self.bar.__enter__()
             self.task = self.bar.add_task("run", total=self.t_end, clock=self.clock_text(0.0), rate="-", eta="-")
         return self

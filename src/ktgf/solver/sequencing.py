@@ -85,9 +85,8 @@ def start_from_run(cfg: Any, cells: tuple[int, ...], lengths: tuple[float, ...])
     old_lengths = box_lengths(old)
     check_compatible(old, cfg, old_lengths, lengths, source)
     U, order = map_state(U_old, tuple(old.grid.cells), old_lengths, cells, lengths, boundaries(cfg).kinds)
-    info = {"from_run": source, "cells": list(old.grid.cells), "lengths_m": list(old_lengths), "remap_order": order,
-            "earlier_run": _earlier_cost(source, steps)}
-    return U, info
+    return U, {"from_run": source, "cells": list(old.grid.cells), "lengths_m": list(old_lengths), "remap_order": order,
+               "earlier_run": _earlier_cost(source, steps)}
 
 
 def mean_temperature(U: np.ndarray) -> float:
@@ -102,9 +101,8 @@ def check_compatible(old: Any, new: Any, old_lengths: tuple[float, ...], new_len
     """Refuse (one line naming the field) an earlier run that is not the same flow on a mappable box."""
     a, b = old.model_dump(mode="json"), new.model_dump(mode="json")
     where = f"(initial.from_run = {source!r})"
-    changed = [f for name in SAME_FIELDS
-               for f in changed_fields(config_value(a, name), config_value(b, name), name + ".")]
-    if changed:
+    if changed := [f for name in SAME_FIELDS
+                   for f in changed_fields(config_value(a, name), config_value(b, name), name + ".")]:
         key = changed[0]
         raise InputError(f"field {key} = {config_value(b, key)!r} differs from the earlier run's "
                          f"{config_value(a, key)!r} {where}: a run maps only onto the same flow")
@@ -160,8 +158,7 @@ def remap_axis(f: np.ndarray, axis: int, n_new: int, periodic: bool, order: int 
     xi = (edges - i - 0.5).reshape((-1,) + (1,) * (f.ndim - 1))
     before = np.concatenate([np.zeros_like(f[:1]), np.cumsum(f, axis=0)[:-1]], axis=0)
     C = before[i] + f[i] * (xi + 0.5) + s[i] * (xi * xi - 0.25) * 0.5
-    out = np.diff(C, axis=0) * (n_new / n_old)
-    return np.moveaxis(out, 0, axis)
+    return np.moveaxis(np.diff(C, axis=0) * (n_new / n_old), 0, axis)
 
 
 def _physical(U: np.ndarray) -> bool:
@@ -185,9 +182,7 @@ def map_state(U: np.ndarray, old_cells: tuple[int, ...], old_lengths: tuple[floa
     for ax, (lo, ln) in enumerate(zip(old_lengths, new_lengths)):
         m = int(round(ln / lo))
         if kinds[ax] == PERIODIC and m > 1:
-            reps = [1] * U.ndim
-            reps[1 + ax] = m
-            U = np.tile(U, reps)
+            U = np.tile(U, [m if b == 1 + ax else 1 for b in range(U.ndim)])
     for order in (2, 1):
         out = U
         for ax, n in enumerate(new_cells):

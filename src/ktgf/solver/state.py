@@ -33,10 +33,9 @@ def conservative_fields(W: Sequence[Any]) -> tuple[Any, ...]:
 
 def primitive_fields(U: Sequence[Any]) -> tuple[Any, ...]:
     """(ρ, u_x, u_y, u_z, θ) from conservative fields."""
-    rho = U[0]
-    inv = 1.0 / rho
+    inv = 1.0 / U[0]
     u = (U[1] * inv, U[2] * inv, U[3] * inv)
-    return (rho, *u, (U[4] * inv - _ke(u)) / 1.5)
+    return (U[0], *u, (U[4] * inv - _ke(u)) / 1.5)
 
 
 def conservative(rho: Any, u: Any, theta: Any) -> Any:

@@ -36,11 +36,10 @@ def compare_chute(history: dict[str, list], phys: Physics, grid: Grid, phi0: flo
     """Max relative deviation of the last profiles from the 1D steady layer on ``n_cells`` (u relative to its maximum)."""
     ref = chute_reference(phys, grid, phi0, n_cells=n_cells)
     a = gradient_axis(grid)
-    err = profile_errors(history, ref, grid.centres(a))
     return {
         "reference": "1D steady inclined layer ktgf.couette.chute.solve_chute (same model, base, lid, inventory "
                      f"and depth; {n_cells} cells)",
-        "max_rel_error": err,
+        "max_rel_error": profile_errors(history, ref, grid.centres(a)),
         "base_shear_stress_Pa": {"run": history["wall_shear_stress_lower"][-1],
                                  "reference": float(ref["wall_shear_stress"].values[0])},
         "base_slip_m_per_s": {"run": history["wall_slip_lower"][-1], "reference": float(ref["wall_slip"].values[0])},
@@ -69,8 +68,7 @@ class Chute(WallCase):
         a, f = AXES.index(axis), AXES.index(getattr(cfg.boundaries, axis).flow)
         z = math.radians(cfg.case.inclination_deg)
         g = [0.0, 0.0, 0.0]
-        g[f] = cfg.case.gravity * math.sin(z)
-        g[a] = -cfg.case.gravity * math.cos(z)
+        g[f], g[a] = cfg.case.gravity * math.sin(z), -cfg.case.gravity * math.cos(z)
         return tuple(g)
 
     def verification(self, history: dict[str, list], phys: Physics, grid: Grid, phi0: float) -> dict[str, Any]:
