@@ -290,7 +290,7 @@ def flux_divergence(W: Sequence[Any], coefficients: tuple[tuple[Any, ...], tuple
             *fields, ghosts, fix = kernel_fields(W, eos, transport, grid, phys, limiter, riemann, viscous, t)
             dU, divu = flux_kernel.flux_divergence(*fields, grid, phys.material_density, limiter, riemann, viscous,
                                                    ghosts)
-            return add_boundary_fluxes(dU, fix, grid), divu
+            return add_boundary_fluxes(dU, fix), divu
     P = pad_fields((*W, *eos), grid, t, velocity=1)
     Pk = pad_fields(transport, grid, t) if viscous else ()
     Pv = (pad_viscous(W, transport, grid, phys, t) if has_walls(grid) else P[:5]) if viscous else ()
@@ -343,7 +343,7 @@ def grid_ends(fields: Sequence[Any], grid: Grid) -> SimpleNamespace:
         fields = [jnp.concatenate([jax.lax.slice_in_dim(f, 0, m, axis=a), jax.lax.slice_in_dim(f, n - m, n, axis=a)],
                                   axis=a) for f in fields]
     # With walls the other axes are periodic: their ghost cells are wrapped here, once, so that the paddings of the
-    # fields that follow (pad) add only the walls' (64³ Couette: boundary terms 2.3-2.4 ms a stage, from 3.0-3.2).
+    # fields that follow (pad) add only the walls' (64³ Couette: 96 XLA fusions a stage, not 118; ≈ 25 % less time).
     wrapped = grid.boundaries.shear_axis is None
     if wrapped:
         fields = [jnp.pad(f, [(0, 0) if b == a else (GHOST, GHOST) for b in range(grid.ndim)], mode="wrap")
@@ -424,7 +424,7 @@ def boundary_terms(ends: SimpleNamespace, grid: Grid, phys: Physics, limiter: st
     return (a, ghosts), (a, d)
 
 
-def add_boundary_fluxes(fields: Sequence[Any], fix: Any, grid: Grid) -> Any:
+def add_boundary_fluxes(fields: Sequence[Any], fix: Any) -> Any:
     """``fields`` with the boundary corrections ``fix`` = (axis, {plane: increments}) of
     :func:`kernel_fields` added to those planes (unchanged for None)."""
     if fix is None:

@@ -234,8 +234,7 @@ def dt_of_limits(lim: Any, num: Numerics) -> Any:
 def stage_kernel_applies(grid: Grid, phys: Physics, num: Numerics, dtype: Any) -> bool:
     """Whether an SSP-RK3 stage runs as one C++ kernel call (:func:`.flux_kernel.ssprk_stage`): where the
     flux kernel's stage variant of ``num``'s limiter and Riemann solver applies (CPU, one device, 3D; built
-    now if needed).  It adds the body force itself; boundaries other than periodic are corrections added to its
-    output."""
+    now if needed).  It adds the body force and the corrections of boundaries other than periodic itself."""
     from . import flux_kernel, fluxes
 
     return (fluxes.FLUX_KERNEL and fluxes.STAGE_KERNEL
