@@ -369,6 +369,7 @@ def pad(fields: Sequence[Any], grid: Any, G: int, t: Any = 0.0, velocity: int | 
     ndim = grid.ndim
     if bc is None or bc.all_periodic:
         return tuple(jnp.pad(f, [(G, G)] * ndim, mode="wrap") for f in fields)
+    wrapped = getattr(grid, "wrapped", False)  # the periodic axes' ghost cells already there (fluxes.grid_ends)
     out = []
     for i, f in enumerate(fields):
         is_velocity = velocity is not None and 0 <= i - velocity < 3
@@ -377,7 +378,6 @@ def pad(fields: Sequence[Any], grid: Any, G: int, t: Any = 0.0, velocity: int | 
             f = _wall_ghosts(f, grid, a, G, role, walls, affine)
         if bc.shear_axis is not None:
             f = _lees_edwards(f, grid, t, 1.0 if (is_velocity and affine and i == velocity + bc.flow) else None, G)
-        wrapped = getattr(grid, "wrapped", False)  # the periodic axes' ghost cells already there (fluxes.grid_ends)
         widths = [(0, 0) if wrapped or b == bc.shear_axis or bc.kinds[b] == WALL else (G, G) for b in range(ndim)]
         out.append(jnp.pad(f, widths, mode="wrap"))
     return tuple(out)
