@@ -9,10 +9,10 @@ Run from the repository root.  Four commands:
     model has a Bagnold interior at the angle at all, and the 1D solver's own error at the
     3D grid's resolution.
 
-``python benchmarks/chute_bagnold.py run --depth 90 --angle 18 [--cells-per-d 1] [--thin]``
-    One 3D run of the chute (RET, φ̄ 0.3, bumpy base, zero-flux lid, IMEX) to steady state
+``python benchmarks/chute_bagnold.py run --depth 90 --angle 18 [--cells-per-d 1] [--thin] [--scheme imex]``
+    One 3D run of the chute (RET, φ̄ 0.3, bumpy base, zero-flux lid, IMEX unless ``--scheme``) to steady state
     (``time.steady_tol`` 1e-4) from a sheared start scaled with Bagnold's law from the 10 d
-    example (``tests/_chute_case.bagnold_case``: γ̇0 = 100/s (H/10d)^{1/2}, θ0 = 0.03 m²/s² (H/10d),
+    example (``tests/helpers/chute_case.bagnold_case``: γ̇0 = 100/s (H/10d)^{1/2}, θ0 = 0.03 m²/s² (H/10d),
     not the 1D answer), checkpointed into the folder ``chute_bagnold_<H>d``, then ``summarize``.
     ``--thin``: a 4 × N × 4 box instead of the 1D grid.
 
@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from _chute_case import bagnold_case  # noqa: E402
+from helpers.chute_case import bagnold_case  # noqa: E402
 
 from ktgf.closures import get_model  # noqa: E402
 from ktgf.couette.chute import solve_chute  # noqa: E402
@@ -98,12 +98,12 @@ def profile_error(y: np.ndarray, v: np.ndarray, ref, k: str) -> float:
     return float(np.max(np.abs(v - r)) / np.max(np.abs(r))) if k == "u" else float(np.max(np.abs(v / r - 1.0)))
 
 
-def run(depth: float, angle: float, cells_per_d: float, thin: bool, folder: Path) -> dict:
+def run(depth: float, angle: float, cells_per_d: float, thin: bool, folder: Path, scheme: str = "imex") -> dict:
     """One 3D run to steady state, checkpointed into ``folder``; then :func:`summarize`."""
     from ktgf.solver.config import parse_config
     from ktgf.solver.run import Simulation
 
-    cfg = bagnold_case(depth, angle, cells_per_d, thin)
+    cfg = bagnold_case(depth, angle, cells_per_d, thin, scheme)
     cfg["output"].update(directory=str(folder), checkpoint_every=5)
     sim = Simulation(parse_config(cfg))
     t0, c0 = time.perf_counter(), time.process_time()
@@ -177,6 +177,7 @@ def main() -> None:
     r.add_argument("--angle", type=float, default=18.0)
     r.add_argument("--cells-per-d", type=float, default=1.0)
     r.add_argument("--thin", action="store_true")
+    r.add_argument("--scheme", choices=("imex", "ssprk3", "auto"), default="imex")
     r.add_argument("--out", type=Path, default=None, help="run folder (default chute_bagnold_<H>d[_thin])")
     c = sub.add_parser("summarize")
     c.add_argument("folders", nargs="+", type=Path)
@@ -187,7 +188,7 @@ def main() -> None:
         oned(a.angle)
     elif a.cmd == "run":
         run(a.depth, a.angle, a.cells_per_d, a.thin,
-            a.out or Path(f"chute_bagnold_{a.depth:g}d{'_thin' if a.thin else ''}"))
+            a.out or Path(f"chute_bagnold_{a.depth:g}d{'_thin' if a.thin else ''}"), a.scheme)
     elif a.cmd == "summarize":
         for f in a.folders:
             summarize(f)

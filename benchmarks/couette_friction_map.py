@@ -20,7 +20,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests"))
 from ktgf.couette.run import Material, to_dataset  # noqa: E402
 from ktgf.couette.solver import solve  # noqa: E402
 from ktgf.errors import KtgfError  # noqa: E402
-from test_friction_couette import SCALE, frictional_wall_problem  # noqa: E402
+from helpers.friction_couette import SCALE, frictional_wall_problem  # noqa: E402
 
 
 def one(stress: str, mu: float, mean_phi: float, angle: float) -> dict:
