@@ -15,7 +15,8 @@ Printed: (1) per DEM state the measured T_rot/T, Walton's 0.497 and the finite-s
 (2) Walton's translational loss at the DEM's T_rot/T (how much the collisional cooling of translation falls
 if rotation is hotter) and what it would do to T and τ/p; (3) the tangential impulse's share of the collisional shear stress, with the constant-β
 check against the first-order-in-s result 3η/(2(1 + e)) derived in docs/friction.md §7.1, and what that
-share would do to T and τ/p.
+share would do to T and τ/p; (4) the part of the tangential impulse's work that heats translation (the rest
+is dissipated through rotation), and the fit / leave-one-state-out errors with that share and that part.
 """
 
 from __future__ import annotations
@@ -72,6 +73,31 @@ class ShearedWalton:
         """Steady T_rot/T: ⟨ΔE_rot⟩ = 0."""
         return brentq(lambda r: self.rotational_change(r, s), 0.05, 5.0, xtol=1e-4)
 
+    def _translational_parts(self, r: float, s: float, normal: bool = False) -> tuple[float, float]:
+        """Per collision: the tangential (``normal``: the normal) impulse's change of the pair's peculiar
+        translational energy, and its work against the mean flow.
+
+        With J = J_n + J_t on particle 1 (m = 1) the pair's peculiar energy changes by J·(c1 − c2) + |J|², whose
+        tangential part is J_t·(c1 − c2) + |J_t|² (J_n ⊥ J_t); the mean flow does the work −J_t·m12 on it, m12 =
+        −s k_y x̂ the mean part of v1 − v2.
+        """
+        _, _, weight, jn, jt = self._collide(r, s)
+        jt = jn if normal else jt
+        c12 = self.c1 - self.c2
+        total = np.sum(weight)
+        change = np.sum(weight * (np.einsum("ij,ij->i", jt, c12) + np.sum(jt**2, 1))) / total
+        work = np.sum(weight * s * jt[:, 0] * self.k[:, 1]) / total
+        return float(change), float(work)
+
+    def translational_fraction(self, s: float, normal: bool = False) -> float:
+        """The part of the tangential impulse's work that heats translation: the change of the tangential
+        impulse's translational energy gain from (s = 0, Walton's ratio) to (s, the steady ratio at s), over its
+        work against the mean flow at s.  The rest goes to rotation, which, steady, dissipates it.  ``normal``:
+        the same for the normal impulse (the rest is then the O(s²) change of the normal loss)."""
+        change0, _ = self._translational_parts(self.ratio(0.0), 0.0, normal)
+        change, work = self._translational_parts(self.ratio(s), s, normal)
+        return (change - change0) / work
+
     def tangential_share(self, r: float, s: float) -> float:
         """⟨J_t,x k_y⟩/⟨J_n,x k_y⟩: the tangential impulse's collisional shear stress over the normal impulse's.
 
@@ -110,13 +136,17 @@ def main() -> None:
     eta = Q * (1.0 + BETA0) / (2.0 * (1.0 + Q))
     print(f"constant β = {BETA0:g} (μ → ∞): {rough.tangential_share(0.5, 0.2):.3f} at s = 0.2 "
           f"against 3η/(2(1 + e)) = {1.5 * eta / (1 + E):.3f}")
+    print("\nPart of the tangential impulse's work that heats translation (the rest is dissipated through rotation):")
+    for s in (1.0, 1.5, 2.2):
+        print(f"  s = {s}: {mc.translational_fraction(s):.3f} (normal impulse: {mc.translational_fraction(s, True):.3f})")
+    fraction = mc.translational_fraction(2.2)
     share = mc.tangential_share(mc.ratio(0.5), 0.5)
     states = frictional_states()
     loss = np.array([-walton._energy_changes(E, MU, float(r))[0] for r in states["Trot_over_T"]])
     what_if("ζ0* × (translational loss at the DEM's T_rot/T)/(Walton's)", zeta_factor=loss / walton.inelasticity(E, MU))
     what_if(f"0.6 λ_b* × (1 + {share:.3f}), the tangential share", eta_share=share)
-    for value in (0.0, share):
-        cross_validate(value)
+    for value, part in ((0.0, 1.0), (share, 1.0), (share, fraction)):
+        cross_validate(value, part)
     print(f"\n{time.perf_counter() - t0:.1f} s wall")
 
 
@@ -155,10 +185,12 @@ def what_if(label: str, *, zeta_factor: Any = 1.0, eta_share: float = 0.0) -> No
               f"| {100 * (today.tau_over_p[i] / states['tau_over_p'][i] - 1):+.1f} % → "
               f"{100 * (ratio[i] / states['tau_over_p'][i] - 1):+.1f} % |")
 
-def cross_validate(share: float) -> None:
+def cross_validate(share: float, fraction: float = 1.0) -> None:
     """Fit and leave-one-state-out errors of the family (μ_Z, k refitted, a, b, c held) with 0.6 λ_b* × (1 + share) at μ > 0.
 
-    share = 0 is the registered ``frictional`` (the table of docs/friction.md §6.0); T_rot/T is Walton's in both.
+    share = 0 is the registered ``frictional`` (the table of docs/friction.md §6.0); T_rot/T is Walton's in all.
+    ``fraction``: the part of the extra shear work Δη* a*² that heats translation; the rest is dissipated (through
+    rotation), i.e. ζ0* gains (1 − fraction) Δη* a*²/(3/2), which in steady shear is ζ0* × η*/(η* − (1 − fraction) Δη*).
     """
     from dataclasses import dataclass
 
@@ -173,14 +205,18 @@ def cross_validate(share: float) -> None:
     class TangentialShare(GarzoDufty1999):
         share: float = 0.0
 
+        fraction: float = 1.0
+
         def reduced(self, phi: Any, e: Any, chi: Any, dchi: Any) -> Any:
             red = super().reduced(phi, e, chi, dchi)
-            return red._replace(eta=red.eta + self.share * 0.6 * red.lambda_b)
+            extra = self.share * 0.6 * red.lambda_b
+            return red._replace(eta=red.eta + extra,
+                                zeta0=red.zeta0 * (red.eta + extra) / (red.eta + self.fraction * extra))
 
     def family(name: str = "family", *, mu: float = 0.0, a: float, exponent: float, c: float, mu_scale: float = 0.1,
                amplitude_growth: float = 0.0) -> Model:
         rdf = FrictionalPowerLaw(mu=mu, a=a, exponent=exponent, mu_scale=mu_scale, amplitude_growth=amplitude_growth)
-        model = Model(name, TangentialShare(share=share), rdf, dissipation=CorrelationLength(c=c))
+        model = Model(name, TangentialShare(share=share, fraction=fraction), rdf, dissipation=CorrelationLength(c=c))
         return model.replace(friction=Friction(mu=mu, restitution="walton", beta0=BETA0))
 
     original = rf.family_model
@@ -197,7 +233,8 @@ def cross_validate(share: float) -> None:
     pstar_fit, pstar_loo = (1 + res[0]) * (1 + res[1]) - 1, (1 + loo[0]) * (1 + loo[1]) - 1
     trot = WaltonRestitution(beta0=BETA0, q=Q).rotational_ratio(E, MU) / states["Trot_over_T"] - 1
     values = ", ".join(f"{k} = {v:.4g}" for k, v in fit.values.items())
-    print(f"\ntangential share {share:.3f}: refit {values}; fit / leave-one-state-out errors")
+    print(f"\ntangential share {share:.3f}, {fraction:.3f} of its work to translation: refit {values}; "
+          "fit / leave-one-state-out errors")
     print("| φ | T | p* | p/(nT) | τ/p | T_rot/T |")
     print("|---|---|---|---|---|---|")
     for i in range(states["phi"].size):
