@@ -73,29 +73,30 @@ class ShearedWalton:
         """Steady T_rot/T: ⟨ΔE_rot⟩ = 0."""
         return brentq(lambda r: self.rotational_change(r, s), 0.05, 5.0, xtol=1e-4)
 
-    def _translational_parts(self, r: float, s: float, normal: bool = False) -> tuple[float, float]:
-        """Per collision: the tangential (``normal``: the normal) impulse's change of the pair's peculiar
-        translational energy, and its work against the mean flow.
+    def _translational_parts(self, r: float, s: float, normal: bool, per_collision: bool) -> tuple[float, float]:
+        """The tangential (``normal``: the normal) impulse's change of the pair's peculiar translational energy,
+        and its work against the mean flow, per unit time (``per_collision``: per collision).
 
         With J = J_n + J_t on particle 1 (m = 1) the pair's peculiar energy changes by J·(c1 − c2) + |J|², whose
         tangential part is J_t·(c1 − c2) + |J_t|² (J_n ⊥ J_t); the mean flow does the work −J_t·m12 on it, m12 =
-        −s k_y x̂ the mean part of v1 − v2.
+        −s k_y x̂ the mean part of v1 − v2.  Per unit time: averages of rate × quantity (the collision rate grows
+        with s); per collision: the same over the mean rate.
         """
         _, _, weight, jn, jt = self._collide(r, s)
         jt = jn if normal else jt
         c12 = self.c1 - self.c2
-        total = np.sum(weight)
+        total = np.sum(weight) if per_collision else weight.size
         change = np.sum(weight * (np.einsum("ij,ij->i", jt, c12) + np.sum(jt**2, 1))) / total
         work = np.sum(weight * s * jt[:, 0] * self.k[:, 1]) / total
         return float(change), float(work)
 
-    def translational_fraction(self, s: float, normal: bool = False) -> float:
+    def translational_fraction(self, s: float, normal: bool = False, per_collision: bool = False) -> float:
         """The part of the tangential impulse's work that heats translation: the change of the tangential
         impulse's translational energy gain from (s = 0, Walton's ratio) to (s, the steady ratio at s), over its
         work against the mean flow at s.  The rest goes to rotation, which, steady, dissipates it.  ``normal``:
         the same for the normal impulse (the rest is then the O(s²) change of the normal loss)."""
-        change0, _ = self._translational_parts(self.ratio(0.0), 0.0, normal)
-        change, work = self._translational_parts(self.ratio(s), s, normal)
+        change0, _ = self._translational_parts(self.ratio(0.0), 0.0, normal, per_collision)
+        change, work = self._translational_parts(self.ratio(s), s, normal, per_collision)
         return (change - change0) / work
 
     def tangential_share(self, r: float, s: float) -> float:
@@ -136,16 +137,22 @@ def main() -> None:
     eta = Q * (1.0 + BETA0) / (2.0 * (1.0 + Q))
     print(f"constant β = {BETA0:g} (μ → ∞): {rough.tangential_share(0.5, 0.2):.3f} at s = 0.2 "
           f"against 3η/(2(1 + e)) = {1.5 * eta / (1 + E):.3f}")
-    print("\nPart of the tangential impulse's work that heats translation (the rest is dissipated through rotation):")
-    for s in (1.0, 1.5, 2.2):
-        print(f"  s = {s}: {mc.translational_fraction(s):.3f} (normal impulse: {mc.translational_fraction(s, True):.3f})")
+    print("\nPart of the impulses' work that heats translation, per unit time (per collision):")
+    print("| s | tangential | normal |")
+    print("|---|---|---|")
+    for s in (0.5, 1.0, 1.5, 2.2):
+        cells = [f"{mc.translational_fraction(s, normal):.3f} ({mc.translational_fraction(s, normal, True):.3f})"
+                 for normal in (False, True)]
+        print(f"| {s} | " + " | ".join(cells) + " |")
     fraction = mc.translational_fraction(2.2)
-    share = mc.tangential_share(mc.ratio(0.5), 0.5)
+    share = walton.tangential_shear_share(E, MU)
+    print(f"\ntangential share, closed form (WaltonRestitution.tangential_shear_share): {share:.4f}")
     states = frictional_states()
     loss = np.array([-walton._energy_changes(E, MU, float(r))[0] for r in states["Trot_over_T"]])
     what_if("ζ0* × (translational loss at the DEM's T_rot/T)/(Walton's)", zeta_factor=loss / walton.inelasticity(E, MU))
     what_if(f"0.6 λ_b* × (1 + {share:.3f}), the tangential share", eta_share=share)
-    for value, part in ((0.0, 1.0), (share, 1.0), (share, fraction)):
+    per_collision = mc.translational_fraction(2.2, per_collision=True)
+    for value, part in ((0.0, 1.0), (share, 1.0), (share, fraction), (share, per_collision)):
         cross_validate(value, part)
     print(f"\n{time.perf_counter() - t0:.1f} s wall")
 

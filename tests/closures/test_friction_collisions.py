@@ -162,6 +162,49 @@ def test_walton_averages_match_monte_carlo(e, mu, beta0, r):
     assert mc_tr == pytest.approx(tr, rel=0.015, abs=0.005)
 
 
+def _sheared_impulse_share(e, mu, beta0, r, s=0.2, n=1_000_000, seed=5, q=0.4):
+    """Monte Carlo of Walton's rule with the mean flow of uniform shear u_x = s y (d = m = T = 1): particle 2 at
+    r1 + k, spins Ω + w with Ω = −(s/2) ẑ.  Returns ⟨(g·k)⁺ J_t,x k_y⟩/⟨(g·k)⁺ J_n,x k_y⟩ (J on particle 1), the
+    same samples at +s and −s differenced so that the isotropic noise cancels."""
+    rng = np.random.default_rng(seed)
+    inertia = q / 4.0
+    c = rng.normal(0.0, 1.0, (2, n, 3))
+    w = rng.normal(0.0, math.sqrt(r / inertia), (2, n, 3))
+    k = rng.normal(size=(n, 3))
+    k /= np.linalg.norm(k, axis=1)[:, None]
+    sums = []
+    for shear in (s, -s):
+        v12 = c[0] - c[1]
+        v12[:, 0] -= shear * k[:, 1]
+        spin = w[0] + w[1] + np.array([0.0, 0.0, -shear])
+        g = v12 + 0.5 * np.cross(spin, k)
+        gn = (g * k).sum(1)
+        gt = g - gn[:, None] * k
+        slip = np.linalg.norm(gt, axis=1) + 1e-300
+        beta = np.minimum(beta0, -1 + mu * (1 + e) * (1 + 1 / q) * gn / slip)
+        rate = np.maximum(gn, 0.0)
+        jn_x = -0.5 * (1 + e) * gn * k[:, 0]
+        jt_x = -q * (1 + beta) / (2 * (1 + q)) * gt[:, 0]
+        sums.append(((rate * jt_x * k[:, 1]).sum(), (rate * jn_x * k[:, 1]).sum()))
+    return (sums[0][0] - sums[1][0]) / (sums[0][1] - sums[1][1])
+
+
+@pytest.mark.analytic
+def test_walton_tangential_shear_share_matches_monte_carlo_and_its_limits():
+    """The closed form (Stein's lemma on the Maxwellian average) against an independent Monte Carlo of the collision
+    rule under shear, and its limits: 0 without friction, 3η0/(2(1 + e)) when every collision sticks."""
+    law = WaltonRestitution(beta0=1.0)
+    assert law.tangential_shear_share(0.7, 0.0) == 0.0
+    for beta0 in (1.0, 0.4):
+        eta0 = 0.4 * (1 + beta0) / (2 * 1.4)
+        assert WaltonRestitution(beta0=beta0).tangential_shear_share(0.7, 1e4) == pytest.approx(1.5 * eta0 / 1.7,
+                                                                                                rel=1e-6)
+    for e, mu, beta0 in ((0.7, 0.5, 1.0), (0.9, 0.2, 0.4)):
+        law = WaltonRestitution(beta0=beta0)
+        mc = _sheared_impulse_share(e, mu, beta0, law.rotational_ratio(e, mu))
+        assert mc == pytest.approx(law.tangential_shear_share(e, mu), rel=0.02), (e, mu, beta0)
+
+
 @pytest.mark.analytic
 def test_walton_limits():
     law = WaltonRestitution(beta0=0.4)

@@ -287,6 +287,28 @@ class WaltonRestitution(FrictionPart):
         f = r / (self.q + r)
         return -(1.0 - float(e) ** 2) - ((1.0 - f) * m1 - m2), m2 / self.q - f * m1
 
+    def tangential_shear_share(self, e: Any, mu: Any) -> float:
+        """Collisional shear stress of the tangential impulses over that of the normal ones, in steady uniform shear.
+
+        Our derivation (docs/friction.md §7.1), for the local-equilibrium (Maxwellian) collisional transfer: to
+        first order in the mean strain E, the mean relative contact velocity −d E·k (spins about half the
+        vorticity) shifts the Gaussian of g_c, and Stein's lemma turns the change of ⟨(g·k)⁺ J k⟩ into moments at
+        E = 0.  The normal impulse gives (1 + e)/(15√π) s, the tangential one ⟨η ρ²⟩/(20 σ²√π) s (orientation
+        averages ⟨k_x²k_y²⟩ = 1/15, ⟨k_y²(1/2 − k_x²)⟩ = 1/10), so the share is
+
+            3 ⟨η ρ²⟩ / (4 σ² (1 + e)),   σ² = 2(1 + r/q),  r = T_rot/T (:meth:`rotational_ratio`),
+
+        with ⟨η ρ²⟩ of :func:`_walton_moments`.  Limits: 0 at μ = 0; for constant β (μ → ∞) ⟨η ρ²⟩ = 2σ²η0 and
+        the share is 3η0/(2(1 + e)), η0 = q(1 + β0)/(2(1 + q)) (0.252 at β0 = 1, e = 0.7, q = 0.4).  Checked against
+        a Monte Carlo of the collision rule under shear in the tests (0.1613 at μ = 0.5, e = 0.7, β0 = 1).
+        Not used by a registered model yet: docs/friction.md §7.1 says what is missing.
+        """
+        if float(mu) == 0.0:
+            return 0.0
+        r = self.rotational_ratio(e, mu)
+        m1, _ = _walton_moments(float(e), float(mu), self.beta0, self.q, r)
+        return 3.0 * m1 / (8.0 * (1.0 + r / self.q) * (1.0 + float(e)))
+
     def hcs_rotational_ratio(self, e: Any, mu: Any) -> float:
         """T_rot/T of the homogeneous cooling state: both temperatures decay at the same relative rate.
 
