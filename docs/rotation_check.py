@@ -31,6 +31,8 @@ from ktgf.calibration.registry_fits import frictional_states
 from ktgf.closures.friction.collisions import WaltonRestitution
 
 Q, E, MU, BETA0 = 0.4, 0.7, 0.5, 1.0
+#: μ_Z, k of the registration before the tangential stress (docs/friction.md §6.0), the base of the what-ifs.
+PREVIOUS = {"mu_scale": 0.6202, "amplitude_growth": 5.772}
 INERTIA = Q / 4.0  # I/(m d²) with q = 4I/(m d²)
 N = 300_000
 
@@ -144,21 +146,23 @@ def main() -> None:
         cells = [f"{mc.translational_fraction(s, normal):.3f} ({mc.translational_fraction(s, normal, True):.3f})"
                  for normal in (False, True)]
         print(f"| {s} | " + " | ".join(cells) + " |")
-    fraction = mc.translational_fraction(2.2)
+    fraction = walton.tangential_work_fraction(E, MU)
     share = walton.tangential_shear_share(E, MU)
-    print(f"\ntangential share, closed form (WaltonRestitution.tangential_shear_share): {share:.4f}")
+    print(f"\nclosed forms (WaltonRestitution): tangential share {share:.4f}, part of its work heating translation "
+          f"per unit time as s → 0 {fraction:.4f}")
     states = frictional_states()
     loss = np.array([-walton._energy_changes(E, MU, float(r))[0] for r in states["Trot_over_T"]])
     what_if("ζ0* × (translational loss at the DEM's T_rot/T)/(Walton's)", zeta_factor=loss / walton.inelasticity(E, MU))
     what_if(f"0.6 λ_b* × (1 + {share:.3f}), the tangential share", eta_share=share)
-    per_collision = mc.translational_fraction(2.2, per_collision=True)
-    for value, part in ((0.0, 1.0), (share, 1.0), (share, fraction), (share, per_collision)):
+    per_unit_time, per_collision = (mc.translational_fraction(2.2, per_collision=flag) for flag in (False, True))
+    for value, part in ((0.0, 1.0), (share, 1.0), (share, fraction), (share, per_unit_time), (share, per_collision)):
         cross_validate(value, part)
     print(f"\n{time.perf_counter() - t0:.1f} s wall")
 
 
 def what_if(label: str, *, zeta_factor: Any = 1.0, eta_share: float = 0.0) -> None:
-    """The registered ``frictional`` at μ = 0.5 with its ζ0* scaled or its Maxwellian collisional viscosity raised.
+    """``frictional`` before the tangential stress (μ_Z, k of :data:`PREVIOUS`) at μ = 0.5 with its ζ0* scaled or its
+    Maxwellian collisional viscosity raised.
 
     Not a closure: a measure of how far (a) a hotter rotation (less translational loss, ``zeta_factor``) or (b) the
     tangential impulse's collisional shear stress, missing from the transport coefficients (0.6 λ_b* raised by
@@ -172,7 +176,8 @@ def what_if(label: str, *, zeta_factor: Any = 1.0, eta_share: float = 0.0) -> No
 
     states = frictional_states()
     phi = states["phi"]
-    model = family_model(mu=MU, **registered_parameters())
+    params = {**registered_parameters(), **PREVIOUS}
+    model = family_model(mu=MU, **params).with_options(tangential_stress="none")
     today = steady_shear(model, phi, E)
     red = model.reduced(phi, E)
     eta = red.eta + eta_share * 0.6 * red.lambda_b
@@ -182,7 +187,7 @@ def what_if(label: str, *, zeta_factor: Any = 1.0, eta_share: float = 0.0) -> No
     a = np.where(lam * k * a0 > 1.0, (a0**2 / (lam * k)) ** (1.0 / 3.0), a0)
     temp = 25.0 * math.pi / (9216.0 * phi**2 * a**2)
     ratio = eta * a / red.p
-    print(f"\nwhat if {label} (registered frictional, no refit):")
+    print(f"\nwhat if {label} (frictional before the tangential stress, no refit):")
     print("| φ | ζ0 factor | 0.6 λ_b*/η* | T today → what-if | τ/p today → what-if |")
     print("|---|---|---|---|---|")
     factor = np.broadcast_to(zeta_factor, phi.shape)
@@ -195,7 +200,9 @@ def what_if(label: str, *, zeta_factor: Any = 1.0, eta_share: float = 0.0) -> No
 def cross_validate(share: float, fraction: float = 1.0) -> None:
     """Fit and leave-one-state-out errors of the family (μ_Z, k refitted, a, b, c held) with 0.6 λ_b* × (1 + share) at μ > 0.
 
-    share = 0 is the registered ``frictional`` (the table of docs/friction.md §6.0); T_rot/T is Walton's in all.
+    share = 0 is ``frictional`` before the tangential stress; share and fraction of the closed forms are the registered
+    ``frictional`` (its table in docs/friction.md §6.0, by another route: ζ0* scaled instead of the sink); T_rot/T is
+    Walton's in all.
     ``fraction``: the part of the extra shear work Δη* a*² that heats translation; the rest is dissipated (through
     rotation), i.e. ζ0* gains (1 − fraction) Δη* a*²/(3/2), which in steady shear is ζ0* × η*/(η* − (1 − fraction) Δη*).
     """
@@ -227,7 +234,7 @@ def cross_validate(share: float, fraction: float = 1.0) -> None:
         return model.replace(friction=Friction(mu=mu, restitution="walton", beta0=BETA0))
 
     original = rf.family_model
-    rf.family_model = family if share > 0.0 else original
+    rf.family_model = family  # without the registered tangential stress: this one adds its own
     try:
         params = rf.registered_parameters()
         frictionless = {k: params[k] for k in rf.FRICTIONLESS_PARAMETERS}

@@ -127,7 +127,8 @@ def test_no_finite_hcs_ratio_is_a_one_line_error():
     assert 0.3 < threshold < 0.5
     assert np.isfinite(WaltonRestitution().hcs_rotational_ratio(0.7, threshold + 2e-3))
     with pytest.raises(InputError, match="chialvo-sundaresan-2013.*no homogeneous cooling state"):
-        cooling_rate(get_model("frictional", restitution="chialvo-sundaresan-2013"), 0.3, 0.7, THETA0, d=D)
+        cooling_rate(get_model("frictional", restitution="chialvo-sundaresan-2013", tangential_stress="none"), 0.3, 0.7,
+                     THETA0, d=D)
 
 
 @pytest.mark.contract

@@ -19,18 +19,20 @@ from ktgf.closures.friction import (
     SrivastavaSundaresanViscosity,
     TanhBlend,
 )
-from ktgf.data import FRICTION_SHEAR as DEM_FILE, read_friction_shear
+from ktgf.closures.rdf import ChialvoSundaresan
+from ktgf.data import FRICTION_SHEAR as DEM_FILE
+from ktgf.data import read_friction_shear
+from ktgf.errors import InputError
+from ktgf.shear.compositions import FrictionalShearParts, frictional_uniform_shear
 from ktgf.shear.dem import (
+    compare_with_dem,
     comparison_markdown,
     compositions,
-    jamming_sensitivity_markdown,
-    compare_with_dem,
     fit_row,
     fit_tangential_restitution,
+    jamming_sensitivity_markdown,
 )
-from ktgf.shear.compositions import FrictionalShearParts, frictional_uniform_shear
-from ktgf.closures.rdf import ChialvoSundaresan
-from ktgf.errors import InputError
+from ktgf.shear.steady import steady_shear
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "friction.md"
 
@@ -210,3 +212,19 @@ def test_closures_run_under_jit():
     for fn, x in ((jj.pressure, 0.55), (blend.weight, 0.6), (MuIRheology().friction, 0.3), (rdf.chi, 0.5),
                   (lambda mu: ChialvoSundaresanRestitution().effective_restitution(0.7, mu), 0.5)):
         assert float(jax.jit(fn)(x)) == pytest.approx(float(fn(x)), rel=1e-12)
+
+
+@pytest.mark.analytic
+def test_tangential_stress_closed_form_is_a_steady_state_of_the_solvers_energy_balance():
+    """The closed form of uniform shear with the tangential impulses' stress (η* − Δη*_loss in its energy balance)
+    against the coefficients every solver takes (ζ0* with the lost work at the local shear measure s = 1/√T):
+    η* a*² = (3/2) ζ0*(s) and τ/p = η* a*/p*, to round-off; with the option off, the stress and the sink vanish."""
+    model = get_model("frictional")
+    phi = np.array([0.3, 0.45, 0.55])
+    state = steady_shear(model, phi, 0.7)
+    red = model.reduced(phi, 0.7, shear=1.0 / np.sqrt(state.T))
+    np.testing.assert_allclose(red.eta * state.astar**2, 1.5 * red.zeta0, rtol=1e-12)
+    np.testing.assert_allclose(state.tau_over_p, red.eta * state.astar / red.p, rtol=1e-12)
+    plain = model.with_options(tangential_stress="none")
+    assert model.tangential_work_loss(0.7, red.lambda_b).min() > 0.0 == plain.tangential_work_loss(0.7, red.lambda_b)
+    assert np.all(steady_shear(plain, phi, 0.7).tau_over_p < state.tau_over_p)

@@ -28,6 +28,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..closures.dissipation import CorrelationLength
+from ..closures.friction.calibrated import FAMILY_FRICTION
 from ..closures.friction.model_slot import Friction
 from ..closures.garzo_dufty1999 import GarzoDufty1999
 from ..closures.jamming import CoordinationJamming, FrictionalPowerLaw
@@ -107,10 +108,11 @@ def subset(states: dict[str, np.ndarray], keep: Any) -> dict[str, np.ndarray]:
 
 def family_model(name: str = "family", *, mu: float = 0.0, a: float, exponent: float, c: float, mu_scale: float = 0.1,
                  amplitude_growth: float = 0.0) -> Model:
-    """The one family at friction μ: RET × FrictionalPowerLaw χ × EKT length (c) × Walton (β0 = 1) if μ > 0."""
+    """The one family at friction μ: RET × FrictionalPowerLaw χ × EKT length (c) × Walton (β0 = 1) with the
+    tangential impulses' collisional stress if μ > 0."""
     rdf = FrictionalPowerLaw(mu=mu, a=a, exponent=exponent, mu_scale=mu_scale, amplitude_growth=amplitude_growth)
     model = Model(name, GarzoDufty1999(), rdf, dissipation=CorrelationLength(c=c))
-    return model.replace(friction=Friction(mu=mu, restitution="walton", beta0=1.0)) if mu > 0.0 else model
+    return model.replace(friction=Friction(**FAMILY_FRICTION, mu=mu)) if mu > 0.0 else model
 
 
 def predict(params: dict[str, float], states: dict[str, np.ndarray]) -> dict[str, np.ndarray]:

@@ -19,6 +19,8 @@ from .._array import namespace
 SQRT_PI = math.sqrt(math.pi)
 #: ℓ φ / d = 5√(2π)/96, the mean-free-path constant of model.md §1.
 MEAN_FREE_PATH_CONSTANT = 5.0 * math.sqrt(2.0 * math.pi) / 96.0
+#: s = dγ̇/√θ = SHEAR_PER_ASTAR · φ · a*, a* = γ̇/ν0 the reduced shear rate (from ν0 above).
+SHEAR_PER_ASTAR = 96.0 / (5.0 * math.sqrt(math.pi))
 
 
 class Reduced(NamedTuple):

@@ -31,16 +31,16 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
-from .._array import asarray, like
+from .._array import asarray, like, namespace
 from ..errors import InputError, UnknownModelError
 from ..validation import check_positive, check_state
-from .coefficients import Dimensional, Reduced, to_dimensional
+from .coefficients import SHEAR_PER_ASTAR, Dimensional, Reduced, to_dimensional
 from .garzo_dufty1999 import GarzoDufty1999
 from .lun1984 import Lun1984
 from .rdf import CarnahanStarling, RadialDistribution, Torquato, ViscosityDivergence
 from .dense import DENSE_PARAMETERS
 from .dissipation import DISSIPATIONS, CorrelationLength, NoDissipationCorrection
-from .friction.calibrated import FRICTIONAL_PARAMETERS
+from .friction.calibrated import FAMILY_FRICTION, FRICTIONAL_PARAMETERS
 from .jamming import FrictionalPowerLaw, check_below_jamming
 from .friction.model_slot import FRICTIONS, Friction, NoFriction
 from .viscosity_divergence import NoViscosityCorrection, ViscosityDivergenceLaw
@@ -154,10 +154,35 @@ class Model:
         chi, dchi = self.rdf.chi(phi), self.rdf.dchi(phi)
         r = self.theory.reduced(phi, e, chi, dchi)
         zeta0 = r.zeta0 * self.dissipation.factor(phi, e, chi, shear)
-        if self.friction.mu > 0.0:  # frictionless (μ = 0): ζ0 untouched, bit for bit
+        eta = r.eta
+        if self.friction.mu > 0.0:  # frictionless (μ = 0): ζ0 and η untouched, bit for bit
             factor = self.friction.hcs_zeta0_factor(e_host) if hcs else self.friction.zeta0_factor(e_host)
             zeta0 = zeta0 * like(factor, phi)
-        return r._replace(eta=r.eta * self.viscosity.factor(phi), zeta0=zeta0)
+            tangential = self.friction.tangential_coefficients(e_host, hcs=hcs)
+            if tangential is not None:  # docs/friction.md §7.1: Δη* = share (3/5)λ_b*, its lost work a sink
+                share, loss = (like(v, phi) for v in tangential)
+                eta = eta + share * 0.6 * r.lambda_b
+                if shear is not None and not hcs:  # (1 − f)Δη* a*² over (3/2), a* = s/(k φ)
+                    xp = namespace(phi, shear)
+                    astar = shear / (SHEAR_PER_ASTAR * xp.where(phi > 0.0, phi, 1.0))
+                    zeta0 = zeta0 + loss * 0.6 * r.lambda_b * astar**2 / 1.5
+        return r._replace(eta=eta * self.viscosity.factor(phi), zeta0=zeta0)
+
+    @property
+    def shear_dependent(self) -> bool:
+        """Whether ζ0 depends on the local shear measure dγ̇/√θ (``reduced(shear=...)``): a dissipation correction
+        (EKT length) or the lost work of the tangential impulses' stress."""
+        tangential = self.friction.mu > 0.0 and getattr(self.friction, "tangential_stress", "none") != "none"
+        return self.dissipation.key != "none" or tangential
+
+    def tangential_work_loss(self, e: Any, lambda_b: Any) -> Any:
+        """Δη*_loss = (1 − f) share (3/5)λ_b*: the part of the tangential impulses' viscosity whose work is dissipated
+        (0 without ``tangential_stress``; docs/friction.md §7.1).  In steady uniform shear the energy balance has
+        η* − Δη*_loss where it has η*; in a solver :meth:`reduced` with ``shear`` adds Δη*_loss a*²/(3/2) to ζ0*."""
+        tangential = self.friction.tangential_coefficients(e) if self.friction.mu > 0.0 else None
+        if tangential is None:
+            return 0.0
+        return like(tangential[1], asarray(lambda_b)) * 0.6 * lambda_b
 
     def coefficients(
         self, phi: Any, e: Any, theta: Any, *, d: Any, rho_s: Any, check: bool = True, shear: Any = None,
@@ -363,12 +388,13 @@ register_model(
         GarzoDufty1999(),
         _family_rdf(0.5),
         dissipation=CorrelationLength(c=DENSE_PARAMETERS["c"]),
-        friction=Friction(mu=0.5, restitution="walton", beta0=1.0),
+        friction=Friction(mu=0.5, **FAMILY_FRICTION),
         label="Frictional",
         description=(
             "Recommended for frictional particles (default mu = 0.5; option mu): 'dense' with Walton's collision "
-            "rule (beta0 = 1), the divergence at the contact-number phi_J(mu) and a friction-grown jamming "
-            "amplitude; mu_Z and k fitted to frictional DEM uniform shear (docs/friction.md); mu = 0 is 'dense'"
+            "rule (beta0 = 1) and its tangential impulses' collisional stress, the divergence at the contact-number "
+            "phi_J(mu) and a friction-grown jamming amplitude; mu_Z and k fitted to frictional DEM uniform shear "
+            "(docs/friction.md); mu = 0 is 'dense'"
         ),
     ),
 )

@@ -150,7 +150,7 @@ class Problem:
         w = self.geometry.angular(u, self.x)
         dw = np.diff(w)
         shear = None
-        if self.model.dissipation.key != "none":  # EKT: ζ0 at the nodes sees the local dγ̇/√θ
+        if self.model.shear_dependent:  # EKT, tangential stress: ζ0 at the nodes sees the local dγ̇/√θ
             rate = np.abs(self.A / self.geometry.stress_metric(self.xf) * dw / self.dx)  # face shear rates
             node_rate = np.concatenate([rate[:1], 0.5 * (rate[1:] + rate[:-1]), rate[-1:]])
             shear = np.concatenate([node_rate / np.sqrt(theta), np.zeros(n - 1)])

@@ -94,10 +94,11 @@ class FrictionalShearParts:
         return self.model
 
 
-def friction_from_law(law: Any, mu: float) -> Friction:
-    """The model's ``friction`` part for a restitution-law object at μ (flat options, see :class:`Friction`)."""
+def friction_from_law(law: Any, mu: float, tangential_stress: str = "none") -> Friction:
+    """The model's ``friction`` part for a restitution-law object at μ (flat options, see :class:`Friction`);
+    ``tangential_stress`` is kept with Walton's rule (the only law that has it)."""
     if isinstance(law, WaltonRestitution):
-        return Friction(mu=float(mu), restitution="walton", beta0=law.beta0, q=law.q)
+        return Friction(mu=float(mu), restitution="walton", beta0=law.beta0, q=law.q, tangential_stress=tangential_stress)
     if isinstance(law, RoughSphereRestitution):
         return Friction(mu=float(mu), restitution="rough-sphere", tangential_beta=law.beta, q=law.q)
     if isinstance(law, ChialvoSundaresanRestitution):
@@ -118,7 +119,9 @@ def frictional_uniform_shear(parts: FrictionalShearParts, phi: Any, e: float, mu
     if not 0.0 < e < 1.0:
         raise InputError(f"restitution coefficient e = {e:g} is out of range: valid 0 < e < 1 (uniform shear needs dissipation)")
     parts.restitution.check(e, mu)
-    model = parts.model_at(mu).replace(friction=friction_from_law(parts.restitution, mu))
+    model = parts.model_at(mu)
+    model = model.replace(friction=friction_from_law(parts.restitution, mu,
+                                                     getattr(model.friction, "tangential_stress", "none")))
     s = steady_shear(model, np.atleast_1d(np.asarray(phi, dtype=float)), e, dense_temperature=parts.dense_temperature)
     if parts.frictional_pressure is None:
         return s

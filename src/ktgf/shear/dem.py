@@ -92,7 +92,7 @@ def compositions(rows: list[dict[str, float]]) -> list[tuple[str, str, Any]]:
          FrictionalShearParts(ret.replace(rdf=fcs), restitution=RoughSphereRestitution(beta=beta))),
         ("RET, χ_CS13(φ_c(μ)), Walton μ, β0 = 1", "nothing (β0 = 1: the DEM contact law)",
          FrictionalShearParts(ret.replace(rdf=fcs), restitution=WaltonRestitution(beta0=1.0))),
-        ("**frictional** (registered): χ at φ_J(μ), EKT, Walton β0 = 1", "a, b, c (frictionless set); μ_Z, k (μ = 0.5 set)",
+        ("**frictional** (registered): χ at φ_J(μ), EKT, Walton β0 = 1, tangential stress", "a, b, c (frictionless set); μ_Z, k (μ = 0.5 set)",
          FrictionalShearParts(get_model("frictional"), restitution=WaltonRestitution(beta0=1.0))),
         ("Enskog, χ_CS13(φ_c(μ)), e_eff Chialvo–Sundaresan", "nothing",
          FrictionalShearParts(get_model("enskog").replace(rdf=fcs))),

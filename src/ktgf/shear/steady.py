@@ -13,8 +13,11 @@ balance is then solved consistently: a*² = 3ζ0*/(2η* max(1, Λ k a*)), whose 
     a* = (a0²/(Λ k))^(1/3)         otherwise,       a0 = √(3ζ0*/(2η*)).
 
 A model's friction part (:mod:`ktgf.closures.friction`) enters through its ζ0 (the factor
-(1 − e_eff²)/(1 − e²)), T_rot/T, and an optional enduring-contact stress w p_f with
-τ_f = (τ_f/p_f) w p_f of unregularised simple shear, its work dissipated without feeding θ.
+(1 − e_eff²)/(1 − e²)), T_rot/T, an optional enduring-contact stress w p_f with
+τ_f = (τ_f/p_f) w p_f of unregularised simple shear, its work dissipated without feeding θ, and an
+optional collisional stress of the tangential impulses (``tangential_stress``, docs/friction.md §7.1): Δη*
+in η*, of whose work the part Δη*_loss (:meth:`~ktgf.closures.models.Model.tangential_work_loss`) is
+dissipated, so the energy balance above has η* − Δη*_loss where it has η*.
 Frictionless models give their Navier–Stokes uniform shear unchanged.
 
 :class:`ShearState` is in the columns of the DEM files (``ktgf.data``, d = m = 1, γ̇ = 1):
@@ -31,13 +34,12 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .._array import asarray, namespace
+from ..closures.coefficients import SHEAR_PER_ASTAR
 from ..closures.models import Model
 from ..errors import InputError
 
 #: η0 d²/√(mT) = 5/(16√π): converts η* = η/η0 to the DEM file's η d²/√(mT).
 ETA0_DEM = 5.0 / (16.0 * math.sqrt(math.pi))
-#: s = dγ̇/√θ = SHEAR_PER_ASTAR · φ · a*, from ν0 = (96/5)(φ/d)√(θ/π).
-SHEAR_PER_ASTAR = 96.0 / (5.0 * math.sqrt(math.pi))
 #: τ/(ρ_s d² γ̇²) = ETA0_CONSTANT η* √T, with η0 = (5√π/96) ρ_s d √θ (model.md §1).
 ETA0_CONSTANT = 5.0 * math.sqrt(math.pi) / 96.0
 
@@ -65,7 +67,7 @@ def _solve(model: Any, phi: Any, e: Any, check: bool = True) -> tuple[Any, Any, 
     phi, e = asarray(phi), asarray(e)
     xp = namespace(phi, e)
     r = model.reduced(phi, e, check=check)
-    a0 = (1.5 * r.zeta0 / r.eta) ** 0.5
+    a0 = (1.5 * r.zeta0 / (r.eta - model.tangential_work_loss(e, r.lambda_b))) ** 0.5
     lam = model.dissipation.coefficient(phi, e, model.chi(phi))
     k = SHEAR_PER_ASTAR * phi
     x = lam * k * a0

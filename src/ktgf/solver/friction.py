@@ -49,7 +49,7 @@ FrictionalReduced = namedtuple("FrictionalReduced", Reduced._fields + ("p_f", "c
 def needs_rate(phys: Physics) -> bool:
     """Whether the cell coefficients depend on the velocity gradient (static)."""
     model = phys.model
-    return model.friction.has_stress or (model.dissipation.key != "none" and not phys.hcs)
+    return model.friction.has_stress or (model.shear_dependent and not phys.hcs)
 
 
 def strain_invariants(u: Any, grid: Grid, t: Any = 0.0) -> tuple[Any, Any]:
@@ -64,15 +64,16 @@ def strain_invariants(u: Any, grid: Grid, t: Any = 0.0) -> tuple[Any, Any]:
 def cell_coefficients(W: Any, grid: Grid, phys: Physics, t: Any = 0.0) -> Any:
     """The closures at the cells of the primitive state W = (ρ, u, θ) at time t (once per stage).
 
-    A plain :meth:`Physics.reduced` unless the model needs the velocity gradient: a dissipation
-    correction in a sheared case, or a frictional stress (then a :class:`FrictionalReduced`).
+    A plain :meth:`Physics.reduced` unless the model needs the velocity gradient: a shear-dependent cooling
+    (dissipation correction or tangential stress) in a sheared case, or a frictional stress (then a
+    :class:`FrictionalReduced`).
     """
     if not needs_rate(phys):
         return phys.reduced(W[0])
     rho, theta = W[0], W[4]
     ss = jnp.maximum(strain_invariants(W[1:4], grid, t)[0], 0.0)  # max: round-off
     model = phys.model
-    shear = phys.diameter * jnp.sqrt(2.0 * ss / theta) if model.dissipation.key != "none" and not phys.hcs else None
+    shear = phys.diameter * jnp.sqrt(2.0 * ss / theta) if model.shear_dependent and not phys.hcs else None
     r = phys.reduced(rho, shear)
     if not model.friction.has_stress:
         return r

@@ -2,9 +2,11 @@
 
 ``frictional`` = ``dense`` (RET × :class:`~ktgf.closures.jamming.FrictionalPowerLaw` χ × EKT length, with
 a, b, c of :data:`ktgf.closures.dense.DENSE_PARAMETERS`) × Walton's collision rule with β0 = 1
-(:mod:`ktgf.closures.friction.model_slot`), at friction μ (default 0.5).  Friction enters in three
-places: the collisional dissipation (Walton, no fitted number), the jamming fraction φ_J(μ) of the
-contact-number law (scale μ_Z) and the amplitude a(μ) = a (1 + k μ/(μ + μ_Z)) of the jamming term.
+(:mod:`ktgf.closures.friction.model_slot`), at friction μ (default 0.5).  Friction enters in four
+places: the collisional dissipation (Walton, no fitted number), the collisional stress of the tangential
+impulses and the part of its work that is dissipated (closed forms of Walton's rule, no fitted number;
+docs/friction.md §7.1), the jamming fraction φ_J(μ) of the contact-number law (scale μ_Z) and the
+amplitude a(μ) = a (1 + k μ/(μ + μ_Z)) of the jamming term.
 
 μ_Z and k are fitted (:func:`ktgf.calibration.registry_fits.fit_frictional`, log-ratios of T, p/(nT),
 τ/p) on the frictional DEM uniform shear at μ = 0.5, e = 0.7, φ 0.3–0.57
@@ -14,5 +16,8 @@ frictionless fit.  At μ = 0 both drop out exactly: ``frictional`` with μ = 0 i
 
 from __future__ import annotations
 
+#: The friction part of the registered family at μ > 0 (``frictional``; ``dense`` is μ = 0): Walton's rule with β0 = 1
+#: and the tangential impulses' collisional stress (docs/friction.md §6.0, §7.1); μ is the model's.
+FAMILY_FRICTION: dict[str, object] = {"restitution": "walton", "beta0": 1.0, "tangential_stress": "maxwellian"}
 #: μ_Z (mu_scale) and k (amplitude_growth), from :func:`ktgf.calibration.registry_fits.fit_frictional` (docs/friction.md §6).
-FRICTIONAL_PARAMETERS: dict[str, float] = {"mu_scale": 0.6202, "amplitude_growth": 5.772}
+FRICTIONAL_PARAMETERS: dict[str, float] = {"mu_scale": 0.6220, "amplitude_growth": 5.899}

@@ -219,6 +219,51 @@ def _walton_moments(e: float, mu: float, beta0: float, q: float, r: float) -> tu
     return m1, m2
 
 
+@lru_cache(maxsize=256)
+def _walton_shear_moments(e: float, mu: float, beta0: float, q: float, r: float) -> Any:
+    """Rate-weighted Gaussian averages E[(g_n)⁺ h A] for Walton's rule at T_rot/T = r (T = m = 1, not per collision).
+
+    Rows h = ηρ², η²ρ²; columns A = 1, (g_n² − 2)/4, ρ²/(2σ⁴) − 1/σ² (the Hermite weights of a second-order
+    shift of the normal and the tangential contact velocity).  The ρ integrals are closed (incomplete gamma
+    functions of v = ρ²/(2σ²), split at the sticking threshold as in :func:`_walton_moments`), the g_n integral
+    is numerical.  Column 0 times √π is :func:`_walton_moments`.
+    """
+    import numpy as np
+    from scipy.integrate import quad
+    from scipy.special import gamma, gammainc, gammaincc
+
+    sigma2 = 2.0 * (1.0 + r / q)
+    eta0 = q * (1.0 + beta0) / (2.0 * (1.0 + q))
+    slide = mu * (1.0 + e)
+
+    def upper(a: float, x: float) -> float:  # Γ(a, x)
+        return gamma(a) * gammaincc(a, x)
+
+    def lower(a: float, x: float) -> float:  # γ(a, x)
+        return gamma(a) * gammainc(a, x)
+
+    def integrand(gn: float, row: int, col: int) -> float:
+        vstar = (slide * (1.0 + 1.0 / q) * gn / (1.0 + beta0)) ** 2 / (2.0 * sigma2)
+        if row == 0:  # ηρ²: 2σ²η0 v sticking, (slide g_n/2) √(2σ² v) sliding
+            stick = 2.0 * sigma2 * eta0 * (lower(2.0, vstar) if col != 2 else lower(3.0, vstar) - lower(2.0, vstar))
+            base = 0.5 * slide * gn * math.sqrt(2.0 * sigma2)
+            sl = base * (upper(1.5, vstar) if col != 2 else upper(2.5, vstar) - upper(1.5, vstar))
+        else:  # η²ρ²: 2σ²η0² v sticking, slide² g_n²/4 sliding
+            stick = 2.0 * sigma2 * eta0**2 * (lower(2.0, vstar) if col != 2 else lower(3.0, vstar) - lower(2.0, vstar))
+            sl = 0.25 * slide**2 * gn**2 * math.exp(-vstar) * (1.0 if col != 2 else vstar)
+        value = stick + sl
+        if col == 1:
+            value *= (gn * gn - 2.0) / 4.0
+        elif col == 2:
+            value /= sigma2
+        return gn * math.exp(-gn * gn / 4.0) / math.sqrt(4.0 * math.pi) * value
+
+    out = np.array([[quad(integrand, 0.0, math.inf, args=(row, col), epsabs=1e-14, epsrel=1e-11, limit=200)[0]
+                     for col in range(3)] for row in range(2)])
+    out.setflags(write=False)  # cached: shared by every caller
+    return out
+
+
 @dataclass(frozen=True)
 class WaltonRestitution(FrictionPart):
     """Coulomb friction μ with a sticking tangential restitution β0 (Walton's collision rule), Maxwellian closure.
@@ -287,7 +332,7 @@ class WaltonRestitution(FrictionPart):
         f = r / (self.q + r)
         return -(1.0 - float(e) ** 2) - ((1.0 - f) * m1 - m2), m2 / self.q - f * m1
 
-    def tangential_shear_share(self, e: Any, mu: Any) -> float:
+    def tangential_shear_share(self, e: Any, mu: Any, r: float | None = None) -> float:
         """Collisional shear stress of the tangential impulses over that of the normal ones, in steady uniform shear.
 
         Our derivation (docs/friction.md §7.1), for the local-equilibrium (Maxwellian) collisional transfer: to
@@ -298,16 +343,50 @@ class WaltonRestitution(FrictionPart):
 
             3 ⟨η ρ²⟩ / (4 σ² (1 + e)),   σ² = 2(1 + r/q),  r = T_rot/T (:meth:`rotational_ratio`),
 
-        with ⟨η ρ²⟩ of :func:`_walton_moments`.  Limits: 0 at μ = 0; for constant β (μ → ∞) ⟨η ρ²⟩ = 2σ²η0 and
+        with ⟨η ρ²⟩ of :func:`_walton_moments` (``r``: another ratio, e.g. the homogeneous cooling state's).
+        Limits: 0 at μ = 0; for constant β (μ → ∞) ⟨η ρ²⟩ = 2σ²η0 and
         the share is 3η0/(2(1 + e)), η0 = q(1 + β0)/(2(1 + q)) (0.252 at β0 = 1, e = 0.7, q = 0.4).  Checked against
         a Monte Carlo of the collision rule under shear in the tests (0.1613 at μ = 0.5, e = 0.7, β0 = 1).
-        Not used by a registered model yet: docs/friction.md §7.1 says what is missing.
+        Used through the friction option ``tangential_stress`` (:meth:`Friction.tangential_coefficients`).
         """
         if float(mu) == 0.0:
             return 0.0
-        r = self.rotational_ratio(e, mu)
+        r = self.rotational_ratio(e, mu) if r is None else float(r)
         m1, _ = _walton_moments(float(e), float(mu), self.beta0, self.q, r)
         return 3.0 * m1 / (8.0 * (1.0 + r / self.q) * (1.0 + float(e)))
+
+    def _shear_balances(self, e: float, mu: float, r: float) -> dict[str, float]:
+        """Rate-weighted rotational and tangential-translational energy changes and the tangential work, at
+        s = 0 and their s² coefficients (s = γ̇d/√T), at T_rot/T = r (:meth:`tangential_work_fraction`)."""
+        mom = _walton_shear_moments(e, mu, self.beta0, self.q, r)
+        sigma2, f = 2.0 * (1.0 + r / self.q), r / (self.q + r)
+        shifted = 0.5 * (mom[:, 1] / 15.0 + mom[:, 2] / 10.0)  # ⟨δ_n²⟩ = s²/15, ⟨|δ_t|²⟩ = s²/10
+        work = mom[0, 0] / (20.0 * sigma2)
+        return {"rot0": -f * mom[0, 0] + mom[1, 0] / self.q, "rot2": -f * shifted[0] + shifted[1] / self.q + f * work,
+                "tr0": -(1.0 - f) * mom[0, 0] + mom[1, 0], "tr2": -(1.0 - f) * shifted[0] + shifted[1] + (1.0 - f) * work,
+                "work2": work}
+
+    def tangential_work_fraction(self, e: Any, mu: Any, dr: float = 1e-4) -> float:
+        """The part of the tangential impulses' shear work that heats translation, in steady uniform shear as s → 0.
+
+        Our derivation (docs/friction.md §7.1), per unit time and to O(s²), s = γ̇d/√T.  Conditioned on the contact
+        velocity g, the spins' share of g_t is f_r = r/(q + r) of its deviation from the mean, so the tangential
+        impulse J_t = −η g_t changes the pair's translational energy by −(1 − f_r)ηρ² + η²ρ² + (1 − f_r)η g_t·δ_t
+        and the rotational one by −f_r ηρ² + η²ρ²/q + f_r η g_t·δ_t, δ = −d E·k the mean contact velocity; η g_t·δ_t
+        is the mean flow's work.  The shift δ of the Gaussian of g is expanded to second order (Hermite weights,
+        :func:`_walton_shear_moments`).  The rotational balance moves the steady ratio by Δr = −s² R₂/∂_r R₀, and
+        the fraction is (X₂ + ∂_r X₀ Δr/s²)/W₂: the translational change over the work, both O(s²).  The rest of
+        the work is dissipated.  0.179 at μ = 0.5, e = 0.7, β0 = 1 (Monte Carlo: 0.167–0.198 at s = 1–2.2).
+        NaN at μ = 0 (no tangential impulse, no work).
+        """
+        if float(mu) == 0.0:
+            return math.nan
+        e, mu = float(e), float(mu)
+        r = self.rotational_ratio(e, mu)
+        b = self._shear_balances(e, mu, r)
+        up, down = self._shear_balances(e, mu, r + dr), self._shear_balances(e, mu, r - dr)
+        shift = -b["rot2"] * 2.0 * dr / (up["rot0"] - down["rot0"])
+        return (b["tr2"] + (up["tr0"] - down["tr0"]) / (2.0 * dr) * shift) / b["work2"]
 
     def hcs_rotational_ratio(self, e: Any, mu: Any) -> float:
         """T_rot/T of the homogeneous cooling state: both temperatures decay at the same relative rate.

@@ -1,9 +1,13 @@
 """The ``friction`` part of a :class:`~ktgf.closures.models.Model`: restitution law + optional frictional stress + blend.
 
 A model is theory × RDF × viscosity law × dissipation × friction.  The friction part changes the
-kinetic coefficients in one place only, the collisional dissipation (``docs/friction.md`` Eq. 1.1):
+kinetic coefficients through the collisional dissipation (``docs/friction.md`` Eq. 1.1):
 
     ζ0* → ζ0* (1 − e_eff²)/(1 − e²),   e_eff from the restitution law at the part's μ,
+
+and, with ``tangential_stress = "maxwellian"``, through the tangential impulses' collisional shear stress
+(η* gains share × (3/5)λ_b*, and ζ0* the part of its work that does not heat θ at the local shear measure;
+:meth:`Friction.tangential_coefficients`, ``Model.reduced``, ``docs/friction.md`` §7.1),
 
 and it carries (for the solvers that add it: uniform shear, Couette) an optional rate-independent
 frictional stress p_f(φ) w(φ) with a frictional viscosity (Johnson & Jackson 1987 with Schaeffer 1987
@@ -16,8 +20,8 @@ handle them like every other option); the sub-parts of :mod:`ktgf.closures.frict
 them and validate them.  :class:`NoFriction` (the default of every model) has no options.
 
 **Reduction at μ = 0**: the law's e_eff is e exactly, and :meth:`Friction.zeta0_factor` returns the
-Python float 1.0 without touching ζ0, so the coefficients are bit-identical to the frictionless
-model's (tested).  The frictional stress does *not* depend on μ (it is the enduring-contact stress of
+Python float 1.0 without touching ζ0 (and ``Model.reduced`` skips the tangential stress), so the
+coefficients are bit-identical to the frictionless model's (tested).  The frictional stress does *not* depend on μ (it is the enduring-contact stress of
 MFiX/OpenFOAM, a continuum law): it is off (``stress = "none"``) unless chosen.
 """
 
@@ -43,6 +47,11 @@ RESTITUTIONS: tuple[str, ...] = ("walton", "rough-sphere", "chialvo-sundaresan-2
 STRESSES: tuple[str, ...] = ("none", "schaeffer", "srivastava-sundaresan")
 #: Blends of the frictional stress by option value.
 BLEND_CHOICES: tuple[str, ...] = ("none", "tanh", "sigmoid")
+#: Collisional stress of the tangential impulses by option value (docs/friction.md §7.1; Walton, rough spheres).
+TANGENTIAL_STRESSES: tuple[str, ...] = ("none", "maxwellian")
+#: μ at which Walton's rule is the constant-β (rough-sphere) law: its T_rot/T, HCS ratio and share equal the
+#: rough-sphere closed forms to 10⁻¹⁵ there (tests/closures/test_friction_registry.py).
+STICKING_MU = 1e8
 
 
 @dataclass(frozen=True)
@@ -65,6 +74,10 @@ class NoFriction:
 
     def rotational_ratio(self, e: Any) -> None:
         """T_rot/T is not modelled (no rotation): ``None``."""
+        return None
+
+    def tangential_coefficients(self, e: Any, *, hcs: bool = False) -> None:
+        """No tangential impulses: ``None``."""
         return None
 
     def check_model(self, model: Any) -> None:
@@ -111,6 +124,10 @@ class Friction:
     regularisation : float
         ε of the rate-independent viscosity in a solver, as a fraction of the flow's shear-rate
         scale: √I2D → √(I2D + (ε γ̇_ref)²) (Schaeffer) — see ``docs/friction.md`` §8.
+    tangential_stress : str
+        ``none`` or ``maxwellian`` (Walton's rule or rough spheres): the collisional shear stress of the tangential impulses in
+        local equilibrium, Δη* = share × (3/5)λ_b*, and the part of its work that does not heat translation
+        dissipated (:meth:`tangential_coefficients`, ``docs/friction.md`` §7.1).
     """
 
     # defaults are the sub-parts' own (one source of every documented constant)
@@ -134,6 +151,7 @@ class Friction:
     blend_phi_star: float = 0.0
     blend_width: float | None = None
     regularisation: float = 1e-3
+    tangential_stress: str = "none"
     key: ClassVar[str] = "coulomb"
     label: ClassVar[str] = "Coulomb friction"
     reference: ClassVar[str] = "docs/friction.md"
@@ -144,6 +162,11 @@ class Friction:
         choice_option("restitution", self.restitution, RESTITUTIONS, owner=owner)
         choice_option("stress", self.stress, STRESSES, owner=owner)
         choice_option("blend", self.blend, BLEND_CHOICES, owner=owner)
+        choice_option("tangential_stress", self.tangential_stress, TANGENTIAL_STRESSES, owner=owner)
+        if self.tangential_stress != "none" and self.restitution == "chialvo-sundaresan-2013":
+            raise InputError(f"option tangential_stress = {self.tangential_stress!r} of friction needs a restitution law "
+                             "with tangential impulses (walton, rough-sphere; got 'chialvo-sundaresan-2013', an "
+                             "effective restitution): set tangential_stress = 'none' with it")
         real_option("regularisation", self.regularisation, owner=owner, low=0.0, high=1.0,
                     why="epsilon as a fraction of the shear-rate scale")
         if self.blend_width is not None:
@@ -206,21 +229,32 @@ class Friction:
         if self.mu == 0.0:
             return 1.0
         if isinstance(self.law, WaltonRestitution):
-            if "jax" in type(e).__module__ and not _is_concrete(e):  # traced (jit): a host callback
-                import jax
-
-                e = jax.numpy.asarray(e)
-                return jax.pure_callback(self._walton_factor, jax.ShapeDtypeStruct(e.shape, e.dtype), e,
-                                         vmap_method="expand_dims")
-            return self._walton_factor(e)
+            return _per_restitution(lambda v: self.law.inelasticity(v, self.mu) / (1.0 - v**2), e)
         return self.law.inelasticity(e, self.mu) / (1.0 - e**2)
 
-    def _walton_factor(self, e: Any) -> Any:
-        values = np.asarray(e, dtype=float)
-        uniq, inverse = np.unique(values, return_inverse=True)
-        factors = np.array([self.law.inelasticity(float(v), self.mu) / (1.0 - float(v) ** 2) for v in uniq])
-        out = factors[inverse].reshape(values.shape)
-        return float(out) if out.ndim == 0 and not isinstance(e, np.ndarray) else out.astype(values.dtype)
+    def tangential_coefficients(self, e: Any, *, hcs: bool = False) -> tuple[Any, Any] | None:
+        """(share, loss) of the tangential impulses' collisional shear stress, ``None`` with ``tangential_stress = "none"``.
+
+        share = :meth:`~ktgf.closures.friction.collisions.WaltonRestitution.tangential_shear_share` multiplies the
+        local-equilibrium collisional viscosity (3/5)λ_b* into the extra Δη*; loss = (1 − f) share, f =
+        :meth:`~ktgf.closures.friction.collisions.WaltonRestitution.tangential_work_fraction`, is the part of it
+        whose work is dissipated instead of heating translation (``docs/friction.md`` §7.1).  ``hcs``: the share at
+        the homogeneous cooling state's T_rot/T (no shear, so no loss).  Python floats (0.0, 0.0) at μ = 0.
+        Evaluated per distinct e, as :meth:`zeta0_factor`.
+        """
+        if self.tangential_stress == "none":
+            return None
+        if self.mu == 0.0 or (self.restitution == "rough-sphere" and self.tangential_beta == -1.0):
+            return 0.0, 0.0
+        law, mu = self.law, self.mu
+        if isinstance(law, RoughSphereRestitution):  # constant β is Walton's rule where every collision sticks
+            law, mu = WaltonRestitution(beta0=law.beta, q=law.q), STICKING_MU
+        if hcs:
+            return _per_restitution(lambda v: law.tangential_shear_share(v, mu, law.hcs_rotational_ratio(v, mu)), e), 0.0
+        share = _per_restitution(lambda v: law.tangential_shear_share(v, mu), e)
+        loss = _per_restitution(lambda v: (1.0 - law.tangential_work_fraction(v, mu)) * law.tangential_shear_share(v, mu),
+                                e)
+        return share, loss
 
     def hcs_zeta0_factor(self, e: Any, *, missing: str = "raise") -> Any:
         """(1 − e_HCS²)/(1 − e²): the multiplier of ζ0* in the homogeneous cooling state (Python 1.0 at μ = 0).
@@ -316,9 +350,26 @@ class Friction:
 
     def describe(self) -> str:
         parts = [f"mu={self.mu:g}", self.restitution]
+        if self.tangential_stress != "none":
+            parts.append(f"tangential stress {self.tangential_stress}")
         if self.has_stress:
             parts.append(f"johnson-jackson+{self.stress}" + (f", {self.blend} blend" if self.blend != "none" else ""))
         return "coulomb(" + ", ".join(parts) + ")"
+
+
+def _per_restitution(fn: Any, e: Any) -> Any:
+    """fn(e) of a scalar-only quadrature (SciPy) at every distinct value of e, in e's shape and dtype; under
+    ``jax.jit`` (a traced e) through a host callback, so e cannot be differentiated."""
+    if "jax" in type(e).__module__ and not _is_concrete(e):
+        import jax
+
+        e = jax.numpy.asarray(e)
+        return jax.pure_callback(lambda v: _per_restitution(fn, np.asarray(v)), jax.ShapeDtypeStruct(e.shape, e.dtype),
+                                 e, vmap_method="expand_dims")
+    values = np.asarray(e, dtype=float)
+    uniq, inverse = np.unique(values, return_inverse=True)
+    out = np.array([fn(float(v)) for v in uniq])[inverse].reshape(values.shape)
+    return float(out) if out.ndim == 0 and not isinstance(e, np.ndarray) else out.astype(values.dtype)
 
 
 def _is_concrete(x: Any) -> bool:
