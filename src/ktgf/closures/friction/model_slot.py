@@ -50,7 +50,7 @@ BLEND_CHOICES: tuple[str, ...] = ("none", "tanh", "sigmoid")
 #: Collisional stress of the tangential impulses by option value (docs/friction.md §7.1; Walton, rough spheres).
 TANGENTIAL_STRESSES: tuple[str, ...] = ("none", "maxwellian")
 #: μ at which Walton's rule is the constant-β (rough-sphere) law: its T_rot/T, HCS ratio and share equal the
-#: rough-sphere closed forms to 10⁻¹⁵ there (tests/closures/test_friction_registry.py).
+#: rough-sphere closed forms to 10⁻¹³ there (tests/closures/test_friction_registry.py).
 STICKING_MU = 1e8
 
 
