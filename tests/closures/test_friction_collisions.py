@@ -237,6 +237,23 @@ def test_walton_second_order_shear_balances_match_monte_carlo():
 
 
 @pytest.mark.analytic
+def test_walton_rotational_shear_shift_matches_the_monte_carlo_steady_ratio():
+    """T_rot/T = r + c_r s² against the ratio at which the Monte Carlo's rotational energy change vanishes under
+    shear (root of the line through two ratios ±0.02 about the prediction, same samples), at the DEM's s (1.5
+    and 2.2, where the shift is 0.03–0.07); the Monte Carlo's root is good to ≈ 0.001 (its scatter at s = 1)."""
+    for e, mu, beta0 in CASES:
+        law = WaltonRestitution(beta0=beta0)
+        r0, c = law.rotational_ratio(e, mu), law.rotational_shear_shift(e, mu)
+        for s in (1.5, 2.2):
+            pred = r0 + c * s**2
+            low, high = (_sheared_walton(e, mu, beta0, pred + dr, s)["rot"] for dr in (-0.02, 0.02))
+            root = pred - 0.02 - low * 0.04 / (high - low)
+            assert root == pytest.approx(pred, abs=0.0025), (e, mu, s, root, pred)
+        assert c * 2.2**2 > 0.025  # the shift is ten times the tolerance
+    assert law.rotational_shear_shift(0.7, 0.0) == 0.0
+
+
+@pytest.mark.analytic
 def test_walton_tangential_work_fraction_limits():
     """β = 1 sticking collisions lose no tangential energy, so all the tangential work heats translation (μ → ∞
     with β0 = 1: 1); without friction there is no tangential work (NaN); between, below 1."""

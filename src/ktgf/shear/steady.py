@@ -122,7 +122,7 @@ def steady_shear(model: Model, phi: Any, e: Any, *, stress_scale: float | None =
         p_f = friction.frictional_pressure(phi, model.phi_max) / stress_scale
         tau_over_p, p_star, p_over_nT = add_frictional_stress(tau_over_p, p_star, p_over_nT, phi * T, p_f,
                                                               friction.simple_shear_stress_ratio(T))
-    rot = friction.rotational_ratio(e)
+    rot = friction.rotational_ratio(e, 1.0 / T)  # the shear measure s = γ̇d/√θ is 1/√T here
     trot = T * math.nan if rot is None else rot + 0.0 * T
     return ShearState(phi=phi + 0.0 * T, T=T, Trot_over_T=trot, p_star=p_star, tau_over_p=tau_over_p + 0.0 * T,
                       p_over_nT=p_over_nT, eta_star=ETA0_DEM * eta + 0.0 * T, eta_over_eta0=eta + 0.0 * T,

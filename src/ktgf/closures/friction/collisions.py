@@ -366,7 +366,15 @@ class WaltonRestitution(FrictionPart):
                 "tr0": -(1.0 - f) * mom[0, 0] + mom[1, 0], "tr2": -(1.0 - f) * shifted[0] + shifted[1] + (1.0 - f) * work,
                 "work2": work}
 
-    def tangential_work_fraction(self, e: Any, mu: Any, dr: float = 1e-4) -> float:
+    def _shear_expansion(self, e: float, mu: float, dr: float = 1e-4) -> tuple[float, float]:
+        """(c_r, f): the steady ratio's shift Δr = c_r s² and the tangential work fraction, both to O(s²)."""
+        r = self.rotational_ratio(e, mu)
+        b = self._shear_balances(e, mu, r)
+        up, down = self._shear_balances(e, mu, r + dr), self._shear_balances(e, mu, r - dr)
+        shift = -b["rot2"] * 2.0 * dr / (up["rot0"] - down["rot0"])
+        return shift, (b["tr2"] + (up["tr0"] - down["tr0"]) / (2.0 * dr) * shift) / b["work2"]
+
+    def tangential_work_fraction(self, e: Any, mu: Any) -> float:
         """The part of the tangential impulses' shear work that heats translation, in steady uniform shear as s → 0.
 
         Our derivation (docs/friction.md §7.1), per unit time and to O(s²), s = γ̇d/√T.  Conditioned on the contact
@@ -374,19 +382,28 @@ class WaltonRestitution(FrictionPart):
         impulse J_t = −η g_t changes the pair's translational energy by −(1 − f_r)ηρ² + η²ρ² + (1 − f_r)η g_t·δ_t
         and the rotational one by −f_r ηρ² + η²ρ²/q + f_r η g_t·δ_t, δ = −d E·k the mean contact velocity; η g_t·δ_t
         is the mean flow's work.  The shift δ of the Gaussian of g is expanded to second order (Hermite weights,
-        :func:`_walton_shear_moments`).  The rotational balance moves the steady ratio by Δr = −s² R₂/∂_r R₀, and
-        the fraction is (X₂ + ∂_r X₀ Δr/s²)/W₂: the translational change over the work, both O(s²).  The rest of
-        the work is dissipated.  0.179 at μ = 0.5, e = 0.7, β0 = 1 (Monte Carlo: 0.167–0.198 at s = 1–2.2).
-        NaN at μ = 0 (no tangential impulse, no work).
+        :func:`_walton_shear_moments`).  The rotational balance moves the steady ratio by Δr = −s² R₂/∂_r R₀
+        (:meth:`rotational_shear_shift`), and the fraction is (X₂ + ∂_r X₀ Δr/s²)/W₂: the translational change over
+        the work, both O(s²).  The rest of the work is dissipated.  0.179 at μ = 0.5, e = 0.7, β0 = 1 (Monte Carlo:
+        0.167–0.198 at s = 1–2.2).  NaN at μ = 0 (no tangential impulse, no work).
         """
         if float(mu) == 0.0:
             return math.nan
-        e, mu = float(e), float(mu)
-        r = self.rotational_ratio(e, mu)
-        b = self._shear_balances(e, mu, r)
-        up, down = self._shear_balances(e, mu, r + dr), self._shear_balances(e, mu, r - dr)
-        shift = -b["rot2"] * 2.0 * dr / (up["rot0"] - down["rot0"])
-        return (b["tr2"] + (up["tr0"] - down["tr0"]) / (2.0 * dr) * shift) / b["work2"]
+        return self._shear_expansion(float(e), float(mu))[1]
+
+    def rotational_shear_shift(self, e: Any, mu: Any) -> float:
+        """c_r in T_rot/T = r + c_r s² of steady uniform shear, s = γ̇d/√T (our derivation, docs/friction.md §7.1).
+
+        The mean strain adds −d E·k to the contact velocity, whose tangential part spins the particles up: the
+        rotational balance R(r, s) = R₀(r) + s² R₂(r) + O(s⁴) (:meth:`_shear_balances`) vanishes at
+        r + Δr with Δr = −s² R₂/∂_r R₀.  This is the same shift that :meth:`tangential_work_fraction` carries into
+        the translational energy balance, so a model with both is consistent to O(s²).  0.0139 at μ = 0.5,
+        e = 0.7, β0 = 1 (the Monte Carlo's steady ratios: 0.5007, 0.5107, 0.5617 at s = 0.5, 1, 2.2 against
+        0.5008, 0.5112, 0.5646).  0 at μ = 0.
+        """
+        if float(mu) == 0.0:
+            return 0.0
+        return self._shear_expansion(float(e), float(mu))[0]
 
     def hcs_rotational_ratio(self, e: Any, mu: Any) -> float:
         """T_rot/T of the homogeneous cooling state: both temperatures decay at the same relative rate.

@@ -72,7 +72,7 @@ class NoFriction:
         """Multiplier of ζ0* in the homogeneous cooling state: 1."""
         return 1.0
 
-    def rotational_ratio(self, e: Any) -> None:
+    def rotational_ratio(self, e: Any, shear2: Any = None) -> None:
         """T_rot/T is not modelled (no rotation): ``None``."""
         return None
 
@@ -284,13 +284,25 @@ class Friction:
         out = factors[inverse].reshape(values.shape)
         return float(out) if out.ndim == 0 and not isinstance(e, np.ndarray) else out
 
-    def rotational_ratio(self, e: Any) -> Any:
-        """T_rot/T of steady homogeneous shear (``None`` if the law does not model rotation; 0 at μ = 0)."""
+    def rotational_ratio(self, e: Any, shear2: Any = None) -> Any:
+        """T_rot/T of steady homogeneous shear (``None`` if the law does not model rotation; 0 at μ = 0).
+
+        With ``tangential_stress = "maxwellian"`` and the local shear measure's square ``shear2`` = s² =
+        (γ̇d)²/θ, the ratio carries the mean strain's O(s²) shift r + c_r s²
+        (:meth:`~ktgf.closures.friction.collisions.WaltonRestitution.rotational_shear_shift`), the shift whose
+        effect on the translational energy is already in the tangential work fraction (``docs/friction.md`` §7.1).
+        """
         if self.restitution == "chialvo-sundaresan-2013":
             return None
         if self.mu == 0.0:
             return 0.0
-        return self.law.rotational_ratio(e, self.mu)
+        ratio = self.law.rotational_ratio(e, self.mu)
+        if shear2 is None or self.tangential_stress == "none":
+            return ratio
+        law, mu = self.law, self.mu
+        if isinstance(law, RoughSphereRestitution):  # as in tangential_coefficients
+            law, mu = WaltonRestitution(beta0=law.beta, q=law.q), STICKING_MU
+        return ratio + _per_restitution(lambda v: law.rotational_shear_shift(v, mu), e) * shear2
 
     def check_state(self, e: Any) -> None:
         """Frictional dissipation at μ > 0 is written through 1/(1 − e²): e < 1 is required."""
