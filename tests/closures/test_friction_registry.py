@@ -206,6 +206,28 @@ def test_shear_cli_mu_prints_the_dem_columns():
 
 
 @pytest.mark.contract
+def test_shear_cli_says_when_a_fitted_model_is_asked_at_another_restitution():
+    """The registered fits know their restitutions (REGISTERED_FITS): dense e = 0.9, frictional's μ > 0 part e = 0.7;
+    a request elsewhere prints one note on stderr naming the fitted e, the output itself unchanged."""
+    from ktgf.calibration.registry_fits import fitted_restitutions
+
+    assert fitted_restitutions("dense", 0.0) == (0.9,) and fitted_restitutions("frictional", 0.0) == (0.9,)
+    assert fitted_restitutions("frictional", 0.25) == (0.7,) and fitted_restitutions("ret", 0.0) is None
+
+    def note(*args):
+        r = runner.invoke(app, ["shear", *args, "--phi", "0.5", "--format", "json"])
+        assert r.exit_code == 0, r.output
+        json.loads(r.stdout)  # stdout stays clean JSON
+        return r.stderr
+
+    assert "dense (mu = 0) was fitted at e = 0.9 only; e = 0.7 is a prediction" in note("--model", "dense", "--e", "0.7")
+    assert "frictional (mu = 0.5) was fitted at e = 0.7 only; e = 0.9" in note("--model", "frictional", "--e", "0.7,0.9")
+    assert "note" not in note("--model", "dense", "--e", "0.9")
+    assert "note" not in note("--model", "frictional", "--mu", "0.25", "--e", "0.7")
+    assert "note" not in note("--model", "ret", "--e", "0.7")
+
+
+@pytest.mark.contract
 @pytest.mark.parametrize(
     "extra, word",
     [

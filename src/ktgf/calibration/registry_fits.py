@@ -69,6 +69,26 @@ REGISTERED_FITS: dict[str, tuple[FitSource, ...]] = {
                    FitSource(FRICTION_SHEAR, _MU_HALF_BASE), FitSource(FRICTION_SHEAR_EXTRA, _MU_HALF_EXTRA)),
 }
 
+
+def fitted_restitutions(name: str, mu: float) -> tuple[float, ...] | None:
+    """The restitutions at which the registered model ``name`` was fitted for friction μ (``None``: no fit on record).
+
+    From :data:`REGISTERED_FITS`: frictionless states fix the μ = 0 part, frictional ones (μ > 0) the rest, so
+    ``frictional`` at μ > 0 answers with the e of its frictional states only (``ktgf shear`` says when a requested
+    e lies outside them: ``docs/friction.md`` §6.2 measures what that costs).
+    """
+    sources = REGISTERED_FITS.get(name)
+    if not sources:
+        return None
+    found: set[float] = set()
+    for src in sources:
+        if src.states is not None:
+            found |= {e for m, _, e in src.states if (m > 0.0) == (mu > 0.0)}
+        elif mu == 0.0:  # a whole frictionless file
+            found |= {float(r["e"]) for r in uniform_shear_records(shipped(src.file))}
+    return tuple(sorted(found)) or None
+
+
 #: Observables compared at every state (log-ratio residuals).
 OBSERVABLES: tuple[str, ...] = ("T", "p_over_nT", "tau_over_p")
 #: Frictionless parameters (step 1) with their starts and bounds.

@@ -99,6 +99,26 @@ def shear(
     emit(rows, fmt, title=f"{', '.join(m.label or m.name for m in ms)}: Navier–Stokes uniform shear (d = m = 1, shear rate 1)")
     if note:
         typer.echo(note, err=fmt == OutputFormat.json)
+    for line in extrapolation_notes(ms if model_file is None else ms[:-1], es):
+        typer.echo(line, err=True)
+
+
+def extrapolation_notes(models: list[Any], e: np.ndarray) -> list[str]:
+    """One line per registered fitted model asked at a restitution it was not fitted at (docs/friction.md §6.2)."""
+    from ..calibration.registry_fits import fitted_restitutions
+
+    lines = []
+    for m in models:
+        fitted = fitted_restitutions(m.name, float(m.friction.mu))
+        if fitted is None:
+            continue
+        outside = [float(q) for q in e if min(abs(float(q) - f) for f in fitted) > 0.025]
+        if outside:
+            lines.append(f"note: {m.name} (mu = {float(m.friction.mu):g}) was fitted at e = "
+                         f"{', '.join(f'{f:g}' for f in fitted)} only; e = {', '.join(f'{q:g}' for q in outside)} is a "
+                         "prediction (docs/friction.md §6.2: ktgf's own DEM runs put T, p/(nT) or tau/p up to 29 % off at mu = 0, "
+                         "e = 0.7 and up to 89 % off at mu = 0.5, e = 0.9)")
+    return lines
 
 
 def _fit_covariance(model_file: Path | None) -> tuple[list[str], Any] | None:
