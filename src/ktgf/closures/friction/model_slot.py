@@ -232,6 +232,13 @@ class Friction:
             return _per_restitution(lambda v: self.law.inelasticity(v, self.mu) / (1.0 - v**2), e)
         return self.law.inelasticity(e, self.mu) / (1.0 - e**2)
 
+    def _walton_view(self) -> tuple[Any, float]:
+        """(law, μ) whose Walton closed forms (share, f, c_r) serve this part: constant β is Walton's rule where every
+        collision sticks (β0 = β at :data:`STICKING_MU`)."""
+        if isinstance(self.law, RoughSphereRestitution):
+            return WaltonRestitution(beta0=self.law.beta, q=self.law.q), STICKING_MU
+        return self.law, self.mu
+
     def tangential_coefficients(self, e: Any, *, hcs: bool = False) -> tuple[Any, Any] | None:
         """(share, loss) of the tangential impulses' collisional shear stress, ``None`` with ``tangential_stress = "none"``.
 
@@ -246,9 +253,7 @@ class Friction:
             return None
         if self.mu == 0.0 or (self.restitution == "rough-sphere" and self.tangential_beta == -1.0):
             return 0.0, 0.0
-        law, mu = self.law, self.mu
-        if isinstance(law, RoughSphereRestitution):  # constant β is Walton's rule where every collision sticks
-            law, mu = WaltonRestitution(beta0=law.beta, q=law.q), STICKING_MU
+        law, mu = self._walton_view()
         if hcs:
             return _per_restitution(lambda v: law.tangential_shear_share(v, mu, law.hcs_rotational_ratio(v, mu)), e), 0.0
         share = _per_restitution(lambda v: law.tangential_shear_share(v, mu), e)
@@ -299,9 +304,7 @@ class Friction:
         ratio = self.law.rotational_ratio(e, self.mu)
         if shear2 is None or self.tangential_stress == "none":
             return ratio
-        law, mu = self.law, self.mu
-        if isinstance(law, RoughSphereRestitution):  # as in tangential_coefficients
-            law, mu = WaltonRestitution(beta0=law.beta, q=law.q), STICKING_MU
+        law, mu = self._walton_view()
         return ratio + _per_restitution(lambda v: law.rotational_shear_shift(v, mu), e) * shear2
 
     def check_state(self, e: Any) -> None:
