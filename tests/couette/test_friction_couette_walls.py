@@ -16,7 +16,7 @@ from helpers.friction_couette import SCALE, frictional_wall_problem, halving_cha
 
 from ktgf import get_model
 from ktgf.couette.run import Material, to_dataset
-from ktgf.couette.solver import solve
+from ktgf.couette.solver import _wall_friction_continuation, naive_start, solve
 from ktgf.errors import InputError
 
 SQ3PI = math.sqrt(3.0) * math.pi
@@ -78,6 +78,24 @@ def test_a_wall_rougher_than_the_bulk_sticks_with_a_slip_set_by_the_regularisati
     assert abs(t["slip"][0]) < 3 * pr.walls[0].slip_regularisation  # stuck: slip ~ ε_w U (U = 1)
     c = halving_changes(0.0, 0.6, 1e-3, 30.0, "srivastava-sundaresan", X)
     assert c["du"] < 1.5e-3 and c["dphi"] < 1e-4 and c["dtau"] < 4e-3
+
+
+@pytest.mark.analytic
+@pytest.mark.slow
+def test_a_wall_that_sticks_beyond_a_fold_is_reached_by_arclength_in_the_wall_friction():
+    """μ = 0, φ̄ = 0.6, Schaeffer, δ_w = 30°, continued from δ_w = 0 in s = tan δ_w / tan 30°: the sliding branch
+    ends at a turning point (s ≈ 0.94) and the stuck branch begins at another (s ≈ 0.82), an S-shaped curve.  Natural
+    steps stall at the first fold; arclength passes both and lands on the stuck wall (Coulomb: traction below
+    p_f tan δ_w, slip ~ ε_w U), which meets the wall conditions.  Before, the solver's path here depended on the BLAS
+    kernel's round-off (it failed with OpenBLAS's Haswell kernels, docs/friction.md §8)."""
+    pr = frictional_wall_problem(0.0, 0.6, 30.0, "schaeffer")
+    X, info = _wall_friction_continuation(pr, naive_start(pr), 1e-10, 60, 400, "natural")
+    assert info["path"].startswith("delta_w-continuation by arclength")
+    folds = info["wall_friction_folds"]
+    assert max(folds) < 1.0 and min(folds) < max(folds) - 0.05  # the sliding branch's end, above the stuck one's
+    t, _ = check_wall_conditions(pr, X)
+    assert abs(t["F"][0]) < t["p_frictional"][0] * math.tan(math.radians(30.0))
+    assert abs(t["slip"][0]) < 3 * pr.walls[0].slip_regularisation
 
 
 @pytest.mark.analytic

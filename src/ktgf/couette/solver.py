@@ -9,7 +9,7 @@ a single step cannot change θ or φ/(φ_max − φ) by more than a factor e^3. 
 
 When Newton fails from the naive start (uniform φ̄, linear velocity, θ of uniform shear), the
 solver first continues a frictional wall (δ_w > 0) in tan δ_w from the solution with δ_w = 0
-(itself solved by every path below; :func:`_wall_friction_continuation`), then tries
+(itself solved by every path below; :func:`_wall_friction_continuation`; by arclength past a fold), then tries
 pseudo-transient continuation, then follows homotopies from an easy problem
 (mean φ ≤ 0.3, e ≥ 0.9, specularity ≥ 0.1, no centripetal term in the annular cell) to the
 target with adaptive steps: one parameter group per stage, then all at once
@@ -375,8 +375,9 @@ def _wall_friction_continuation(problem: Problem, start: np.ndarray, tol: float,
     """Frictional walls: the cell with δ_w = 0 first (by every path of :func:`solve`), then tan δ_w from 0 to its value.
 
     Natural-parameter steps in s = tan δ_w / tan δ_w,target (adaptive, as :func:`_follow`), each a Newton solve from
-    the previous solution.  Raises :class:`CouetteConvergenceError` where a step stalls (the caller then takes the
-    generic fallbacks).
+    the previous solution.  Where they stall (a turning point: the wall goes from sliding to sticking through an
+    S-shaped curve, docs/friction.md §8) the rest is followed by pseudo-arclength continuation in s.  Raises
+    :class:`CouetteConvergenceError` if that stalls too (the caller then takes the generic fallbacks).
     """
     X, info = solve(_with_wall_friction(problem, 0.0), start, tol=tol, max_iter=max_iter, ptc_max_iter=ptc_max_iter,
                     continuation=continuation)
@@ -393,12 +394,26 @@ def _wall_friction_continuation(problem: Problem, start: np.ndarray, tol: float,
             s, X, ds = s_try, Xt, min(1.0, 1.5 * ds)
             continue
         ds *= 0.5
-        if ds < 1e-3:
-            raise CouetteConvergenceError(
-                f"continuation in the wall friction angle stalled at tan(delta_w) = {s_try:.4f} of its value: "
-                f"{rep.message}", history, Xt, sub)
+        if ds >= 1e-3:
+            continue
+        why = f"continuation in the wall friction angle stalled at tan(delta_w) = {s_try:.4f} of its value: {rep.message}"
+        if s == 0.0:  # no arclength start: ∂R/∂s is a central difference, and s < 0 is no wall
+            raise CouetteConvergenceError(why, history, Xt, sub)
+        try:
+            X, path = arclength.follow(lambda lam: _with_wall_friction(problem, lam), X, s, 1.0, lam_min=0.5 * s)
+        except arclength.ArclengthStall as exc:
+            raise CouetteConvergenceError(f"{why}; then {exc}", history, exc.X, sub) from None
+        X, rep = newton(problem, X, tol=tol)
+        history += rep.history
+        info["iterations"] += path.corrector_iterations + rep.iterations
+        steps += len(path.lam) - 1 + path.rejected_steps
+        if not rep.converged:
+            raise CouetteConvergenceError(f"{why}; the arclength path reached tan(delta_w) but Newton did not polish it "
+                                          f"({rep.message})", history, X, problem)
+        info["wall_friction_folds"] = path.folds  # the values of s at the turning points passed
+        break
     info.update(continuation_steps=info.get("continuation_steps", 0) + steps, residual=relative_residual(problem, X),
-                path=f"delta_w-continuation ({info['path']} at delta_w = 0)", method="wall-friction continuation")
+                path=f"delta_w-continuation{' by arclength' if 'wall_friction_folds' in info else ''} ({info['path']} at delta_w = 0)", method="wall-friction continuation")
     return X, info
 
 
