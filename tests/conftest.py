@@ -25,6 +25,21 @@ REFERENCE_LABELS = ("published", "analytic", "dem", "regression", "contract")
 LISTED = 20
 
 
+def _start_the_longest_tests_first(config, items) -> None:
+    """With ``--dist load`` (CI's slow step), start the longest tests first: ``@pytest.mark.slow(minutes=…)``
+    (worker-minutes on 2 idle cores) sorts a test ahead of the others, longest first, so that pytest-xdist hands
+    them out in turn and its workers finish together instead of one running a 6-minute test alone at the end
+    (tests/README.md, "What CI runs").  Not with the default ``worksteal``, which gives each worker a contiguous
+    block of the list (the long tests would all go to one worker).  ``-m`` deselection keeps this order."""
+    if config.getoption("dist", default="no") != "load":
+        return
+
+    def minutes(item) -> float:
+        return max((m.kwargs.get("minutes", 0.0) for m in item.iter_markers("slow")), default=0.0)
+
+    items.sort(key=lambda item: -minutes(item))  # stable: the rest keep their order
+
+
 @pytest.hookimpl(tryfirst=True)  # before ``-m`` deselects: the rule holds for slow tests too
 def pytest_collection_modifyitems(config, items) -> None:
     """Fail the collection when a test has no reference label or more than one.
@@ -48,6 +63,7 @@ def pytest_collection_modifyitems(config, items) -> None:
         config.hook.pytest_collectreport(
             report=pytest.CollectReport("reference labels", "failed", message, result=[]))
         items.clear()
+    _start_the_longest_tests_first(config, items)
 
 
 @pytest.fixture(scope="session")

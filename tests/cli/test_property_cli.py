@@ -112,7 +112,7 @@ def test_plot_dispersion(tmp_path_factory, phi: str, e: str, ext: str, k_max: st
     _check(args + (["--k-max", k_max] if k_max is not None else []))
 
 
-@pytest.mark.slow
+@pytest.mark.slow(minutes=1.6)
 @LONG
 @given(MODELS, VALUES, VALUES, st.one_of(st.none(), NUMBER), NUMBER, NUMBER, NUMBER)
 def test_long_fuzz(model: str, phi: str, e: str, box: str | None, theta: str, d: str, rho: str) -> None:

@@ -50,6 +50,7 @@ def test_frictional_mu05_phi05_e07(tmp_path, data_dir):
     assert not _agree(mine, ref, ("T", "Trot_over_T", "p_star", "tau_over_p", "p_over_nT", "eta_over_eta0"))
 
 
+@pytest.mark.slow(minutes=6.6)
 def test_couette_wall_stresses(tmp_path, data_dir):
     # a shorter protocol than the shared file's (40 + 30 strain units, ~7 CPU minutes): the wall stresses
     # are converged by then, the dense core's profiles are not (docs/dem.md)

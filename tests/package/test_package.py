@@ -71,7 +71,7 @@ def test_citation_and_changelog_present() -> None:
     assert f"## [{version}]" in (ROOT / "CHANGELOG.md").read_text()
 
 
-@pytest.mark.slow
+@pytest.mark.slow(minutes=1.5)
 def test_wheel_installs_into_fresh_venv(wheel: Path, tmp_path: Path) -> None:
     """`pip install ktgf-*.whl` (with its dependencies) in a new venv, then import and run the CLI, and
     ``ktgf reproduce --quick`` outside any checkout: a complete report with every DEM comparison (~3 min)."""

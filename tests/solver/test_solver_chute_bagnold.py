@@ -74,7 +74,7 @@ def _deep_run(depth_d: float) -> dict:
             "err": compare_chute(h, sim.phys, sim.grid, sim.phi0, n_cells=fine)["max_rel_error"]}
 
 
-@pytest.mark.slow
+@pytest.mark.slow(minutes=2.6)
 def test_deep_3d_layers_follow_the_1d_solver_towards_bagnold():
     """3D runs (1D grid, 1 cell per d, SSP-RK3, steady_tol 1e-4) at 57.6 and 72 d, 18°, from a
     Bagnold-scaled linear start: u(H) within 0.5 % and the u profile within 1 % of the 1D solver

@@ -138,7 +138,7 @@ def test_couette_3d_perturbation_measure() -> None:
 
 
 @pytest.mark.analytic
-@pytest.mark.slow
+@pytest.mark.slow(minutes=1.9)
 def test_the_dense_couette_chain_to_3d_reaches_the_1d_solver_from_a_uniform_start(tmp_path, monkeypatch) -> None:
     """The shipped chain examples/couette_dense_3d.toml (φ̄ 0.5; `ktgf run` runs the 4 × 64 × 4 slab of
     couette_dense.toml first, from a uniform start, then the cube with implicit acoustics and sink), with the cube

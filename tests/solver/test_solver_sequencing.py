@@ -319,7 +319,7 @@ def test_the_sequencing_examples_chain_their_output_folders() -> None:
 
 
 @pytest.mark.analytic
-@pytest.mark.slow
+@pytest.mark.slow(minutes=4.7)
 def test_the_sequenced_dense_couette_at_128_cells_reaches_the_1d_solver_within_one_percent(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """φ̄ 0.55, 32 → 64 → 128 cells across the 10 d gap (the three examples as shipped, run from one

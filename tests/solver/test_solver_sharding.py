@@ -102,7 +102,7 @@ print(json.dumps(out))
 """
 
 
-@pytest.mark.slow
+@pytest.mark.slow(minutes=1.4)
 def test_sharded_lees_edwards_and_wall_cases_match_single_device() -> None:
     """The sheared and gravity cases on two devices: the Lees–Edwards image shift rolls along the sharded axis;
     the chute's body force and bumpy base split along the periodic flow axis."""
