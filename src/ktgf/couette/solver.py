@@ -396,7 +396,8 @@ def _wall_friction_continuation(problem: Problem, start: np.ndarray, tol: float,
         ds *= 0.5
         if ds >= 1e-3:
             continue
-        why = f"continuation in the wall friction angle stalled at tan(delta_w) = {s_try:.4f} of its value: {rep.message}"
+        why = (f"continuation in the wall friction angle stalled at tan(delta_w) = {s_try:.4f} of its value: "
+               f"{rep.message}")
         if s == 0.0:  # no arclength start: ∂R/∂s is a central difference, and s < 0 is no wall
             raise CouetteConvergenceError(why, history, Xt, sub)
         try:
@@ -412,8 +413,9 @@ def _wall_friction_continuation(problem: Problem, start: np.ndarray, tol: float,
                                           f"({rep.message})", history, X, problem)
         info["wall_friction_folds"] = path.folds  # the values of s at the turning points passed
         break
+    how = " by arclength" if "wall_friction_folds" in info else ""
     info.update(continuation_steps=info.get("continuation_steps", 0) + steps, residual=relative_residual(problem, X),
-                path=f"delta_w-continuation{' by arclength' if 'wall_friction_folds' in info else ''} ({info['path']} at delta_w = 0)", method="wall-friction continuation")
+                path=f"delta_w-continuation{how} ({info['path']} at delta_w = 0)", method="wall-friction continuation")
     return X, info
 
 
