@@ -338,29 +338,44 @@ def _follow(problem: Problem, stages: list[dict[str, Any]], history: list, tol: 
     return X, total_it, steps, folds, arclength_stages
 
 
-def _arclength_stage(problem: Problem, a: dict[str, Any], b: dict[str, Any], s: float, X: np.ndarray,
-                     history: list, tol: float, why: str = ""):
-    """Pseudo-arclength continuation of one homotopy stage from its fraction s to 1, polished by Newton."""
+def _arclength_then_newton(problem_at, end: Problem, X: np.ndarray, s: float, lam_min: float, history: list,
+                           tol: float, stalled, unpolished):
+    """Pseudo-arclength continuation of ``problem_at(λ)`` from λ = s to 1, then Newton on ``end`` (the problem at 1).
+
+    ``stalled(exc)`` builds the error raised when the path stalls; ``unpolished(report)`` the message when Newton
+    does not converge at the end.  Returns the solution and the path (its corrector count includes the polish).
+    """
     try:
-        X, path = arclength.follow(lambda lam: _staged_problem(problem, _interpolate(a, b, lam)), X, s, 1.0,
-                                   lam_min=0.0)
+        X, path = arclength.follow(problem_at, X, s, 1.0, lam_min=lam_min)
     except arclength.ArclengthStall as exc:
-        last = _staged_problem(problem, _interpolate(a, b, exc.lam))
-        _, theta, phi = last.unpack(exc.X)
-        raise CouetteConvergenceError(
-            f"Couette continuation failed: {why}{exc} (there: mean phi {last.mean_phi:.4f}, e {last.e:.4f}, "
-            f"specularity {[round(w.specularity, 5) for w in last.walls]}; the last point has max phi = "
-            f"phi_max - {last.phi_max - float(phi.max()):.2g} and min theta = {float(theta.min()):.2g} V^2)",
-            history, exc.X, last) from None
-    end = _staged_problem(problem, b)
+        raise stalled(exc) from None
     Xn, rn = newton(end, X, tol=tol)
     history += rn.history
     path.corrector_iterations += rn.iterations
     if not rn.converged:
-        raise CouetteConvergenceError(
-            f"Couette continuation: the arclength path reached the end of the stage but Newton did not polish it "
-            f"({rn.message}; relative residual {rn.residual:.3g})", history, Xn, end)
+        raise CouetteConvergenceError(unpolished(rn), history, Xn, end)
     return Xn, path
+
+
+def _arclength_stage(problem: Problem, a: dict[str, Any], b: dict[str, Any], s: float, X: np.ndarray,
+                     history: list, tol: float, why: str = ""):
+    """Pseudo-arclength continuation of one homotopy stage from its fraction s to 1, polished by Newton."""
+    def stage(lam):
+        return _staged_problem(problem, _interpolate(a, b, lam))
+
+    def stalled(exc):
+        last = stage(exc.lam)
+        _, theta, phi = last.unpack(exc.X)
+        return CouetteConvergenceError(
+            f"Couette continuation failed: {why}{exc} (there: mean phi {last.mean_phi:.4f}, e {last.e:.4f}, "
+            f"specularity {[round(w.specularity, 5) for w in last.walls]}; the last point has max phi = "
+            f"phi_max - {last.phi_max - float(phi.max()):.2g} and min theta = {float(theta.min()):.2g} V^2)",
+            history, exc.X, last)
+
+    return _arclength_then_newton(
+        stage, _staged_problem(problem, b), X, s, 0.0, history, tol, stalled,
+        lambda rn: (f"Couette continuation: the arclength path reached the end of the stage but Newton did not "
+                    f"polish it ({rn.message}; relative residual {rn.residual:.3g})"))
 
 
 def _with_wall_friction(problem: Problem, s: float) -> Problem:
@@ -400,17 +415,12 @@ def _wall_friction_continuation(problem: Problem, start: np.ndarray, tol: float,
                f"{rep.message}")
         if s == 0.0:  # no arclength start: ∂R/∂s is a central difference, and s < 0 is no wall
             raise CouetteConvergenceError(why, history, Xt, sub)
-        try:
-            X, path = arclength.follow(lambda lam: _with_wall_friction(problem, lam), X, s, 1.0, lam_min=0.5 * s)
-        except arclength.ArclengthStall as exc:
-            raise CouetteConvergenceError(f"{why}; then {exc}", history, exc.X, sub) from None
-        X, rep = newton(problem, X, tol=tol)
-        history += rep.history
-        info["iterations"] += path.corrector_iterations + rep.iterations
+        X, path = _arclength_then_newton(
+            lambda lam: _with_wall_friction(problem, lam), problem, X, s, 0.5 * s, history, tol,
+            lambda exc: CouetteConvergenceError(f"{why}; then {exc}", history, exc.X, sub),
+            lambda rn: f"{why}; the arclength path reached tan(delta_w) but Newton did not polish it ({rn.message})")
+        info["iterations"] += path.corrector_iterations
         steps += len(path.lam) - 1 + path.rejected_steps
-        if not rep.converged:
-            raise CouetteConvergenceError(f"{why}; the arclength path reached tan(delta_w) but Newton did not polish it "
-                                          f"({rep.message})", history, X, problem)
         info["wall_friction_folds"] = path.folds  # the values of s at the turning points passed
         break
     how = " by arclength" if "wall_friction_folds" in info else ""
