@@ -391,3 +391,24 @@ def test_the_frictional_wall_ghost_makes_the_wall_stress_the_johnson_jackson_tra
         heat_out = kap * (P[4][c] - P[4][g]) / h
         np.testing.assert_allclose(heat_out, RHO_S * jj_dissipation(wall, phi_w, chi, theta_w) - c_jj * size**2,
                                    rtol=1e-10)
+
+
+@pytest.mark.analytic
+@pytest.mark.parametrize("mu", [0.0, 0.5])
+def test_closed_form_uniform_shear_with_a_sheared_chi_is_a_steady_state_of_the_3d_equations(mu: float) -> None:
+    """χ(φ, s) of FrictionalPowerLaw Eq. (3): the 3D cells see it through their shear measure d√(2S:S)/√θ, and
+    the closed form of ``ktgf shear`` (a fixed point in s) is their steady state, with its pressure."""
+    m = get_model("frictional", mu=mu, shear_amplitude=0.4)
+    assert m.shear_dependent
+    grid = _shear_grid(8)
+    phys = _physics(m, "uniform-shear", grid)
+    theta, tau, p = _closed_form(m, 0.5)
+    U = add_base_flow(conservative(jnp.full(grid.cells, RHO_S * 0.5), jnp.zeros((3, *grid.cells)),
+                                   jnp.full(grid.cells, theta)), grid)
+    dU = [np.asarray(x) for x in jax.jit(rhs)(tuple(U), grid, phys, Numerics(), 0.21)]
+    assert np.max(np.abs(dU[4])) < 1e-10 * tau * RATE
+    P = np.asarray(stress_tensor(U, 0.0, grid, phys))
+    np.testing.assert_allclose(-P[3], tau, rtol=1e-10)
+    np.testing.assert_allclose(P[:3], p, rtol=1e-10)
+    # and the sheared χ is seen: without it the pressure differs by far more than the tolerance
+    assert abs(_closed_form(m.with_options(shear_amplitude=0.0), 0.5)[2] / p - 1.0) > 0.05

@@ -36,6 +36,7 @@ from ..closures.models import Model
 from ..data import (
     FRICTION_SHEAR,
     FRICTION_SHEAR_EXTRA,
+    HCS_COOLING,
     UNIFORM_SHEAR,
     UNIFORM_SHEAR_EXTRA,
     read_friction_shear,
@@ -93,6 +94,9 @@ def fitted_restitutions(name: str, mu: float) -> tuple[float, ...] | None:
 OBSERVABLES: tuple[str, ...] = ("T", "p_over_nT", "tau_over_p")
 #: Frictionless parameters (step 1) with their starts and bounds.
 FRICTIONLESS_PARAMETERS = {"a": (0.3, 0.0, 5.0), "exponent": (1.5, 0.5, 4.0), "c": (1.0, 0.05, 5.0)}
+#: Step 1 with the sheared χ (Eq. (3) of FrictionalPowerLaw): start, lower, upper of a, b, c and A.
+SHEARED_PARAMETERS = {**FRICTIONLESS_PARAMETERS, "a": (0.05, 0.0, 5.0), "exponent": (2.0, 0.5, 4.0),
+                      "shear_amplitude": (0.3, 0.0, 20.0)}
 #: Frictional parameters (step 2): μ_Z's lower bound is raised to keep every fitted state below φ_J(μ).
 FRICTIONAL_PARAMETERS = {"mu_scale": (0.6, 0.01, 50.0), "amplitude_growth": (3.0, 0.0, 100.0)}
 
@@ -127,10 +131,11 @@ def subset(states: dict[str, np.ndarray], keep: Any) -> dict[str, np.ndarray]:
 
 
 def family_model(name: str = "family", *, mu: float = 0.0, a: float, exponent: float, c: float, mu_scale: float = 0.1,
-                 amplitude_growth: float = 0.0) -> Model:
-    """The one family at friction μ: RET × FrictionalPowerLaw χ × EKT length (c) × Walton (β0 = 1) with the
-    tangential impulses' collisional stress if μ > 0."""
-    rdf = FrictionalPowerLaw(mu=mu, a=a, exponent=exponent, mu_scale=mu_scale, amplitude_growth=amplitude_growth)
+                 amplitude_growth: float = 0.0, shear_amplitude: float = 0.0) -> Model:
+    """The one family at friction μ: RET × FrictionalPowerLaw χ (sheared part A = ``shear_amplitude``) × EKT length (c)
+    × Walton (β0 = 1) with the tangential impulses' collisional stress if μ > 0."""
+    rdf = FrictionalPowerLaw(mu=mu, a=a, exponent=exponent, mu_scale=mu_scale, amplitude_growth=amplitude_growth,
+                             shear_amplitude=shear_amplitude)
     model = Model(name, GarzoDufty1999(), rdf, dissipation=CorrelationLength(c=c))
     return model.replace(friction=Friction(**FAMILY_FRICTION, mu=mu)) if mu > 0.0 else model
 
@@ -201,6 +206,44 @@ def fit_frictionless(states: dict[str, np.ndarray] | None = None, *, hold: dict[
     return _result(names, sol, cov, sd, states, params)
 
 
+def cooling_states(path: Any = None) -> dict[str, np.ndarray]:
+    """φ, e and p/(nT) of the homogeneous cooling states (default: the shipped ``dem_hcs_cooling.csv``)."""
+    import csv
+
+    with open(path or shipped(HCS_COOLING), newline="") as fh:
+        rows = list(csv.DictReader(line for line in fh if not line.startswith("#")))
+    return {k: np.array([float(r[k]) for r in rows]) for k in ("phi", "e", "p_over_nT")}
+
+
+def cooling_log_errors(params: dict[str, float], cooling: dict[str, np.ndarray]) -> np.ndarray:
+    """ln(model/DEM) of p/(nT) = 1 + 2(1 + e)φχ(φ) in the cooling states: χ without shear (there is none)."""
+    rdf = FrictionalPowerLaw(a=params["a"], exponent=params["exponent"])
+    phi, e = cooling["phi"], cooling["e"]
+    return np.log((1.0 + 2.0 * (1.0 + e) * phi * rdf.chi(phi)) / cooling["p_over_nT"])
+
+
+def fit_sheared_structure(states: dict[str, np.ndarray] | None = None, cooling: dict[str, np.ndarray] | None = None, *,
+                          hold: dict[str, float] | None = None) -> Fit:
+    """Step 1 with the sheared χ: a, b, c and A on the frictionless uniform shear and the cooling states' p/(nT).
+
+    The cooling states (no shear, φ ≤ 0.4) fix χ without shear; the shear states at e = 0.9 its sheared part
+    (``docs/dense_physics.md`` §8).  ``Fit.residuals`` are those of the shear states; ``n_points`` counts both.
+    """
+    states = frictionless_states() if states is None else states
+    cooling = cooling_states() if cooling is None else cooling
+    hold = dict(hold or {})
+    names, start, lower, upper = _free(SHEARED_PARAMETERS, hold)
+
+    def params(x: np.ndarray) -> dict[str, float]:
+        return {**hold, **dict(zip(names, x))}
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        return np.concatenate([log_errors(params(x), states).ravel(), cooling_log_errors(params(x), cooling)])
+
+    sol, cov, sd = _least_squares(residual, names, start, lower, upper)
+    return _result(names, sol, cov, sd, states, params)
+
+
 def _lowest_mu_scale(states: dict[str, np.ndarray]) -> float:
     """The μ_Z below which φ_J(μ) would fall under a fitted state's φ (the data say those states flow)."""
     law = CoordinationJamming()
@@ -227,7 +270,7 @@ def fit_frictional(frictionless: dict[str, float], states: dict[str, np.ndarray]
     if "mu_scale" in names:
         lower[0] = max(lower[0], _lowest_mu_scale(states) * (1.0 + 1e-6) + 1e-9)
         start[0] = min(max(start[0], lower[0] * 1.5), upper[0])
-    base = {**{k: frictionless[k] for k in FRICTIONLESS_PARAMETERS}, **hold}
+    base = {**{k: frictionless[k] for k in SHEARED_PARAMETERS if k in frictionless}, **hold}
 
     def params(x: np.ndarray) -> dict[str, float]:
         return {**base, **dict(zip(names, x))}

@@ -51,8 +51,9 @@ from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
-from .._array import namespace
+from .._array import namespace, power
 from ..errors import InputError
+from .coefficients import SHEAR_PER_ASTAR
 from .friction._part import FrictionPart, check_friction_coefficient, check_range
 from .friction.jamming import JammingFraction, with_jamming_fraction
 from .rdf import RadialDistribution, jamming_power_chi, jamming_power_dchi
@@ -268,6 +269,17 @@ class FrictionalPowerLaw(RadialDistribution):
     calibration parameters of the registered models (``docs/dense.md``, ``docs/friction.md``); the form of
     a(μ) between μ = 0 and the one frictional μ of the shared data (0.5) is our choice, not a fit.
 
+    Under shear the amplitude gains a part proportional to the reduced shear rate a* = γ̇/ν0 = s/(k0 φ)
+    (s = dγ̇/√θ, k0 = 96/(5√π); ``docs/dense_physics.md`` §8):
+
+        χ(φ, s) = χ(φ) + A a* (1 + k s(μ)) φ²/(φ_J(μ) − φ)^b                                          (3)
+
+    A (``shear_amplitude``, default 0: no shear dependence) is our calibration parameter: the mean shear
+    brings neighbours into contact at a rate ∝ γ̇ besides the thermal rate ∝ √θ/d, which raises the
+    collision frequency, i.e. the effective contact value, by a part ∝ γ̇d/√θ.  With A > 0 the sheared
+    χ holds only where a shear measure is given (:meth:`shear_chi`; ``Model.reduced(shear=...)``):
+    the homogeneous cooling state keeps χ(φ).
+
     Parameters
     ----------
     mu : float
@@ -278,6 +290,8 @@ class FrictionalPowerLaw(RadialDistribution):
         μ_Z of the contact-number law (default 0.1).
     amplitude_growth : float
         k of Eq. (2) (≥ 0; default 0: the amplitude does not depend on μ).
+    shear_amplitude : float
+        A of Eq. (3) (≥ 0; default 0: χ does not depend on the shear).
     """
 
     mu: float = 0.0
@@ -285,6 +299,7 @@ class FrictionalPowerLaw(RadialDistribution):
     exponent: float = 1.5
     mu_scale: float = 0.1
     amplitude_growth: float = 0.0
+    shear_amplitude: float = 0.0
     key: ClassVar[str] = "frictional-power-law"
     label: ClassVar[str] = "CS + power law at φ_J(μ)"
     reference: ClassVar[str] = ("Chialvo & Sundaresan, Phys. Fluids 25, 070603 (2013) (form); φ_J(μ): "
@@ -299,6 +314,8 @@ class FrictionalPowerLaw(RadialDistribution):
         real_option("exponent", self.exponent, owner=owner, low=0.0, high=10.0, low_open=True,
                     why="divergence exponent, at most 10")
         real_option("amplitude_growth", self.amplitude_growth, owner=owner, low=0.0, low_open=False, why="k of a(mu) = a (1 + k s(mu))")
+        real_option("shear_amplitude", self.shear_amplitude, owner=owner, low=0.0, low_open=False,
+                    why="A of the sheared amplitude A a* (1 + k s(mu))")
         _ = self.jamming_law  # validates mu_scale
 
     @property
@@ -332,3 +349,22 @@ class FrictionalPowerLaw(RadialDistribution):
 
     def dchi(self, phi: Any) -> Any:
         return jamming_power_dchi(phi, self.amplitude, self.phi_c, self.exponent)
+
+    @property
+    def shear_dependent(self) -> bool:
+        """Whether χ depends on the shear measure (A > 0; a JAX-valued A counts as shear dependent)."""
+        return not (isinstance(self.shear_amplitude, (int, float)) and self.shear_amplitude == 0.0)
+
+    def _shear_scale(self, shear: Any) -> Any:
+        # A (1 + k s(μ)) a* φ = A (1 + k s(μ)) s/k0: the sheared amplitude of Eq. (3) times φ
+        return self.shear_amplitude * (1.0 + self.amplitude_growth * self.friction_share) * shear / SHEAR_PER_ASTAR
+
+    def shear_chi(self, phi: Any, shear: Any) -> Any:
+        """The sheared part of Eq. (3), A a* (1 + k s(μ)) φ²/(φ_J − φ)^b, at shear measure s = dγ̇/√θ."""
+        return self._shear_scale(shear) * phi / power(self.phi_c - phi, self.exponent)
+
+    def shear_dchi(self, phi: Any, shear: Any) -> Any:
+        """∂/∂φ of :meth:`shear_chi` at fixed s."""
+        gap = self.phi_c - phi
+        return self._shear_scale(shear) * (1.0 / power(gap, self.exponent)
+                                           + self.exponent * phi / power(gap, self.exponent + 1.0))

@@ -130,15 +130,18 @@ class Model:
         check_state(phi, e, theta, phi_max=self.phi_max, rdf_name=self.rdf.describe())
         self.friction.check_state(e)
 
-    def reduced(self, phi: Any, e: Any, *, check: bool = True, shear: Any = None, hcs: bool = False) -> Reduced:
+    def reduced(self, phi: Any, e: Any, *, check: bool = True, shear: Any = None, hcs: bool = False,
+                chi_shear: Any = None) -> Reduced:
         """Reduced coefficients at solid fraction φ and restitution e (broadcast together).
 
         Works on NumPy arrays and on JAX arrays (also under ``jit``/``grad``, where the range
         check is skipped).  Raises :class:`~ktgf.errors.InputError` for φ outside
         [0, phi_max), e outside (0, 1] or NaN.  ``shear`` is the local shear measure dγ̇/√θ,
-        used only by a dissipation correction (extended kinetic theory); without it ζ0 is the
-        theory's own.  g and C always refer to the theory's own ζ0 and p* (they serve the HCS,
-        where there is no shear).
+        used by a dissipation correction (extended kinetic theory) and by a shear-dependent RDF
+        (χ(φ, s), e.g. ``FrictionalPowerLaw(shear_amplitude=...)``); without it ζ0 and χ are the
+        theory's own.  ``chi_shear`` gives the RDF a shear measure alone (the closed form of steady uniform
+        shear applies the dissipation correction itself).  g and C always refer to the theory's own ζ0
+        and p* (they serve the HCS, where there is no shear).
 
         ``hcs=True`` gives the homogeneous cooling state's coefficients (``docs/friction.md`` §7): the
         friction part's HCS dissipation (rotation at its HCS ratio, :meth:`Friction.hcs_zeta0_factor`)
@@ -147,11 +150,14 @@ class Model:
         """
         if check:
             self.check(phi, e)
-        if hcs and shear is not None:
+        if hcs and (shear is not None or chi_shear is not None):
             raise InputError("the homogeneous cooling state has no shear: give shear = None with hcs = True")
         phi, e_host = asarray(phi), asarray(e)
         e = like(e_host, phi)  # a static (host) e: in the cells' precision
         chi, dchi = self.rdf.chi(phi), self.rdf.dchi(phi)
+        structure = shear if chi_shear is None else chi_shear
+        if structure is not None and getattr(self.rdf, "shear_dependent", False):
+            chi, dchi = chi + self.rdf.shear_chi(phi, structure), dchi + self.rdf.shear_dchi(phi, structure)
         r = self.theory.reduced(phi, e, chi, dchi)
         zeta0 = r.zeta0 * self.dissipation.factor(phi, e, chi, shear)
         eta = r.eta
@@ -170,10 +176,10 @@ class Model:
 
     @property
     def shear_dependent(self) -> bool:
-        """Whether ζ0 depends on the local shear measure dγ̇/√θ (``reduced(shear=...)``): a dissipation correction
-        (EKT length) or the lost work of the tangential impulses' stress."""
+        """Whether the coefficients depend on the local shear measure dγ̇/√θ (``reduced(shear=...)``): a dissipation
+        correction (EKT length), the lost work of the tangential impulses' stress, or a shear-dependent χ."""
         tangential = self.friction.mu > 0.0 and getattr(self.friction, "tangential_stress", "none") != "none"
-        return self.dissipation.key != "none" or tangential
+        return self.dissipation.key != "none" or tangential or getattr(self.rdf, "shear_dependent", False)
 
     def tangential_work_loss(self, e: Any, lambda_b: Any) -> Any:
         """Δη*_loss = (1 − f) share (3/5)λ_b*: the part of the tangential impulses' viscosity whose work is dissipated
@@ -200,9 +206,12 @@ class Model:
             check_positive("material density rho_s", rho_s, "kg/m^3")
         return to_dimensional(self.reduced(phi, e, check=False, shear=shear, hcs=hcs), asarray(phi), theta, d, rho_s)
 
-    def chi(self, phi: Any) -> Any:
-        """The model's radial distribution function χ(φ)."""
-        return self.rdf.chi(asarray(phi))
+    def chi(self, phi: Any, shear: Any = None) -> Any:
+        """The model's radial distribution function χ(φ), or χ(φ, s) at shear measure s if its RDF depends on it."""
+        phi = asarray(phi)
+        if shear is None or not getattr(self.rdf, "shear_dependent", False):
+            return self.rdf.chi(phi)
+        return self.rdf.chi(phi) + self.rdf.shear_chi(phi, shear)
 
     def replace(self, **changes: Any) -> Model:
         """A copy with fields replaced, e.g. ``model.replace(rdf=Torquato())``."""

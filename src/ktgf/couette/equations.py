@@ -150,10 +150,11 @@ class Problem:
         w = self.geometry.angular(u, self.x)
         dw = np.diff(w)
         shear = None
-        if self.model.shear_dependent:  # EKT, tangential stress: ζ0 at the nodes sees the local dγ̇/√θ
+        if self.model.shear_dependent:  # EKT, tangential stress: ζ0 at the nodes sees the local dγ̇/√θ;
+            # a shear-dependent χ: p, ζ0 at the nodes and η, κ at the faces see it
             rate = np.abs(self.A / self.geometry.stress_metric(self.xf) * dw / self.dx)  # face shear rates
             node_rate = np.concatenate([rate[:1], 0.5 * (rate[1:] + rate[:-1]), rate[-1:]])
-            shear = np.concatenate([node_rate / np.sqrt(theta), np.zeros(n - 1)])
+            shear = np.concatenate([node_rate / np.sqrt(theta), rate / np.sqrt(theta_f)])
         c = self.model.coefficients(
             np.concatenate([phi, phi_f]), self.e, np.concatenate([theta, theta_f]), d=1.0, rho_s=1.0, check=False,
             shear=shear,
@@ -166,7 +167,7 @@ class Problem:
         E = self.B * (c.kappa[face] * np.diff(theta) + c.omega[face] * np.diff(phi)) / self.dx
         P = F_kinetic * dw  # frictional work is dissipated at the contacts (frictional_stress.py)
         gamma = 1.5 * phi * theta * c.zeta0[node]
-        chi_w = self.model.chi(phi[[0, -1]])
+        chi_w = self.model.chi(phi[[0, -1]], None if shear is None else shear[[0, n - 1]])
         p = c.p[node] + p_fric
         F_wall = np.zeros(2)
         E_wall = np.zeros(2)
@@ -241,9 +242,13 @@ class Problem:
         R0m = R0.reshape(n, N_VARS)
         Xm = X.reshape(n, N_VARS)
         inv_row = (n - 1) * N_VARS + 2
+        # a residual row sees the nodes within `reach` of its own: 1, but 2 with a shear-dependent χ (p at a node
+        # then depends on the velocities of its neighbours, and the rows next to it see that p)
+        reach = 2 if getattr(self.model.rdf, "shear_dependent", False) else 1
+        offsets = (*range(-reach, reach + 1), "walls") if reach == 1 else tuple(range(-reach, reach + 1))
         for k in range(N_VARS):
-            for colour in range(3):
-                j = np.arange(colour, n, 3)
+            for colour in range(2 * reach + 1):
+                j = np.arange(colour, n, 2 * reach + 1)
                 h = self.fd_step * (1.0 + np.abs(Xm[j, k]))
                 Xp = Xm.copy()
                 Xp[j, k] += h
@@ -253,7 +258,7 @@ class Problem:
                     dR = 0.5 * (self.residual(Xp.ravel()) - self.residual(Xn.ravel())).reshape(n, N_VARS)
                 else:
                     dR = self.residual(Xp.ravel()).reshape(n, N_VARS) - R0m
-                for off in (-1, 0, 1, "walls"):
+                for off in offsets:
                     if off == "walls":  # wall rows also see the third node (one-sided wall gradients)
                         i = np.where(j == 2, 0, np.where(j == n - 3, n - 1, -1))
                     else:

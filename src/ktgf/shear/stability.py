@@ -109,10 +109,11 @@ def shear_base_state(model: Any, phi: float, e: float, shear_rate: float, *, d: 
     check_positive("material density rho_s", rho_s, "kg/m^3")
     if model.shear_dependent:
         what = (f"dissipation {model.dissipation.key!r}" if model.dissipation.key != "none"
+                else "radial distribution (shear_amplitude > 0)" if getattr(model.rdf, "shear_dependent", False)
                 else "sink of the tangential stress (friction option tangential_stress)")
         raise InputError(f"model {model.name!r} has the shear-dependent {what}; the uniform-shear stability analysis "
-                         "supports models whose cooling does not depend on the shear (dissipation 'none', "
-                         "tangential_stress 'none')")
+                         "supports models whose coefficients do not depend on the shear (dissipation 'none', "
+                         "tangential_stress 'none', shear_amplitude 0)")
     theta = float(steady_temperature(model, phi, e)) * (shear_rate * d) ** 2
     c = model.coefficients(phi, e, theta, d=d, rho_s=rho_s)
     r = model.reduced(phi, e)

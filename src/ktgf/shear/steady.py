@@ -65,17 +65,33 @@ def _solve(model: Any, phi: Any, e: Any, check: bool = True) -> tuple[Any, Any, 
     tracers have no value to check) ``jax.jacfwd`` differentiates it exactly (used by calibration).
     """
     phi, e = asarray(phi), asarray(e)
-    xp = namespace(phi, e)
     r = model.reduced(phi, e, check=check)
+    a, length = _balance(model, phi, e, r, None)
+    if getattr(model.rdf, "shear_dependent", False):
+        # χ(φ, s) with s = dγ̇/√θ = k0 φ a*: the balance's a* moves χ, which moves a*; a fixed point, contracting
+        # (docs/dense_physics.md §8), iterated a fixed number of times so that JAX traces it
+        for _ in range(STRUCTURE_ITERATIONS):
+            s = SHEAR_PER_ASTAR * phi * a
+            r = model.reduced(phi, e, check=False, chi_shear=s)
+            a, length = _balance(model, phi, e, r, s)
+    return r, a, length, r.eta
+
+
+#: Fixed-point iterations of steady uniform shear with a shear-dependent χ (converged to round-off: tested).
+STRUCTURE_ITERATIONS = 40
+
+
+def _balance(model: Any, phi: Any, e: Any, r: Any, chi_shear: Any) -> tuple[Any, Any]:
+    """(a*, L/d) from the energy balance (3/2)ζ0 d/L = (η* − Δη*_loss) a*² with the EKT length L/d = max(1, Λ k0 φ a*)."""
+    xp = namespace(phi, e)
     a0 = (1.5 * r.zeta0 / (r.eta - model.tangential_work_loss(e, r.lambda_b))) ** 0.5
-    lam = model.dissipation.coefficient(phi, e, model.chi(phi))
+    lam = model.dissipation.coefficient(phi, e, model.chi(phi, chi_shear))
     k = SHEAR_PER_ASTAR * phi
     x = lam * k * a0
     correlated = xp.isfinite(x) & (x > 1.0)
     safe = xp.where(correlated, lam * k, 1.0)
     a = xp.where(correlated, (a0**2 / safe) ** (1.0 / 3.0), a0)
-    length = xp.where(correlated, lam * k * a, 1.0)
-    return r, a, length, r.eta
+    return a, xp.where(correlated, lam * k * a, 1.0)
 
 
 def steady_temperature(model: Model, phi: Any, e: Any, *, check: bool = True) -> Any:
