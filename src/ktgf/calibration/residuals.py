@@ -66,8 +66,8 @@ def shear_prediction(model: Model, data: UniformShearData, *, traced: bool = Fal
     else:
         xp = np
     phi, e = xp.asarray(data.phi), xp.asarray(data.e)
-    r = model.reduced(phi, e, check=False)
     T = steady_temperature(model, phi, e, check=not traced)
+    r = model.reduced(phi, e, check=False, chi_shear=1.0 / xp.sqrt(T))  # χ at the state's s = 1/√T if it has χ(φ, s)
     return xp.concatenate([T, r.eta, r.p])
 
 
