@@ -167,7 +167,7 @@ class Problem:
         E = self.B * (c.kappa[face] * np.diff(theta) + c.omega[face] * np.diff(phi)) / self.dx
         P = F_kinetic * dw  # frictional work is dissipated at the contacts (frictional_stress.py)
         gamma = 1.5 * phi * theta * c.zeta0[node]
-        chi_w = self.model.chi(phi[[0, -1]], None if shear is None else shear[[0, n - 1]])
+        chi_w = self.model.chi(phi[[0, -1]])  # the wall's JJ conditions take χ(φ) (as the 3D wall ghosts do)
         p = c.p[node] + p_fric
         F_wall = np.zeros(2)
         E_wall = np.zeros(2)
