@@ -39,6 +39,7 @@ from ..data import (
     HCS_COOLING,
     UNIFORM_SHEAR,
     UNIFORM_SHEAR_EXTRA,
+    read_cooling,
     read_friction_shear,
     shipped,
     uniform_shear_records,
@@ -208,18 +209,14 @@ def fit_frictionless(states: dict[str, np.ndarray] | None = None, *, hold: dict[
 
 def cooling_states(path: Any = None) -> dict[str, np.ndarray]:
     """φ, e and p/(nT) of the homogeneous cooling states (default: the shipped ``dem_hcs_cooling.csv``)."""
-    import csv
-
-    with open(path or shipped(HCS_COOLING), newline="") as fh:
-        rows = list(csv.DictReader(line for line in fh if not line.startswith("#")))
-    return {k: np.array([float(r[k]) for r in rows]) for k in ("phi", "e", "p_over_nT")}
+    columns = read_cooling(path or shipped(HCS_COOLING))
+    return {k: np.asarray(columns[k], dtype=float) for k in ("phi", "e", "p_over_nT")}
 
 
 def cooling_log_errors(params: dict[str, float], cooling: dict[str, np.ndarray]) -> np.ndarray:
-    """ln(model/DEM) of p/(nT) = 1 + 2(1 + e)φχ(φ) in the cooling states: χ without shear (there is none)."""
-    rdf = FrictionalPowerLaw(a=params["a"], exponent=params["exponent"])
-    phi, e = cooling["phi"], cooling["e"]
-    return np.log((1.0 + 2.0 * (1.0 + e) * phi * rdf.chi(phi)) / cooling["p_over_nT"])
+    """ln(model/DEM) of p/(nT) in the cooling states: the frictionless family's p* there, χ without shear."""
+    model = family_model(a=params["a"], exponent=params["exponent"], c=params["c"])
+    return np.log(np.asarray(model.reduced(cooling["phi"], cooling["e"], hcs=True).p) / cooling["p_over_nT"])
 
 
 def fit_sheared_structure(states: dict[str, np.ndarray] | None = None, cooling: dict[str, np.ndarray] | None = None, *,
