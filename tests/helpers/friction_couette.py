@@ -14,11 +14,12 @@ from ktgf.couette.solver import solve
 SCALE = 2500.0
 
 
-def frictional_wall_problem(mu, mean_phi, angle=0.0, stress="schaeffer", eps=1e-3, n=80, e=0.7):
+def frictional_wall_problem(mu, mean_phi, angle=0.0, stress="schaeffer", eps=1e-3, n=80, e=0.7, **options):
     """The map's cell: 20 d planar, JJ walls φ' = 0.2, e_w = 0.85 with wall friction angle δ_w = ``angle`` (degrees).
 
-    ``eps`` is both the frictional viscosity's regularisation and the wall's slip regularisation ε_w."""
-    model = get_model("frictional", mu=mu, stress=stress, regularisation=eps)
+    ``eps`` is both the frictional viscosity's regularisation and the wall's slip regularisation ε_w; ``options``
+    go to the model (``frictional``)."""
+    model = get_model("frictional", mu=mu, stress=stress, regularisation=eps, **options)
     g = PlanarCell(20.0, 1.0)
     x0, x1 = g.bounds(1.0)
     w = Wall(specularity=0.2, restitution=0.85, friction_angle=angle, slip_regularisation=eps)

@@ -39,6 +39,12 @@ from .frictional_stress import frictional_terms
 from .walls import Wall, bumpy_wall_fluxes, jj_friction, jj_frictional_wall_stress, jj_heat_loss
 
 N_VARS = 3  # u, ln θ, ψ per node
+#: Relative step of the Jacobian's central differences.
+FD_STEP = 1e-5
+#: The step with a shear-dependent χ (rdf option ``shear_amplitude``), which is nonlinear in γ̇ on the scale of γ̇
+#: itself: in a creeping core (γ̇ ~ 1e-4 U/H) a step of 1e-5 U in u changes the local rate by tens of percent and
+#: the Jacobian is too inexact for Newton (tests/couette/test_couette_sheared_chi.py).
+SHEARED_CHI_FD_STEP = 1e-7
 
 
 def phi_from_psi(psi: np.ndarray, phi_max: float) -> np.ndarray:
@@ -79,7 +85,7 @@ class Problem:
     v_scale: float = 1.0
     centrifugal: float = 1.0  # multiplier of the centripetal term (1 = physics; <1 only inside a homotopy)
     central_differences: bool = True  # O(h²) Jacobian: the near-jammed states have condition numbers ~1e13
-    fd_step: float = 1e-5
+    fd_step: float | None = None  # the Jacobian's relative step (None: FD_STEP, or SHEARED_CHI_FD_STEP)
     stress_scale: float = 0.0  # ρ_s V² [Pa]: converts a frictional stress (model option stress) to solver units
 
     def __post_init__(self) -> None:
@@ -97,6 +103,8 @@ class Problem:
         self.u_wall = g.wall_velocities()
         self.walls = (self.bottom, self.top)
         self.reference_shear_rate = abs(self.u_wall[1] - self.u_wall[0]) / (x[-1] - x[0])  # U/H in V/d
+        if self.fd_step is None:
+            self.fd_step = SHEARED_CHI_FD_STEP if getattr(self.model.rdf, "shear_dependent", False) else FD_STEP
         if not 0.0 < self.mean_phi < self.phi_max:
             from ..errors import InputError
 
