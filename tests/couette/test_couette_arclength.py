@@ -143,3 +143,27 @@ def test_dem_cell_e07_every_specularity_converges():
         verdicts[round(float(spec), 5)] = bool(ds.attrs["physically_valid"])
     assert not failures, failures
     assert all(v == (s > 0.232) for s, v in verdicts.items()), verdicts
+
+
+@pytest.mark.analytic
+@pytest.mark.slow(minutes=3.0)
+def test_a_cell_whose_continuation_snakes_is_solved_by_mesh_sequencing():
+    """``frictional`` with the sheared-χ fit (μ 0.5, Schaeffer, e 0.7), φ̄ 0.57, 10 d planar cell, JJ walls φ' 0.1,
+    200 cells: continuation in φ̄ on this grid stalls among fold pairs (measured: 153 s, then the error); the last
+    fallback solves the cell on 50 cells and reaches 200 by Newton from the interpolated solution (measured 160 s
+    in all).  The state conserves what it must: inventory and energy budget."""
+    from helpers.friction_couette import SHEARED_CHI
+
+    from ktgf.couette.run import to_dataset
+
+    model = get_model("frictional", mu=0.5, stress="schaeffer", **SHEARED_CHI)
+    w = Wall(specularity=0.1, restitution=0.9)
+    material = Material(1e-3, 2500.0, 0.7)
+    pr = build_problem(model, PlanarCell(0.01, 1.0), w, w, 0.57, material, 200, 1.5)
+    X, info = solve(pr)
+    assert info["path"].startswith("mesh-sequencing (") and info["path"].endswith("on 50 cells)"), info["path"]
+    assert info["residual"] < 1e-10
+    ds = to_dataset(pr, X, material)
+    phi = pr.unpack(X)[2]
+    assert float(np.sum(pr.V * phi) / pr.V.sum()) == pytest.approx(0.57, rel=1e-10)
+    assert ds.attrs["energy_budget_relative_error"] < 1e-8

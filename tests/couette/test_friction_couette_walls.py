@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 import pytest
-from helpers.friction_couette import SCALE, frictional_wall_problem, halving_changes
+from helpers.friction_couette import SCALE, SHEARED_CHI, frictional_wall_problem, halving_changes
 
 from ktgf import get_model
 from ktgf.couette.run import Material, to_dataset
@@ -145,11 +145,6 @@ def test_frictional_wall_map_from_a_naive_start():
                         failures.append((case, str(exc)[:120]))
     assert not failures, failures
     assert refused == expected and len(refused) == 6  # φ̄ = 0.6 at μ = 0.5, both stresses, three angles
-
-
-#: The sheared-χ fit of docs/dense_physics.md §8 (not registered): frictionless structure, then friction's.
-SHEARED_CHI = {"a": 0.0, "exponent": 2.1552, "c": 0.8852, "shear_amplitude": 0.386, "mu_scale": 0.5879,
-               "amplitude_growth": 1.203}
 
 
 @pytest.mark.analytic

@@ -10,6 +10,10 @@ from ktgf.couette.equations import Problem
 from ktgf.couette.geometry import stretched_nodes
 from ktgf.couette.solver import solve
 
+#: The sheared-χ fit of docs/dense_physics.md §8 (not registered): frictionless structure, then friction's.
+SHEARED_CHI = {"a": 0.0, "exponent": 2.1552, "c": 0.8852, "shear_amplitude": 0.386, "mu_scale": 0.5879,
+               "amplitude_growth": 1.203}
+
 #: ρ_s V² [Pa] of the test cell (2500 kg/m³, V = 1 m/s): the Johnson–Jackson stress (Pa) in solver units.
 SCALE = 2500.0
 

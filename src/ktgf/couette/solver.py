@@ -17,6 +17,8 @@ target with adaptive steps: one parameter group per stage, then all at once
 solution curve; if every path stalls (a stage's step below 1e-3), each path is resumed where it
 stalled and the rest of that stage is followed by pseudo-arclength continuation
 (:mod:`ktgf.couette.arclength`), which can (``continuation="arclength"`` uses it for every stage).
+If that fails too, the last fallback is mesh sequencing (:func:`_mesh_sequenced`): the same paths on every other
+node (repeatedly, to at most 64 nodes), then Newton on each finer grid from the coarser solution.
 The fallback is the default because it leaves every case that natural steps solve on its old
 path, solution and time (docs/dense.md §5.2).  Near-jammed plug states (φ within ~1e-4 of φ_c, θ ~ 1e-8 U²) have
 Jacobian condition numbers of 1e12–1e13 and are where the solver can stop.  If it fails it raises :class:`~ktgf.errors.ConvergenceError`
@@ -429,6 +431,40 @@ def _wall_friction_continuation(problem: Problem, start: np.ndarray, tol: float,
     return X, info
 
 
+#: Mesh sequencing coarsens a grid (every other node) down to at most this many nodes.
+COARSEST_NODES = 64
+
+
+def _mesh_sequenced(problem: Problem, tol: float, max_iter: int, ptc_max_iter: int,
+                    continuation: str) -> tuple[np.ndarray, dict[str, Any]] | None:
+    """The last fallback: solve on every other node, repeatedly (to at most :data:`COARSEST_NODES` nodes), then
+    Newton on each finer grid from the coarser solution interpolated linearly in (u, ln θ, ψ).
+
+    Continuation in φ̄ on a fine grid can snake through fold pairs, one per cell that a front crosses, until its
+    steps run out, while the target state is reached at once from the coarse solution (docs/dense_physics.md §8).
+    Returns None where the grid cannot be coarsened (too few nodes, or an even node count).
+    """
+    levels = [problem]
+    while levels[-1].n > COARSEST_NODES and (levels[-1].n - 1) % 2 == 0:
+        levels.append(dataclasses.replace(levels[-1], x=levels[-1].x[::2]))
+    if len(levels) == 1:
+        return None
+    X, info = solve(levels[-1], tol=tol, max_iter=max_iter, ptc_max_iter=ptc_max_iter, continuation=continuation)
+    coarsest = f"{info['path']} on {levels[-1].n - 1} cells"
+    for coarse, fine in zip(levels[:0:-1], levels[-2::-1]):
+        Xm = X.reshape(coarse.n, -1)
+        start = np.column_stack([np.interp(fine.x, coarse.x, Xm[:, k]) for k in range(Xm.shape[1])]).ravel()
+        X, rep = newton(fine, start, tol=tol, max_iter=max_iter)
+        info["history"] = list(info["history"]) + list(rep.history)
+        info["iterations"] += rep.iterations
+        if not rep.converged:
+            raise CouetteConvergenceError(f"Newton on {fine.n - 1} cells from the {coarse.n - 1}-cell solution did not "
+                                          f"converge ({rep.message})", info["history"], X, fine)
+    info.update(residual=relative_residual(problem, X), method="mesh sequencing",
+                path=f"mesh-sequencing ({coarsest})")
+    return X, info
+
+
 def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10, max_iter: int = 60,
           ptc_max_iter: int = 400, continuation: str = "natural") -> tuple[np.ndarray, dict[str, Any]]:
     """Solve the steady problem; returns the unknowns and a dict of solver diagnostics.
@@ -442,8 +478,8 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
     Raises
     ------
     CouetteConvergenceError
-        With the residual history and the last iterate, if neither Newton from the start nor
-        the continuation converges.
+        With the residual history and the last iterate, if neither Newton from the start, nor
+        the continuation, nor mesh sequencing converges.
     """
     if continuation not in ("natural", "arclength"):
         raise InputError(f"continuation = {continuation!r} is not valid: choose 'natural' or 'arclength'")
@@ -493,7 +529,17 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
             break
     if not done:
         assert failure is not None
-        raise failure
+        try:
+            sequenced = _mesh_sequenced(problem, tol, max_iter, ptc_max_iter, continuation)
+        except CouetteConvergenceError as exc:
+            raise CouetteConvergenceError(f"{failure}; then mesh sequencing failed: {exc}", history, failure.last_iterate,
+                                          failure.problem) from None
+        if sequenced is None:
+            raise failure
+        X, info = sequenced
+        info["iterations"] += total_it
+        info["history"] = history + info["history"]
+        return X, info
     return X, {"iterations": total_it, "continuation_steps": steps, "residual": relative_residual(problem, X),
                "history": history, "method": "continuation", "folds": folds,
                "path": "arclength" if n_arc else "natural"}
