@@ -146,24 +146,70 @@ def test_dem_cell_e07_every_specularity_converges():
 
 
 @pytest.mark.analytic
-@pytest.mark.slow(minutes=3.0)
-def test_a_cell_whose_continuation_snakes_is_solved_by_mesh_sequencing():
+@pytest.mark.slow(minutes=0.4)
+def test_a_cell_whose_continuation_snakes_is_reached_from_its_coarse_grid():
     """``frictional`` with the sheared-χ fit (μ 0.5, Schaeffer, e 0.7), φ̄ 0.57, 10 d planar cell, JJ walls φ' 0.1,
-    200 cells: continuation in φ̄ on this grid stalls among fold pairs (measured: 153 s, then the error); the last
-    fallback solves the cell on 50 cells and reaches 200 by Newton from the interpolated solution (measured 160 s
-    in all).  The state conserves what it must: inventory and energy budget."""
+    200 cells: continuation in φ̄ on this grid stalls among fold pairs (measured: 153 s, then the error; not rerun
+    here), while mesh sequencing solves the cell on 50 cells and reaches 200 by Newton from the interpolated
+    solution.  The state conserves what it must: inventory and energy budget."""
     from helpers.friction_couette import SHEARED_CHI
 
     from ktgf.couette.run import to_dataset
+    from ktgf.couette.solver import _mesh_sequenced
 
     model = get_model("frictional", mu=0.5, stress="schaeffer", **SHEARED_CHI)
     w = Wall(specularity=0.1, restitution=0.9)
     material = Material(1e-3, 2500.0, 0.7)
     pr = build_problem(model, PlanarCell(0.01, 1.0), w, w, 0.57, material, 200, 1.5)
-    X, info = solve(pr)
+    X, info = _mesh_sequenced(pr, 1e-10, 60, 400, "natural")
     assert info["path"].startswith("mesh-sequencing (") and info["path"].endswith("on 50 cells)"), info["path"]
     assert info["residual"] < 1e-10
-    ds = to_dataset(pr, X, material)
     phi = pr.unpack(X)[2]
     assert float(np.sum(pr.V * phi) / pr.V.sum()) == pytest.approx(0.57, rel=1e-10)
-    assert ds.attrs["energy_budget_relative_error"] < 1e-8
+    assert to_dataset(pr, X, material).attrs["energy_budget_relative_error"] < 1e-8
+
+
+@pytest.mark.contract
+def test_mesh_sequencing_is_the_last_fallback(monkeypatch):
+    """Where Newton from the start, pseudo-transient continuation and every homotopy path fail on the grid (made to
+    fail here), ``solve`` returns the mesh-sequenced state (RET cell, 100 cells, from 50); where sequencing fails
+    too, the error names both."""
+    from ktgf.couette import solver as sv
+
+    real_newton, calls = sv.newton, []
+
+    def newton_failing_first(problem, X, **kw):  # the Newton from the start fails; later ones are real
+        calls.append(problem.n)
+        if len(calls) == 1:
+            return X, sv.NewtonReport(False, 0, message="made to fail")
+        return real_newton(problem, X, **kw)
+
+    def fail_on_fine_grids(real):
+        def wrapped(problem, *args, **kw):
+            if problem.n > sv.COARSEST_NODES:
+                raise sv.CouetteConvergenceError("made to fail", [], np.zeros(1), problem)
+            return real(problem, *args, **kw)
+        return wrapped
+
+    def ptc_failing(problem, X, **kw):
+        return X, sv.NewtonReport(False, 0, message="made to fail")
+
+    monkeypatch.setattr(sv, "newton", newton_failing_first)
+    monkeypatch.setattr(sv, "pseudo_transient", ptc_failing)
+    monkeypatch.setattr(sv, "_follow", fail_on_fine_grids(sv._follow))
+    w = Wall(specularity=0.2, restitution=0.85)
+    pr = build_problem(get_model("ret"), PlanarCell(0.02, 1.0), w, w, 0.45, Material(1e-3, 2500.0, 0.8), 100, 1.5)
+    X, info = solve(pr)
+    assert info["path"] == "mesh-sequencing (newton on 50 cells)" and info["residual"] < 1e-10
+    assert calls == [101, 51, 101]  # the failed start, the coarse grid, Newton back on the fine grid
+    direct, _ = real_newton(pr, X, tol=1e-10, max_iter=5)
+    np.testing.assert_allclose(direct, X, atol=1e-9)  # a steady state of the fine grid itself
+
+    def follow_failing(problem, *args, **kw):
+        where = "fine" if problem.n > sv.COARSEST_NODES else "coarse"
+        raise sv.CouetteConvergenceError(f"{where} made to fail", [], np.zeros(1), problem)
+
+    monkeypatch.setattr(sv, "newton", ptc_failing)
+    monkeypatch.setattr(sv, "_follow", follow_failing)
+    with pytest.raises(sv.CouetteConvergenceError, match="^fine made to fail; then mesh sequencing failed: coarse made to fail$"):
+        solve(pr)
