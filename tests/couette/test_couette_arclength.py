@@ -211,5 +211,6 @@ def test_mesh_sequencing_is_the_last_fallback(monkeypatch):
 
     monkeypatch.setattr(sv, "newton", ptc_failing)
     monkeypatch.setattr(sv, "_follow", follow_failing)
-    with pytest.raises(sv.CouetteConvergenceError, match="^fine made to fail; then mesh sequencing failed: coarse made to fail$"):
+    both = "^fine made to fail; then mesh sequencing failed: coarse made to fail$"
+    with pytest.raises(sv.CouetteConvergenceError, match=both):
         solve(pr)

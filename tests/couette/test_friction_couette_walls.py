@@ -151,9 +151,9 @@ def test_frictional_wall_map_from_a_naive_start():
 @pytest.mark.slow(minutes=0.5)
 def test_a_sheared_chi_converges_quadratically_in_a_creeping_core():
     """Schaeffer, μ = 0.25, δ_w = 30°, φ̄ = 0.6 with the sheared-χ fit: the walls slide (u_sl ≈ 0.46 U) round a
-    creeping core (γ̇ ~ 1e-4 U/H), where χ ∝ |γ̇| varies on the scale of γ̇ itself.  The Jacobian's difference step
-    in u is then 1e-7 instead of 1e-5: with 1e-5 the solver stalled here; with 1e-7 it converges to a residual of
-    2e-14, and the state meets the wall conditions."""
+    creeping core (γ̇ ~ 1e-4 U/H), where χ ∝ |γ̇| varies on the scale of γ̇ itself.  The Jacobian's difference
+    step in u is then 1e-7 instead of 1e-5: with 1e-5 the solver stalled here; with 1e-7 it converges to a
+    residual of 2e-14, and the state meets the wall conditions."""
     pr = frictional_wall_problem(0.25, 0.6, 30.0, **SHEARED_CHI)
     assert pr.fd_step == 1e-7 and frictional_wall_problem(0.25, 0.6, 30.0).fd_step == 1e-5
     X, info = solve(pr)

@@ -532,8 +532,8 @@ def solve(problem: Problem, X0: np.ndarray | None = None, *, tol: float = 1e-10,
         try:
             sequenced = _mesh_sequenced(problem, tol, max_iter, ptc_max_iter, continuation)
         except CouetteConvergenceError as exc:
-            raise CouetteConvergenceError(f"{failure}; then mesh sequencing failed: {exc}", history, failure.last_iterate,
-                                          failure.problem) from None
+            raise CouetteConvergenceError(f"{failure}; then mesh sequencing failed: {exc}", history,
+                                          failure.last_iterate, failure.problem) from None
         if sequenced is None:
             raise failure
         X, info = sequenced
