@@ -43,7 +43,7 @@ N_VARS = 3  # u, ln θ, ψ per node
 FD_STEP = 1e-5
 #: The step with a shear-dependent χ (rdf option ``shear_amplitude``), which is nonlinear in γ̇ on the scale of γ̇
 #: itself: in a creeping core (γ̇ ~ 1e-4 U/H) a step of 1e-5 U in u changes the local rate by tens of percent and
-#: the Jacobian is too inexact for Newton (tests/couette/test_couette_sheared_chi.py).
+#: the Jacobian is too inexact for Newton (test_a_sheared_chi_converges_quadratically_in_a_creeping_core).
 SHEARED_CHI_FD_STEP = 1e-7
 
 
@@ -103,8 +103,10 @@ class Problem:
         self.u_wall = g.wall_velocities()
         self.walls = (self.bottom, self.top)
         self.reference_shear_rate = abs(self.u_wall[1] - self.u_wall[0]) / (x[-1] - x[0])  # U/H in V/d
+        # χ(φ, s): a wider Jacobian stencil and a finer difference step
+        self.sheared_chi = bool(getattr(self.model.rdf, "shear_dependent", False))
         if self.fd_step is None:
-            self.fd_step = SHEARED_CHI_FD_STEP if getattr(self.model.rdf, "shear_dependent", False) else FD_STEP
+            self.fd_step = SHEARED_CHI_FD_STEP if self.sheared_chi else FD_STEP
         if not 0.0 < self.mean_phi < self.phi_max:
             from ..errors import InputError
 
@@ -252,7 +254,7 @@ class Problem:
         inv_row = (n - 1) * N_VARS + 2
         # a residual row sees the nodes within `reach` of its own: 1, but 2 with a shear-dependent χ (p at a node
         # then depends on the velocities of its neighbours, and the rows next to it see that p)
-        reach = 2 if getattr(self.model.rdf, "shear_dependent", False) else 1
+        reach = 2 if self.sheared_chi else 1
         offsets = (*range(-reach, reach + 1), "walls") if reach == 1 else tuple(range(-reach, reach + 1))
         for k in range(N_VARS):
             for colour in range(2 * reach + 1):
