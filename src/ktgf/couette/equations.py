@@ -41,10 +41,12 @@ from .walls import Wall, bumpy_wall_fluxes, jj_friction, jj_frictional_wall_stre
 N_VARS = 3  # u, ln θ, ψ per node
 #: Relative step of the Jacobian's central differences.
 FD_STEP = 1e-5
-#: The step with a shear-dependent χ (rdf option ``shear_amplitude``), which is nonlinear in γ̇ on the scale of γ̇
-#: itself: in a creeping core (γ̇ ~ 1e-4 U/H) a step of 1e-5 U in u changes the local rate by tens of percent and
-#: the Jacobian is too inexact for Newton (test_a_sheared_chi_converges_quadratically_in_a_creeping_core).
-SHEARED_CHI_FD_STEP = 1e-7
+#: The step where a coefficient varies on the scale of the shear rate itself, so that a step of 1e-5 U in u is
+#: too coarse for Newton: a shear-dependent χ (rdf option ``shear_amplitude``, χ ∝ |γ̇|; a creeping core has
+#: γ̇ ~ 1e-4 U/H: test_a_sheared_chi_converges_quadratically_in_a_creeping_core) and a frictional stress (its
+#: viscosity ∝ 1/√(I2D + ε²(U/H)²) changes over ε U/H = 1e-3 U/H, while 1e-5 U over a face of a 10 d gap on
+#: 800 cells is 8e-3 U/H: Newton lost descent there: test_a_frictional_stress_converges_on_a_fine_mesh).
+RATE_SENSITIVE_FD_STEP = 1e-7
 
 
 def phi_from_psi(psi: np.ndarray, phi_max: float) -> np.ndarray:
@@ -85,7 +87,7 @@ class Problem:
     v_scale: float = 1.0
     centrifugal: float = 1.0  # multiplier of the centripetal term (1 = physics; <1 only inside a homotopy)
     central_differences: bool = True  # O(h²) Jacobian: the near-jammed states have condition numbers ~1e13
-    fd_step: float | None = None  # the Jacobian's relative step (None: FD_STEP, or SHEARED_CHI_FD_STEP)
+    fd_step: float | None = None  # the Jacobian's relative step (None: FD_STEP, or RATE_SENSITIVE_FD_STEP)
     stress_scale: float = 0.0  # ρ_s V² [Pa]: converts a frictional stress (model option stress) to solver units
 
     def __post_init__(self) -> None:
@@ -106,7 +108,8 @@ class Problem:
         # χ(φ, s): a wider Jacobian stencil and a finer difference step
         self.sheared_chi = bool(getattr(self.model.rdf, "shear_dependent", False))
         if self.fd_step is None:
-            self.fd_step = SHEARED_CHI_FD_STEP if self.sheared_chi else FD_STEP
+            rate_sensitive = self.sheared_chi or self.model.friction.has_stress
+            self.fd_step = RATE_SENSITIVE_FD_STEP if rate_sensitive else FD_STEP
         if not 0.0 < self.mean_phi < self.phi_max:
             from ..errors import InputError
 
