@@ -144,6 +144,7 @@ def test_dense_couette_with_implicit_acoustics_reaches_the_1d_solver_within_one_
 
 
 @pytest.mark.analytic
+@pytest.mark.slow  # 36-42 s, run twice in CI's default steps (with and without the compiler)
 def test_a_lees_edwards_box_with_implicit_acoustics_is_half_of_a_box_twice_as_tall() -> None:
     """A Lees–Edwards box (gradient y, flow z, random perturbation) and a box twice as tall holding it and,
     above, its Galilean image (velocity +γ̇L e_z): the lower half of the tall box must evolve as the box,

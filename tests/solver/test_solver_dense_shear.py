@@ -77,6 +77,7 @@ def test_dense_uniform_shear_small_box_reaches_the_closed_form_and_stops_when_st
 
 
 @pytest.mark.analytic
+@pytest.mark.slow  # 36-42 s, run twice in CI's default steps (with and without the compiler)
 def test_dense_uniform_shear_with_implicit_acoustics_reaches_the_closed_form() -> None:
     """φ 0.55 on 8³ (16 d) with the pressure waves implicit across the Lees–Edwards boundary (cfl_source 0.2, as
     for the dense Couette cell: at 0.5 this box diverges at step 28).  Measured: θ 5.8e-6, η 1.1e-5, p 1.5e-5
