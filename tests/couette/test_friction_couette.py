@@ -12,7 +12,7 @@ from ktgf import get_model
 from ktgf.couette import PlanarCell, Wall
 from ktgf.couette.equations import FD_STEP, RATE_SENSITIVE_FD_STEP, Problem
 from ktgf.couette.run import Material, build_problem, run
-from ktgf.couette.solver import naive_start, newton, solve
+from ktgf.couette.solver import naive_start, newton, prolonged, solve
 from ktgf.errors import InputError
 
 
@@ -90,8 +90,7 @@ def test_a_frictional_stress_converges_on_a_fine_mesh():
     coarse = dataclasses.replace(fine, x=fine.x[::2])
     Xc, info = solve(coarse)
     assert info["residual"] < 1e-10
-    Xm = Xc.reshape(coarse.n, -1)
-    start = np.column_stack([np.interp(fine.x, coarse.x, Xm[:, k]) for k in range(Xm.shape[1])]).ravel()
+    start = prolonged(coarse, fine, Xc)
     assert not newton(dataclasses.replace(fine, fd_step=FD_STEP), start)[1].converged
     X, rep = newton(fine, start)
     assert rep.converged and rep.iterations <= 8 and rep.residual < 1e-10, (rep.iterations, rep.residual)

@@ -105,7 +105,7 @@ class Problem:
         self.u_wall = g.wall_velocities()
         self.walls = (self.bottom, self.top)
         self.reference_shear_rate = abs(self.u_wall[1] - self.u_wall[0]) / (x[-1] - x[0])  # U/H in V/d
-        # χ(φ, s): a wider Jacobian stencil and a finer difference step
+        # χ(φ, s) widens the Jacobian's stencil; it and a frictional stress need the finer difference step
         self.sheared_chi = bool(getattr(self.model.rdf, "shear_dependent", False))
         if self.fd_step is None:
             rate_sensitive = self.sheared_chi or self.model.friction.has_stress

@@ -435,6 +435,12 @@ def _wall_friction_continuation(problem: Problem, start: np.ndarray, tol: float,
 COARSEST_NODES = 64
 
 
+def prolonged(coarse: Problem, fine: Problem, X: np.ndarray) -> np.ndarray:
+    """The unknowns ``X`` of ``coarse`` interpolated linearly in (u, ln θ, ψ) onto the nodes of ``fine``."""
+    Xm = X.reshape(coarse.n, -1)
+    return np.column_stack([np.interp(fine.x, coarse.x, Xm[:, k]) for k in range(Xm.shape[1])]).ravel()
+
+
 def _mesh_sequenced(problem: Problem, tol: float, max_iter: int, ptc_max_iter: int,
                     continuation: str) -> tuple[np.ndarray, dict[str, Any]] | None:
     """The last fallback: solve on every other node, repeatedly (to at most :data:`COARSEST_NODES` nodes), then
@@ -452,9 +458,7 @@ def _mesh_sequenced(problem: Problem, tol: float, max_iter: int, ptc_max_iter: i
     X, info = solve(levels[-1], tol=tol, max_iter=max_iter, ptc_max_iter=ptc_max_iter, continuation=continuation)
     coarsest = f"{info['path']} on {levels[-1].n - 1} cells"
     for coarse, fine in zip(levels[:0:-1], levels[-2::-1]):
-        Xm = X.reshape(coarse.n, -1)
-        start = np.column_stack([np.interp(fine.x, coarse.x, Xm[:, k]) for k in range(Xm.shape[1])]).ravel()
-        X, rep = newton(fine, start, tol=tol, max_iter=max_iter)
+        X, rep = newton(fine, prolonged(coarse, fine, X), tol=tol, max_iter=max_iter)
         info["history"] = list(info["history"]) + list(rep.history)
         info["iterations"] += rep.iterations
         if not rep.converged:
