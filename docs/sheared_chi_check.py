@@ -2,8 +2,9 @@
 
     python docs/sheared_chi_check.py
 
-Step 1 (``registry_fits.fit_sheared_structure``): a, b, c and A on the shared frictionless uniform shear (e = 0.9)
-and the cooling states' p/(nT); leave-one-state-out errors.  Step 2 (``fit_frictional``): μ_Z and k on the shared
+Step 1 (``registry_fits.fit_sheared_structure``): a, b, c and A on the shared frictionless uniform shear (e = 0.9),
+the cooling states' p/(nT) and the static contact value near jamming (Torquato 1995, Eq. 13, at φ 0.55–0.6);
+leave-one-state-out errors.  Step 2 (``fit_frictional``): μ_Z and k on the shared
 μ = 0.5 states.  Then predictions (never fitted) at the shared μ = 0, e = 0.7 row and at ktgf's own LAMMPS runs
 (``docs/data/ktgf_dem_uniform_shear_predictions.csv``), next to the registered ``dense``/``frictional``.
 """
@@ -44,6 +45,11 @@ def main() -> None:
     cool = np.expm1(rf.cooling_log_errors(fit.values, cooling))
     reg_cool = np.expm1(rf.cooling_log_errors(rf.registered_parameters(), cooling))
     print(f"cooling p/(nT): max |error| {100 * np.abs(cool).max():.1f} % (registered dense {100 * np.abs(reg_cool).max():.1f} %)")
+    static = rf.static_contact_states()
+    print("static χ against Torquato (1995) Eq. 13 at φ " + ", ".join(f"{p:g}" for p in static["phi"]) + ": "
+          + ", ".join(_pct(x) for x in np.expm1(rf.static_log_errors(fit.values, static)))
+          + " (registered dense: " + ", ".join(_pct(x) for x in np.expm1(rf.static_log_errors(rf.registered_parameters(), static)))
+          + ")")
 
     frictional = rf.frictional_states()
     step2 = rf.fit_frictional(fit.values, frictional)

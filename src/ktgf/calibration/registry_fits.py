@@ -33,6 +33,7 @@ from ..closures.friction.model_slot import Friction
 from ..closures.garzo_dufty1999 import GarzoDufty1999
 from ..closures.jamming import CoordinationJamming, FrictionalPowerLaw
 from ..closures.models import Model
+from ..closures.rdf import Torquato
 from ..data import (
     FRICTION_SHEAR,
     FRICTION_SHEAR_EXTRA,
@@ -219,15 +220,42 @@ def cooling_log_errors(params: dict[str, float], cooling: dict[str, np.ndarray])
     return np.log(np.asarray(model.reduced(cooling["phi"], cooling["e"], hcs=True).p) / cooling["p_over_nT"])
 
 
-def fit_sheared_structure(states: dict[str, np.ndarray] | None = None, cooling: dict[str, np.ndarray] | None = None, *,
-                          hold: dict[str, float] | None = None) -> Fit:
-    """Step 1 with the sheared χ: a, b, c and A on the frictionless uniform shear and the cooling states' p/(nT).
+#: Where the static contact value near jamming is taken (:func:`static_contact_states`): the metastable branch
+#: above freezing, up to the densest frictionless shear state (0.6), below both divergences (0.634 here, 0.64 in
+#: Torquato's fit), where the two forms part.
+STATIC_PHI: tuple[float, ...] = (0.55, 0.575, 0.6)
 
-    The cooling states (no shear, φ ≤ 0.4) fix χ without shear; the shear states at e = 0.9 its sheared part
-    (``docs/dense_physics.md`` §8).  ``Fit.residuals`` are those of the shear states; ``n_points`` counts both.
+
+def static_contact_states(phi: tuple[float, ...] = STATIC_PHI) -> dict[str, np.ndarray]:
+    """φ and the contact value χ of hard spheres without shear on the metastable branch near jamming.
+
+    From Torquato, Phys. Rev. E 51, 3170 (1995), Eq. (13) (:class:`~ktgf.closures.rdf.Torquato`, φ_f 0.49,
+    φ_c 0.64): his fit to the metastable (non-crystallising) hard-sphere fluid's pressure above freezing.  The
+    shared files hold no static state there (the cooling states stop at φ 0.4), so without these points the
+    unsheared part of the sheared χ is not fixed near jamming (``docs/dense_physics.md`` §8).
+    """
+    phis = np.asarray(phi, dtype=float)
+    return {"phi": phis, "chi": np.asarray(Torquato().chi(phis), dtype=float)}
+
+
+def static_log_errors(params: dict[str, float], static: dict[str, np.ndarray]) -> np.ndarray:
+    """ln(model/static) of the contact value without shear at the states of :func:`static_contact_states`."""
+    rdf = FrictionalPowerLaw(a=params["a"], exponent=params["exponent"])
+    return np.log(np.asarray(rdf.chi(static["phi"])) / static["chi"])
+
+
+def fit_sheared_structure(states: dict[str, np.ndarray] | None = None, cooling: dict[str, np.ndarray] | None = None, *,
+                          static: dict[str, np.ndarray] | None = None, hold: dict[str, float] | None = None) -> Fit:
+    """Step 1 with the sheared χ: a, b, c and A on the frictionless uniform shear, the cooling states' p/(nT) and
+    the static contact value near jamming.
+
+    The cooling states (no shear, φ ≤ 0.4) and the static states (:func:`static_contact_states`, φ 0.55–0.6; give
+    an empty dict to leave them out) fix χ without shear; the shear states at e = 0.9 its sheared part
+    (``docs/dense_physics.md`` §8).  ``Fit.residuals`` are those of the shear states; ``n_points`` counts all.
     """
     states = frictionless_states() if states is None else states
     cooling = cooling_states() if cooling is None else cooling
+    static = static_contact_states() if static is None else static
     hold = dict(hold or {})
     names, start, lower, upper = _free(SHEARED_PARAMETERS, hold)
 
@@ -235,7 +263,10 @@ def fit_sheared_structure(states: dict[str, np.ndarray] | None = None, cooling: 
         return {**hold, **dict(zip(names, x))}
 
     def residual(x: np.ndarray) -> np.ndarray:
-        return np.concatenate([log_errors(params(x), states).ravel(), cooling_log_errors(params(x), cooling)])
+        parts = [log_errors(params(x), states).ravel(), cooling_log_errors(params(x), cooling)]
+        if static:
+            parts.append(static_log_errors(params(x), static))
+        return np.concatenate(parts)
 
     sol, cov, sd = _least_squares(residual, names, start, lower, upper)
     return _result(names, sol, cov, sd, states, params)
