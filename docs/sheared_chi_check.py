@@ -46,10 +46,12 @@ def main() -> None:
     reg_cool = np.expm1(rf.cooling_log_errors(rf.registered_parameters(), cooling))
     print(f"cooling p/(nT): max |error| {100 * np.abs(cool).max():.1f} % (registered dense {100 * np.abs(reg_cool).max():.1f} %)")
     static = rf.static_contact_states()
+
+    def static_errors(params: dict[str, float]) -> str:
+        return ", ".join(_pct(x) for x in np.expm1(rf.static_log_errors(params, static)))
+
     print("static χ against Torquato (1995) Eq. 13 at φ " + ", ".join(f"{p:g}" for p in static["phi"]) + ": "
-          + ", ".join(_pct(x) for x in np.expm1(rf.static_log_errors(fit.values, static)))
-          + " (registered dense: " + ", ".join(_pct(x) for x in np.expm1(rf.static_log_errors(rf.registered_parameters(), static)))
-          + ")")
+          + static_errors(fit.values) + " (registered dense: " + static_errors(rf.registered_parameters()) + ")")
 
     frictional = rf.frictional_states()
     step2 = rf.fit_frictional(fit.values, frictional)

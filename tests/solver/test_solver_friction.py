@@ -214,9 +214,9 @@ def test_frictional_walls_keep_the_1d_solution_of_a_dense_cell(chi: str, strain:
     0.54 %, wall stress 1.95 / 1.29 / 0.65 %, u 0.09 / 0.44 / 0.29 %, φ 0.13 / 0.05 / 0.03 % (θ second order at
     most, the stress first: also without wall friction at 128 cells, 1.3 %), so 2 % in θ and stress at 128 cells,
     1 % in u, φ.  53 s wall idle.  With the sheared χ (its static part fitted, §8 of docs/dense_physics.md) at 128
-    cells: u 0.25 %, φ 0.27 %, θ 0.96 %, wall stress 1.2 % after strain 10, the same to 0.05 points from strain 2 on, so
-    that run stops at strain 4 (without the static part the shear gathered in a wall band thinner than a cell of the 1D
-    reference and the run left it within strain 0.1: u 15 %, θ 66 % at strain 10).  ~60 s wall idle."""
+    cells: u 0.25 %, φ 0.27 %, θ 0.96 %, wall stress 1.2 % after strain 10, the same to 0.05 points from strain 2
+    on, so that run stops at strain 4 (without the static part the shear gathered in a wall band thinner than a cell
+    of the 1D reference and the run left it within strain 0.1: u 15 %, θ 66 % at strain 10).  113 s wall idle."""
     import dataclasses
 
     from helpers.couette_case import couette_case as _couette
