@@ -3,10 +3,12 @@ leave-one-state-out cross-validation.
 
 Run from the repository root:  python docs/dense_fit.py        (reads the data shipped in ktgf.data)
 
-Step 1 (``dense``): a, b of χ and c of the EKT length on the frictionless uniform shear, e = 0.9, φ 0.3–0.6
-(dem_uniform_shear.csv + dem_uniform_shear_extra.csv).  Step 2 (``frictional``): μ_Z and k on the μ = 0.5
-uniform shear, e = 0.7, φ 0.3–0.57 (dem_uniform_shear_friction.csv + _extra), step 1 held.  Predicted, never
-fitted: the μ = 0, e = 0.7 row and the Couette file (`ktgf couette compare --model dense`).
+Step 1 (``dense``): a, b and the sheared part A of χ and c of the EKT length on the frictionless uniform shear,
+e = 0.9, φ 0.3–0.6 (dem_uniform_shear.csv + dem_uniform_shear_extra.csv), p/(nT) of the cooling states
+(dem_hcs_cooling.csv) and Torquato's (1995, Eq. 13) static contact value at φ 0.55–0.6 (the last two held in
+every leave-one-out refit).  Step 2 (``frictional``): μ_Z and k on the μ = 0.5 uniform shear, e = 0.7,
+φ 0.3–0.57 (dem_uniform_shear_friction.csv + _extra), step 1 held.  Predicted, never fitted: the μ = 0, e = 0.7
+row, the cooling rates and the Couette file (`ktgf couette compare --model dense`).
 """
 
 from __future__ import annotations
@@ -14,23 +16,23 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from scipy.optimize import least_squares
 
-from ktgf import get_model
 from ktgf.calibration.registry_fits import (
-    FRICTIONLESS_PARAMETERS,
     OBSERVABLES,
-    family_model,
+    cooling_log_errors,
+    cooling_states,
     fit_frictional,
     fit_frictionless,
+    fit_sheared_structure,
     frictional_states,
     frictionless_states,
     leave_one_out,
     log_errors,
     registered_parameters,
+    static_contact_states,
+    static_log_errors,
     subset,
 )
-from ktgf.data import HCS_COOLING, read_cooling, shipped
 
 LABELS = {"T": "T", "p_over_nT": "p/(nT)", "tau_over_p": "τ/p"}
 
@@ -67,21 +69,34 @@ def table(states, fit_err, loo_err, mu_label):
 
 
 t0 = time.perf_counter()
-fl, fr = frictionless_states(), frictional_states()
-f1 = fit_frictionless(fl)
+fl, fr, cool, static = frictionless_states(), frictional_states(), cooling_states(), static_contact_states()
+f1 = fit_sheared_structure(fl, cool, static=static)
 f2 = fit_frictional(f1.values, fr)
-report_fit("step 1, frictionless (dense): a, b, c", f1)
+report_fit("step 1, frictionless (dense): a, b, c, A (shear states, cooling p/(nT), static χ)", f1)
 report_fit("step 2, μ = 0.5 (frictional): mu_scale, amplitude_growth", f2)
 reg = registered_parameters()
 print("\nregistered:", reg)
 
 
-loo1 = leave_one_out(lambda s: fit_frictionless(s).values, fl)
+def step1(states):
+    return fit_sheared_structure(states, cool, static=static).values
+
+
+loo1 = leave_one_out(step1, fl)
 loo2 = leave_one_out(lambda s: {**f1.values, **fit_frictional(f1.values, s).values}, fr)
 print("\n## frictionless, e = 0.9 (fit set of step 1): fit residuals and leave-one-state-out errors")
 table(fl, f1.residuals, loo1, lambda i: "0")
 print("\n## μ = 0.5, e = 0.7 (fit set of step 2, step 1 held): fit residuals and leave-one-state-out errors")
 table(fr, f2.residuals, loo2, lambda i: f"{fr['mu'][i]:g}")
+
+
+print("\n## fitted in step 1 besides the shear states: χ without shear (registered parameters)")
+cool_err = np.expm1(cooling_log_errors(reg, cool))
+print("| φ | e | p/(nT) DEM | error |\n|---|---|---|---|")
+for phi, e, p, x in zip(cool["phi"], cool["e"], cool["p_over_nT"], cool_err):
+    print(f"| {phi:g} | {e:g} | {p:.4f} | {pct(x)} |")
+print("static χ against Torquato (1995) Eq. 13 at φ " + ", ".join(f"{x:g}" for x in static["phi"]) + ": "
+      + ", ".join(pct(x) for x in np.expm1(static_log_errors(reg, static))))
 
 print("\n## predicted, never fitted: the μ = 0, e = 0.7 row (registered parameters)")
 every = frictional_states(frictional_only=False)
@@ -91,46 +106,28 @@ for i in range(zero["phi"].size):
     print(f"- μ = 0, φ = {zero['phi'][i]:g}, e = {zero['e'][i]:g}: "
           + ", ".join(f"{LABELS[k]} {pct(err[j, i])}" for j, k in enumerate(OBSERVABLES)))
 
-print("\n## predicted, never fitted: homogeneous cooling (dem_hcs_cooling.csv), p/(nT) = 1 + 2(1 + e)φχ of dense")
-
-hcs = read_cooling(shipped(HCS_COOLING))
-dense = get_model("dense")
-print("| φ | e | p/(nT) DEM | dense | err | Carnahan–Starling χ (RET) | err |")
-print("|---|---|---|---|---|---|---|")
-for phi, e, p in zip(hcs["phi"], hcs["e"], hcs["p_over_nT"]):
-    model, cs = float(dense.reduced(phi, e, hcs=True).p), float(get_model("ret").reduced(phi, e).p)
-    print(f"| {phi:g} | {e:g} | {p:.4f} | {model:.4f} | {pct(model / p - 1)} | {cs:.4f} | {pct(cs / p - 1)} |")
-
-print("\n## variant: the cooling-state p/(nT) added to the step-1 residuals (10 more points)")
-names = tuple(FRICTIONLESS_PARAMETERS)
-
-
-def with_hcs(x):
-    p = dict(zip(names, x))
-    m = family_model(**p)
-    cool = [float(m.reduced(phi, e, hcs=True).p) for phi, e in zip(hcs["phi"], hcs["e"])]
-    return np.concatenate([log_errors(p, fl).ravel(), np.log(np.array(cool) / hcs["p_over_nT"])])
-
-
-lo, hi = zip(*((v[1], v[2]) for v in FRICTIONLESS_PARAMETERS.values()))
-v = least_squares(with_hcs, [f1.values[n] for n in names], bounds=(lo, hi))
-r = np.expm1(with_hcs(v.x))
-print(", ".join(f"{n} = {x:.4g}" for n, x in zip(names, v.x)) + "; max |error| shear T, p/(nT), τ/p: "
-      + ", ".join(pct(np.max(np.abs(r[k * fl['phi'].size:(k + 1) * fl['phi'].size])), '') for k in range(3))
-      + f"; cooling p/(nT): {pct(np.max(np.abs(r[3 * fl['phi'].size:])), '')}")
-
-print("\n## alternative kept for comparison: Chialvo–Sundaresan's exponent b = 1.5 held (a, c fitted)")
-g1 = fit_frictionless(fl, hold={"exponent": 1.5})
-g2 = fit_frictional({**g1.values, "exponent": 1.5}, fr)
-gp = {**g1.values, "exponent": 1.5, **g2.values}
-print(f"a = {g1.values['a']:.4g} ± {g1.stderr['a']:.2g}, c = {g1.values['c']:.4g} ± {g1.stderr['c']:.2g}; "
-      f"mu_scale = {g2.values['mu_scale']:.4g}, amplitude_growth = {g2.values['amplitude_growth']:.4g}")
-g_loo1 = leave_one_out(lambda s: {**fit_frictionless(s, hold={"exponent": 1.5}).values, "exponent": 1.5}, fl)
+print("\n## alternative kept for comparison: no sheared part (A = 0), a, b, c on the shear states only "
+      "(the registered fit before 2026-12)")
+g1 = fit_frictionless(fl)
+g2 = fit_frictional(g1.values, fr)
+gp = {**g1.values, **g2.values}
+print(", ".join(f"{k} = {v:.4g}" for k, v in gp.items()))
+g_loo1 = leave_one_out(lambda s: fit_frictionless(s).values, fl)
 g_loo2 = leave_one_out(lambda s: {**gp, **fit_frictional(gp, s).values}, fr)
 table(fl, g1.residuals, g_loo1, lambda i: "0")
 table(fr, g2.residuals, g_loo2, lambda i: f"{fr['mu'][i]:g}")
 e0 = np.expm1(log_errors(gp, zero))
-print("μ = 0, e = 0.7 row:", ", ".join(f"{LABELS[k]} {pct(e0[j, 0])}" for j, k in enumerate(OBSERVABLES)))
+print("μ = 0, e = 0.7 row, max |error|: " + ", ".join(f"{LABELS[k]} {pct(np.max(np.abs(e0[j])), '')}"
+                                                      for j, k in enumerate(OBSERVABLES)))
+print("cooling p/(nT), max |error|: " + pct(np.max(np.abs(np.expm1(cooling_log_errors(gp, cool)))), ""))
+print("static χ: " + ", ".join(pct(x) for x in np.expm1(static_log_errors(gp, static))))
+
+print("\n## alternative: Chialvo–Sundaresan's exponent b = 1.5 held (a, c, A fitted)")
+h1 = fit_sheared_structure(fl, cool, static=static, hold={"exponent": 1.5})
+hp = {**h1.values, "exponent": 1.5}
+print(", ".join(f"{k} = {v:.4g}" for k, v in hp.items()) + "; max |error| shear T, p/(nT), τ/p: "
+      + ", ".join(pct(np.max(np.abs(np.expm1(h1.residuals[k]))), "") for k in range(len(OBSERVABLES)))
+      + "; static χ: " + ", ".join(pct(x) for x in np.expm1(static_log_errors(hp, static))))
 
 print("\n## φ_J(μ) alone (amplitude_growth k = 0 held, mu_scale fitted)")
 h = fit_frictional(f1.values, fr, hold={"amplitude_growth": 0.0})

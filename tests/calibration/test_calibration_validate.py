@@ -72,11 +72,15 @@ def test_dem_columns_and_errors(dense_table, data_dir):
 
 
 def test_rows_marked_from_what_dense_was_fitted_to(dense_table):
-    """docs/dense.md §3: a, b, c of dense fitted on the frictionless uniform shear (base + extra file): the rest is predicted."""
+    """docs/dense.md §3: a, b, c, A of dense fitted on the frictionless uniform shear (base + extra file) and on p/(nT)
+    of the cooling states (not their cooling rates): the rest is predicted."""
     for r in dense_table["rows"]:
-        assert r["role"] == ("fitted" if r["file"] in SHEAR_FILES else "predicted"), r
-    roles = {(s["case"], s["role"]) for s in dense_table["summary"]}
-    assert ("uniform-shear", "fitted") in roles and ("frictional-shear", "predicted") in roles
+        fitted = r["file"] in SHEAR_FILES or (r["file"] == "dem_hcs_cooling.csv" and r["quantity"] == "p_over_nT")
+        assert r["role"] == ("fitted" if fitted else "predicted"), r
+    roles = {(s["case"], s["quantity"], s["role"]) for s in dense_table["summary"]}
+    assert ("homogeneous-cooling", "p_over_nT", "fitted") in roles
+    assert ("homogeneous-cooling", "A_main", "predicted") in roles
+    assert ("uniform-shear", "T", "fitted") in roles and ("frictional-shear", "T", "predicted") in roles
 
 
 def test_frictional_fitted_on_its_mu_half_rows(data_dir):

@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from ktgf import get_model, list_models
 from ktgf.calibration.model_file import dumps, load_model_file, part_choice_options
-from ktgf.calibration.registry_fits import fit_frictional, fit_frictionless, frictional_states
+from ktgf.calibration.registry_fits import fit_frictional, fit_sheared_structure, frictional_states
 from ktgf.cli import app
 from ktgf.closures.dense import DENSE_PARAMETERS
 from ktgf.closures.friction import WaltonRestitution
@@ -81,7 +81,8 @@ def test_friction_changes_the_dissipation_and_the_viscosity_by_walton_closed_for
     sheared = fr.reduced(PHI[:-1], 0.7, shear=shear)
     plain = fr.with_options(tangential_stress="none").reduced(PHI[:-1], 0.7, shear=shear)
     astar = shear / (96.0 / (5.0 * np.sqrt(np.pi)) * PHI[:-1])
-    loss = (1.0 - law.tangential_work_fraction(0.7, 0.5)) * share * 0.6 * b.lambda_b
+    lambda_b = ref.reduced(PHI[:-1], 0.7, shear=shear).lambda_b  # at the sheared χ, which the shear measure raises
+    loss = (1.0 - law.tangential_work_fraction(0.7, 0.5)) * share * 0.6 * lambda_b
     np.testing.assert_allclose(sheared.zeta0, plain.zeta0 + loss * astar**2 / 1.5, rtol=1e-13)
 
 
@@ -278,8 +279,8 @@ def test_friction_part_is_hashable_and_a_value():
 
 @pytest.mark.dem
 def test_the_fitted_constants_are_the_registered_ones():
-    """μ_Z and k of ``frictional`` refit from the shipped μ = 0.5 uniform shear (a, b, c from the frictionless set)."""
-    step1 = fit_frictionless()
+    """μ_Z and k of ``frictional`` refit from the shipped μ = 0.5 uniform shear (a, b, c, A from step 1)."""
+    step1 = fit_sheared_structure()
     fit = fit_frictional(step1.values)
     assert fit.success and fit.n_points == 21
     for name, value in FRICTIONAL_PARAMETERS.items():

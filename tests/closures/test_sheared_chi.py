@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers.friction_couette import SHEARED_CHI
+from helpers.friction_couette import PREVIOUS_CHI
 
 from ktgf import get_model
 from ktgf.calibration import registry_fits as rf
@@ -101,11 +101,6 @@ def test_couette_faces_see_the_sheared_chi() -> None:
         assert np.all(np.abs(terms[0.4][name]) > np.abs(terms[0.0][name]))
 
 
-#: The sheared-χ fit (docs/dense_physics.md §8): step 1 (frictionless) and step 2 (μ_Z, k), checked below.
-SHEARED_FRICTION = {k: SHEARED_CHI[k] for k in ("mu_scale", "amplitude_growth")}
-SHEARED = {k: v for k, v in SHEARED_CHI.items() if k not in SHEARED_FRICTION}
-
-
 @pytest.mark.analytic
 def test_static_contact_states_are_torquatos_metastable_branch() -> None:
     """Torquato (1995) Eq. (13), written out here: χ_CS(0.49)(0.64 − 0.49)/(0.64 − φ),
@@ -120,27 +115,23 @@ def test_static_contact_states_are_torquatos_metastable_branch() -> None:
 @pytest.mark.dem
 def test_fitted_on_the_shared_homogeneous_files_it_predicts_the_e07_pressure() -> None:
     """Calibrated on the shared homogeneous files only (e = 0.9 shear, cooling p/(nT)) and the static contact value
-    near jamming (Torquato 1995), the frictionless e = 0.7 row (never fitted) gets p/(nT) within 5 % (measured
-    +0.1 %; registered ``dense``: −9.6 %).  The static states fix the part of χ without shear: a > 0, so χ
-    diverges at φ_J without shear too (the registered χ(φ) is 29–85 % above Torquato's there)."""
-    fit = rf.fit_sheared_structure()
-    assert fit.success and fit.points_per_parameter >= 8
-    for name, value in SHEARED.items():
-        assert fit.values[name] == pytest.approx(value, rel=2e-3), name
+    near jamming (Torquato 1995), the registered family (``test_dense_fit_reproduces_the_registered_parameters``
+    checks that it is this fit) gets p/(nT) of the frictionless e = 0.7 row (never fitted) within 5 % (measured
+    +0.1 %; the χ(φ) before: −9.6 %).  The static states fix the part of χ without shear: a > 0, so χ diverges at
+    φ_J without shear too (the χ(φ) before is 29–85 % above Torquato's there)."""
+    params = rf.registered_parameters()
     static = rf.static_contact_states()
-    assert np.max(np.abs(np.expm1(rf.static_log_errors(fit.values, static)))) < 0.05  # measured 4.7 %
-    assert np.min(np.expm1(rf.static_log_errors(rf.registered_parameters(), static))) > 0.25
+    assert params["a"] > 0.0 and params["shear_amplitude"] > 0.0
+    assert np.max(np.abs(np.expm1(rf.static_log_errors(params, static)))) < 0.05  # measured 4.7 %
+    assert np.min(np.expm1(rf.static_log_errors(PREVIOUS_CHI, static))) > 0.25
     shared = rf.frictional_states(frictional_only=False)
     row = rf.subset(shared, (shared["mu"] == 0.0) & (shared["e"] == 0.7))
-    pred = rf.predict(fit.values, row)
+    pred = rf.predict(params, row)
     assert abs(pred["p_over_nT"][0] / row["p_over_nT"][0] - 1.0) < 0.05
-    registered = rf.predict(rf.registered_parameters(), row)
-    assert abs(registered["p_over_nT"][0] / row["p_over_nT"][0] - 1.0) > 0.05
-    # and the cooling states' p/(nT) within 6.5 % (measured 6.1 %; registered dense: up to 10.4 %)
-    assert np.max(np.abs(np.expm1(rf.cooling_log_errors(fit.values, rf.cooling_states())))) < 0.065
-    step2 = rf.fit_frictional(fit.values, rf.frictional_states())
-    for name, value in SHEARED_FRICTION.items():
-        assert step2.values[name] == pytest.approx(value, rel=2e-3), name
+    previous = rf.predict(PREVIOUS_CHI, row)
+    assert abs(previous["p_over_nT"][0] / row["p_over_nT"][0] - 1.0) > 0.05
+    # and the cooling states' p/(nT) within 6.5 % (measured 6.1 %; the χ(φ) before: up to 10.4 %)
+    assert np.max(np.abs(np.expm1(rf.cooling_log_errors(params, rf.cooling_states())))) < 0.065
 
 
 @pytest.mark.analytic
@@ -151,7 +142,7 @@ def test_with_its_static_part_a_frictional_wall_cell_converges_with_the_mesh() -
     one to three cells thick and the stress does not converge (266.6, 253.6, 238.5, 225.6 Pa; §8)."""
     from ktgf.couette.run import Material, run
 
-    model = get_model("frictional", mu=0.5, stress="schaeffer", **SHEARED_CHI)
+    model = get_model("frictional", mu=0.5, stress="schaeffer")
     wall = Wall(specularity=0.1, restitution=0.9, friction_angle=30.0)
     material = Material(1e-3, 2500.0, 0.7)
     tau = [float(run(model, PlanarCell(0.01, 1.0), wall, wall, 0.57, material, n_cells=n, stretch=1.0)
@@ -159,16 +150,3 @@ def test_with_its_static_part_a_frictional_wall_cell_converges_with_the_mesh() -
     steps = np.abs(np.diff(tau))
     assert np.all(steps[1:] < steps[:-1] / 1.6), tau
     assert steps[-1] < 0.005 * tau[-1], tau
-
-
-@pytest.mark.dem
-def test_sheared_chi_solves_the_shared_couette_cell_within_15_percent(data_dir) -> None:
-    """Between the DEM's bumpy walls (nothing fitted) the cell converges from the naive start (the Jacobian's
-    stencil is five nodes wide with a shear-dependent χ) and meets the Couette goal (measured −7.4 %, −2.5 %)."""
-    from ktgf.couette.compare import compare_with_dem
-
-    model = get_model("dense", **SHEARED)
-    rows, _ = compare_with_dem(data_dir / "dem_couette_e0.9_phi0.50.csv", [model], n_cells=100, wall="bumpy")
-    row = rows[0]
-    assert row["valid"], row["message"]
-    assert abs(row["tau_error"]) < 0.15 and abs(row["p_error"]) < 0.15

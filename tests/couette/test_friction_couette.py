@@ -22,8 +22,9 @@ def _problem(mu, mean_phi, stress="schaeffer", eps=1e-3, n=80, e=0.7):
 
 @pytest.mark.analytic
 def test_frictional_terms_are_the_closures():
-    """At a (non-solution) state the shear flux is (η + μ_f) γ̇ with Schaeffer's μ_f, and p includes w p_f."""
-    pr = _problem(0.5, 0.52)
+    """At a (non-solution) state the shear flux is (η + μ_f) γ̇ with Schaeffer's μ_f, and p includes w p_f (χ without
+    its sheared part, so that the kinetic η at the faces is the one of ``coefficients`` without a shear measure)."""
+    pr = frictional_wall_problem(0.5, 0.52, 0.0, "schaeffer", 1e-3, 80, 0.7, shear_amplitude=0.0)
     rng = np.random.default_rng(3)
     X = naive_start(pr) + 0.02 * rng.standard_normal(3 * pr.n)
     t = pr.terms(X)

@@ -76,7 +76,7 @@ def test_frictionless_files_read_back_and_resume(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("args, words", [
     (["--phi", "0.64", "--e", "0.9"], ["phi = 0.64", "jamming", "would jam"]),
-    (["--phi", "0.6", "--e", "0.7", "--mu", "0.5"], ["phi = 0.6", "jamming", "0.596"]),
+    (["--phi", "0.6", "--e", "0.7", "--mu", "0.5"], ["phi = 0.6", "jamming", "0.594"]),
     (["--phi", "0.5", "--e", "1.2"], ["e = 1.2", "0 < e"]),
     (["--phi", "0.5", "--e", "0"], ["e = 0", "0 < e"]),
     (["--phi", "0.5", "--e", "0.9", "--mu", "-0.1"], ["mu = -0.1", "mu >= 0"]),

@@ -10,10 +10,10 @@ from ktgf.couette.equations import Problem
 from ktgf.couette.geometry import stretched_nodes
 from ktgf.couette.solver import solve
 
-#: The sheared-χ fit of docs/dense_physics.md §8 (not registered): frictionless structure with the static contact
-#: value near jamming, then friction's (``tests/closures/test_sheared_chi.py`` checks it against the fit).
-SHEARED_CHI = {"a": 0.02955, "exponent": 2.0502, "c": 0.8854, "shear_amplitude": 0.3364, "mu_scale": 0.5633,
-               "amplitude_growth": 1.784}
+#: The χ(φ) registered before 7 December 2026 (no sheared part; ``registry_fits.fit_frictionless``, then
+#: ``fit_frictional``): the comparison the sheared χ's tests measure their gain against (docs/dense.md §4).
+PREVIOUS_CHI = {"a": 0.1238, "exponent": 1.9102, "c": 0.8861, "shear_amplitude": 0.0, "mu_scale": 0.6220,
+                "amplitude_growth": 5.899}
 #: The earlier fit without the static states: no jamming term without shear (a = 0).  Its dense frictional cells
 #: gather the shear in wall bands as thin as the grid allows, the hard cases the solver tests keep.
 SHEARED_CHI_WITHOUT_STATIC = {"a": 0.0, "exponent": 2.1552, "c": 0.8852, "shear_amplitude": 0.386, "mu_scale": 0.5879,

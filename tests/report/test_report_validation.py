@@ -41,7 +41,11 @@ def test_validation_section_marks_fitted_and_predicted_rows(tmp_path, data_dir):
         n_us = sum(read_table(data_dir / f).values.shape[0] for f in DEM_FILES if f.startswith("dem_uniform_shear")
                    and "friction" not in f)
         assert us.sizes["row"] == 3 * n_us and set(us.role.values) == {"fitted"}  # dense was fitted to all of them
-        assert set(ds.where(ds.case != "uniform-shear", drop=True).role.values) == {"predicted"}
+        rest = ds.where(ds.case != "uniform-shear", drop=True)
+        fitted = rest.where(rest.role == "fitted", drop=True)  # and p/(nT) of the cooling states: χ without shear
+        assert set(fitted.case.values) == {"homogeneous-cooling"} and set(fitted.quantity.values) == {"p_over_nT"}
+        assert fitted.sizes["row"] == read_table(data_dir / "dem_hcs_cooling.csv").values.shape[0]
+        assert set(rest.where(rest.quantity != "p_over_nT", drop=True).role.values) == {"predicted"}
         # the same rows as `ktgf validate` on one file
         one = validate(get_model("dense"), [data_dir / UNIFORM_SHEAR], sources=fit_sources("dense"))
         mine = ds.where(ds.file == UNIFORM_SHEAR, drop=True)

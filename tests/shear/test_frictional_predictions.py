@@ -23,32 +23,23 @@ FILE = Path(__file__).resolve().parents[2] / "docs" / "data" / "ktgf_dem_uniform
 GOALS = {"T": 0.15, "p_over_nT": 0.10, "tau_over_p": 0.10}
 #: (μ, φ, e, quantity): the measured relative error (docs/friction.md §6.2); each must stay within 2 points of it.
 MISSES: dict[tuple[float, float, float, str], float] = {
-    # frictionless (the registered `dense`) at e = 0.7: the e = 0.9 fit does not carry over
-    (0.0, 0.3, 0.7, "T"): +0.240,
-    (0.0, 0.4, 0.7, "T"): +0.219,
-    (0.0, 0.55, 0.7, "p_over_nT"): -0.142,
-    (0.0, 0.55, 0.7, "tau_over_p"): +0.190,
-    (0.0, 0.58, 0.7, "T"): -0.201,
-    (0.0, 0.58, 0.7, "p_over_nT"): -0.205,
-    (0.0, 0.58, 0.7, "tau_over_p"): +0.289,
+    # frictionless (the registered `dense`) at e = 0.7: T and τ/p of the e = 0.9 fit do not carry over (p/(nT) does)
+    (0.0, 0.3, 0.7, "T"): +0.223,
+    (0.0, 0.4, 0.7, "T"): +0.206,
+    (0.0, 0.55, 0.7, "tau_over_p"): +0.172,
+    (0.0, 0.58, 0.7, "T"): -0.163,
+    (0.0, 0.58, 0.7, "tau_over_p"): +0.260,
     # weaker friction at the fit's e = 0.7
-    (0.1, 0.4, 0.7, "T"): +0.159,
-    (0.1, 0.4, 0.7, "p_over_nT"): -0.102,
-    (0.1, 0.5, 0.7, "T"): +0.183,
-    (0.1, 0.57, 0.7, "p_over_nT"): -0.122,
-    (0.1, 0.57, 0.7, "tau_over_p"): +0.172,
-    (0.25, 0.4, 0.7, "p_over_nT"): -0.103,
-    (0.25, 0.5, 0.7, "T"): +0.163,
-    (0.25, 0.57, 0.7, "tau_over_p"): +0.144,
-    # the fit's μ = 0.5 at e = 0.9: misses by factors above φ 0.4
-    (0.5, 0.4, 0.9, "p_over_nT"): +0.124,
-    (0.5, 0.4, 0.9, "tau_over_p"): -0.129,
-    (0.5, 0.5, 0.9, "T"): +0.445,
-    (0.5, 0.5, 0.9, "p_over_nT"): +0.288,
-    (0.5, 0.5, 0.9, "tau_over_p"): -0.230,
-    (0.5, 0.55, 0.9, "T"): +0.885,
-    (0.5, 0.55, 0.9, "p_over_nT"): +0.441,
-    (0.5, 0.55, 0.9, "tau_over_p"): -0.259,
+    (0.1, 0.5, 0.7, "T"): +0.200,
+    (0.1, 0.57, 0.7, "tau_over_p"): +0.158,
+    (0.25, 0.5, 0.7, "T"): +0.174,
+    (0.25, 0.57, 0.7, "tau_over_p"): +0.137,
+    # the fit's μ = 0.5 at e = 0.9: T and τ/p miss above φ 0.4 (p/(nT) within 9.2 %)
+    (0.5, 0.4, 0.9, "tau_over_p"): -0.126,
+    (0.5, 0.5, 0.9, "T"): +0.393,
+    (0.5, 0.5, 0.9, "tau_over_p"): -0.216,
+    (0.5, 0.55, 0.9, "T"): +0.775,
+    (0.5, 0.55, 0.9, "tau_over_p"): -0.236,
 }
 
 

@@ -4,8 +4,11 @@ One family for all μ (``docs/dense.md``, ``docs/friction.md``): RET × :class:`
 FrictionalPowerLaw` χ (diverging at the contact-number φ_J(μ)) × the EKT correlation length × Walton's
 collision rule (β0 = 1) for μ > 0.  The parameters are chosen in two steps, on homogeneous flows only:
 
-1. :func:`fit_frictionless` — a, b of χ and c of the EKT length on the frictionless uniform shear
-   (``dem_uniform_shear.csv`` + ``dem_uniform_shear_extra.csv``, e = 0.9, φ 0.3–0.6);
+1. :func:`fit_sheared_structure` — a, b and the sheared part A of χ and c of the EKT length on the
+   frictionless uniform shear (``dem_uniform_shear.csv`` + ``dem_uniform_shear_extra.csv``, e = 0.9,
+   φ 0.3–0.6), on p/(nT) of the homogeneous cooling states (``dem_hcs_cooling.csv``) and on Torquato's
+   static contact value near jamming (:func:`static_contact_states`); :func:`fit_frictionless` is the same
+   step without the sheared part, the cooling and the static points (the registered fit before 2026-12);
 2. :func:`fit_frictional` — the friction scale μ_Z of φ_J(μ) and the amplitude growth k on the
    frictional uniform shear at μ > 0 (``dem_uniform_shear_friction.csv`` + ``_extra``), the
    frictionless parameters held.
@@ -51,24 +54,32 @@ from ..shear.steady import steady_shear
 
 @dataclass(frozen=True)
 class FitSource:
-    """States of one data file a model was fitted to: ``states`` are (μ, φ, e) tuples, or None for every state."""
+    """States of one data file a model was fitted to.
+
+    ``states`` are (μ, φ, e) tuples, or None for every state; ``quantities`` the columns that entered the fit,
+    or None for every one (e.g. only p/(nT) of the cooling file: its cooling rates are predictions).
+    """
 
     file: str
     states: tuple[tuple[float, float, float], ...] | None = None
     sha256: str = ""
+    quantities: tuple[str, ...] | None = None
 
 
 #: The μ = 0.5 rows (μ, φ, e) of the base and extra frictional files (the base file's μ = 0, e = 0.7 row is a
 #: prediction); ``tests/calibration/test_calibration_validate.py`` checks them against the files.
 _MU_HALF_BASE = ((0.5, 0.4, 0.7), (0.5, 0.5, 0.7))
 _MU_HALF_EXTRA = ((0.5, 0.3, 0.7), (0.5, 0.45, 0.7), (0.5, 0.52, 0.7), (0.5, 0.55, 0.7), (0.5, 0.57, 0.7))
-#: What the registered fitted models were fitted to (docs/dense.md §3, docs/friction.md §6.0): ``dense`` — a, b, c
-#: on every state of the frictionless uniform shear (base + extra); ``frictional`` — those, and μ_Z, k on every
-#: μ = 0.5 state of the frictional uniform shear (base + extra).  The other registered models have published
-#: parameters only: every row is a prediction.  Update this with the fits.
+#: The cooling file's part of step 1: p/(nT) of every state (χ without shear); its cooling rates stay predictions.
+_COOLING = FitSource(HCS_COOLING, quantities=("p_over_nT",))
+#: What the registered fitted models were fitted to (docs/dense.md §3, docs/friction.md §6.0): ``dense`` — a, b, c, A
+#: on every state of the frictionless uniform shear (base + extra) and p/(nT) of every cooling state (and Torquato's
+#: static χ, a published formula, not a file); ``frictional`` — those, and μ_Z, k on every μ = 0.5 state of the
+#: frictional uniform shear (base + extra).  The other registered models have published parameters only: every
+#: row is a prediction.  Update this with the fits.
 REGISTERED_FITS: dict[str, tuple[FitSource, ...]] = {
-    "dense": (FitSource(UNIFORM_SHEAR), FitSource(UNIFORM_SHEAR_EXTRA)),
-    "frictional": (FitSource(UNIFORM_SHEAR), FitSource(UNIFORM_SHEAR_EXTRA),
+    "dense": (FitSource(UNIFORM_SHEAR), FitSource(UNIFORM_SHEAR_EXTRA), _COOLING),
+    "frictional": (FitSource(UNIFORM_SHEAR), FitSource(UNIFORM_SHEAR_EXTRA), _COOLING,
                    FitSource(FRICTION_SHEAR, _MU_HALF_BASE), FitSource(FRICTION_SHEAR_EXTRA, _MU_HALF_EXTRA)),
 }
 
@@ -85,6 +96,8 @@ def fitted_restitutions(name: str, mu: float) -> tuple[float, ...] | None:
         return None
     found: set[float] = set()
     for src in sources:
+        if src.quantities is not None and "T" not in src.quantities:  # no sheared state (the cooling file's p/(nT))
+            continue
         if src.states is not None:
             found |= {e for m, _, e in src.states if (m > 0.0) == (mu > 0.0)}
         elif mu == 0.0:  # a whole frictionless file

@@ -17,11 +17,12 @@ homogeneous cooling (``phi, e, A_main, A_early``)
     the cooling rate A = ζ0/√T (:func:`ktgf.hcs.cooling_rate`, d = 1, T = 1) against both Haff fits,
     and p/(nT) of the cooling state; the model at μ = 0.
 
-A row is *fitted* when its state (a row of a shear file, a Couette file) was in the data the
-model's parameters were fitted to: for a model file, the files of its ``[[provenance.data]]`` (by
-SHA-256, or by name for a file without hash) with every state :func:`ktgf.data.read_data`
-takes from them (``ktgf calibrate`` fits them all); for a registered model,
-:data:`ktgf.calibration.registry_fits.REGISTERED_FITS`.
+A row is *fitted* when its state (a row of a shear or cooling file, a Couette file) and its quantity
+were in the data the model's parameters were fitted to: for a model file, the files of its
+``[[provenance.data]]`` (by SHA-256, or by name for a file without hash) with every state
+:func:`ktgf.data.read_data` takes from them (``ktgf calibrate`` fits them all); for a registered model,
+:data:`ktgf.calibration.registry_fits.REGISTERED_FITS` (e.g. p/(nT) of the cooling states, not their
+cooling rates).
 """
 
 from __future__ import annotations
@@ -208,23 +209,29 @@ def fit_sources(model_name: str | None = None, model_file: Any = None) -> tuple[
     return REGISTERED_FITS.get(str(model_name), ())
 
 
-def _fitted_keys(path: Path, case: str, sources: Sequence[FitSource]) -> set[tuple] | None:
-    """States of ``path`` in the fit (None: the file was not used)."""
+def _fitted_keys(path: Path, case: str,
+                 sources: Sequence[FitSource]) -> tuple[set[tuple], tuple[str, ...] | None] | None:
+    """States of ``path`` in the fit and the quantities fitted there (None: every one); None: the file was not used."""
     for s in sources:
         same = file_hash(path) == s.sha256 if s.sha256 else path.name == Path(s.file).name
         if not same:
             continue
         if case == "couette":
-            return {("couette",)}
+            return {("couette",)}, s.quantities
         if s.states is not None:
-            return {tuple(float(x) for x in k) for k in s.states}
+            return {tuple(float(x) for x in k) for k in s.states}, s.quantities
+        if case == "homogeneous-cooling":
+            from ..data import read_cooling
+
+            cols = read_cooling(path)
+            return {(0.0, float(p), float(e)) for p, e in zip(cols["phi"], cols["e"])}, s.quantities
         from ..data import read_uniform_shear
 
         try:  # ktgf calibrate fits every state its reader takes: the frictionless rows
             d = read_uniform_shear(path)
         except InputError:
-            return set()
-        return {(0.0, float(p), float(e)) for p, e in zip(d.phi, d.e)}
+            return set(), s.quantities
+        return {(0.0, float(p), float(e)) for p, e in zip(d.phi, d.e)}, s.quantities
     return None
 
 
@@ -276,7 +283,8 @@ def validate(model: Any, paths: Sequence[str | Path], *, sources: Sequence[FitSo
         fitted = _fitted_keys(path, case, sources)
         for r in new:
             key = r.pop("_key")
-            r["role"] = "fitted" if fitted is not None and key in fitted else "predicted"
+            hit = fitted is not None and key in fitted[0] and (fitted[1] is None or r["quantity"] in fitted[1])
+            r["role"] = "fitted" if hit else "predicted"
         rows += new
     if not sources:
         notes.append(f"no fit recorded for model {model.name!r} (published parameters, or a model file without "

@@ -19,9 +19,9 @@ proposed    Garzó & Dufty (1999)  viscosity-divergence RDF   theory's own
 
 and one recommended family for all friction coefficients μ (``docs/dense.md``, ``docs/friction.md``):
 RET × Carnahan–Starling plus a Chialvo–Sundaresan jamming term diverging at the contact-number
-φ_J(μ) (:class:`~ktgf.closures.jamming.FrictionalPowerLaw`) × the EKT correlation length, with
-Walton's collision rule for μ > 0 — ``dense`` is its member at μ = 0 (a, b, c fitted to frictionless
-DEM uniform shear, :mod:`ktgf.closures.dense`), ``frictional`` the member at μ (default 0.5; μ_Z and k
+φ_J(μ), its amplitude growing with the reduced shear rate (:class:`~ktgf.closures.jamming.FrictionalPowerLaw`)
+× the EKT correlation length, with Walton's collision rule for μ > 0 — ``dense`` is its member at μ = 0 (a, b,
+c, A fitted to frictionless DEM uniform shear, cooling p/(nT) and the static χ, :mod:`ktgf.closures.dense`), ``frictional`` the member at μ (default 0.5; μ_Z and k
 fitted to frictional DEM uniform shear, :mod:`ktgf.closures.friction.calibrated`).
 """
 
@@ -374,7 +374,7 @@ register_model(
 def _family_rdf(mu: float) -> FrictionalPowerLaw:
     """The χ of the registered family at friction μ (``dense`` is μ = 0)."""
     return FrictionalPowerLaw(mu=mu, a=DENSE_PARAMETERS["a"], exponent=DENSE_PARAMETERS["exponent"],
-                              **FRICTIONAL_PARAMETERS)
+                              shear_amplitude=DENSE_PARAMETERS["shear_amplitude"], **FRICTIONAL_PARAMETERS)
 
 
 register_model(
@@ -386,8 +386,8 @@ register_model(
         label="Dense",
         description=(
             "Recommended for dense flows: RET, Carnahan-Starling + Chialvo-Sundaresan jamming term diverging at "
-            "phi_J(0) = 0.634, EKT correlation length; a, b, c fitted to DEM uniform shear (docs/dense.md); "
-            "'frictional' at mu = 0"
+            "phi_J(0) = 0.634 whose amplitude grows with the reduced shear rate, EKT correlation length; a, b, c, A "
+            "fitted to DEM uniform shear, cooling p/(nT) and Torquato's static chi (docs/dense.md); 'frictional' at mu = 0"
         ),
     ),
 )

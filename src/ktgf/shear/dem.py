@@ -5,7 +5,7 @@ uniform-shear file (``dem_uniform_shear*.csv``).  Frictional (``dem_uniform_shea
 :func:`compositions` lists the compared compositions and what each fits.  At most one number per
 composition is fitted: the tangential restitution β of the rough-sphere dissipation, to the rotational
 temperature T_rot/T of the row μ = 0.5, φ = 0.4 (:func:`fit_tangential_restitution`); and, for the
-registered ``frictional`` model, μ_Z and k of its χ on the whole μ = 0.5 set, a, b, c on the frictionless set
+registered ``frictional`` model, μ_Z and k of its χ on the whole μ = 0.5 set, a, b, c, A on the frictionless set
 (:mod:`ktgf.calibration.registry_fits`).  Everything else is predicted.
 """
 
@@ -92,7 +92,8 @@ def compositions(rows: list[dict[str, float]]) -> list[tuple[str, str, Any]]:
          FrictionalShearParts(ret.replace(rdf=fcs), restitution=RoughSphereRestitution(beta=beta))),
         ("RET, χ_CS13(φ_c(μ)), Walton μ, β0 = 1", "nothing (β0 = 1: the DEM contact law)",
          FrictionalShearParts(ret.replace(rdf=fcs), restitution=WaltonRestitution(beta0=1.0))),
-        ("**frictional** (registered): χ at φ_J(μ), EKT, Walton β0 = 1, tangential stress", "a, b, c (frictionless set); μ_Z, k (μ = 0.5 set)",
+        ("**frictional** (registered): sheared χ at φ_J(μ), EKT, Walton β0 = 1, tangential stress",
+         "a, b, c, A (frictionless set, cooling, static χ); μ_Z, k (μ = 0.5 set)",
          FrictionalShearParts(get_model("frictional"), restitution=WaltonRestitution(beta0=1.0))),
         ("Enskog, χ_CS13(φ_c(μ)), e_eff Chialvo–Sundaresan", "nothing",
          FrictionalShearParts(get_model("enskog").replace(rdf=fcs))),
