@@ -12,7 +12,13 @@ import time
 
 import numpy as np
 import pytest
-from helpers.friction_couette import SCALE, SHEARED_CHI_WITHOUT_STATIC, frictional_wall_problem, halving_changes
+from helpers.friction_couette import (
+    PREVIOUS_CHI,
+    SCALE,
+    SHEARED_CHI_WITHOUT_STATIC,
+    frictional_wall_problem,
+    halving_changes,
+)
 
 from ktgf import get_model
 from ktgf.couette.equations import RATE_SENSITIVE_FD_STEP
@@ -88,8 +94,10 @@ def test_a_wall_that_sticks_beyond_a_fold_is_reached_by_arclength_in_the_wall_fr
     ends at a turning point (s ≈ 0.94) and the stuck branch begins at another (s ≈ 0.82), an S-shaped curve.  Natural
     steps stall at the first fold; arclength passes both and lands on the stuck wall (Coulomb: traction below
     p_f tan δ_w, slip ~ ε_w U), which meets the wall conditions.  Before, the solver's path here depended on the BLAS
-    kernel's round-off (it failed with OpenBLAS's Haswell kernels, docs/friction.md §8)."""
-    pr = frictional_wall_problem(0.0, 0.6, 30.0, "schaeffer")
+    kernel's round-off (it failed with OpenBLAS's Haswell kernels, docs/friction.md §8).  The S is that of the χ(φ)
+    registered before 7 December 2026 (``PREVIOUS_CHI``); with the registered sheared χ natural steps reach δ_w = 30°
+    (measured), so the fold-passing this test checks needs the older model."""
+    pr = frictional_wall_problem(0.0, 0.6, 30.0, "schaeffer", **PREVIOUS_CHI)
     X, info = _wall_friction_continuation(pr, naive_start(pr), 1e-10, 60, 400, "natural")
     assert info["path"].startswith("delta_w-continuation by arclength")
     folds = info["wall_friction_folds"]
@@ -250,12 +258,13 @@ def test_cli_bad_friction_is_a_one_line_error(tmp_path, args, words):
 @pytest.mark.analytic
 @pytest.mark.slow
 def test_a_wall_rougher_than_the_bulk_has_a_stuck_and_a_sliding_state():
-    """Schaeffer, μ = 0.25, φ̄ = φ_J(0.25) − 0.026 = 0.584, δ_w = 30° (tan δ_w > sin φ_fr: the wall can hold more
+    """Schaeffer, μ = 0.25, φ̄ = φ_J(0.25) − 0.04, δ_w = 30° (tan δ_w > sin φ_fr: the wall can hold more
     than the bulk yields): Newton from the naive start reaches a stuck wall (slip ~ ε_w U, dense wall layer);
     continuing δ_w from the sliding 25° state keeps a sliding wall.  Two steady states, both meeting the wall
-    conditions (docs/friction.md §8).  (φ̄ sits as far below jamming as the 0.55 of the first frictional model,
-    whose φ_c(0.25) was 0.576.)"""
-    mean_phi = get_model("frictional", mu=0.25).phi_max - 0.026
+    conditions (docs/friction.md §8).  Which state the naive start reaches changes with φ̄ (docs/dense_physics.md
+    §8: stuck at φ_J − 0.04 and − 0.03, sliding at − 0.02 … − 0.005 with the registered sheared χ), so φ̄ is taken
+    where Newton reaches the stuck one."""
+    mean_phi = get_model("frictional", mu=0.25).phi_max - 0.04
     pr = frictional_wall_problem(0.25, mean_phi, 30.0)
     Xs, info = solve(pr)
     assert info["path"] == "newton"

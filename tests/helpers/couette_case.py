@@ -47,9 +47,10 @@ vtk = false
 """
 
 
-def run_from_profile_within_one_percent(sim, ref, phi_mean: float):
+def run_from_profile_within_one_percent(sim, ref, phi_mean: float, theta_tol: float = 0.01):
     """Start ``sim`` (cells across the gap on axis 0) from the 1D profile ``ref``, run it, and check that
-    u, φ, θ and both wall shear stresses stay within 1 % of the reference; returns the initial state."""
+    u, φ and both wall shear stresses stay within 1 % of the reference and θ within ``theta_tol`` (1 % unless a
+    caller measured that θ's discretisation error at its grid is larger); returns the initial state."""
     n = sim.grid.cells[0]
     y = sim.grid.centres(0) - 0.5 * sim.grid.lengths[0]
     yr = ref["y"].values
@@ -63,7 +64,9 @@ def run_from_profile_within_one_percent(sim, ref, phi_mean: float):
     sim.initial_state = lambda: sim.place(U0)
     sim.run(progress=False, write_files=False)
     ver = sim.verification
-    assert max(ver["max_rel_error"].values()) < 0.01, ver["max_rel_error"]
+    err = ver["max_rel_error"]
+    assert err["u"] < 0.01 and err["phi"] < 0.01 and err["theta"] < theta_tol, err
+    assert set(err) == {"u", "phi", "theta"}, err
     tau_run, tau_ref = ver["wall_shear_stress_Pa"]["run"], ver["wall_shear_stress_Pa"]["reference"]
     assert abs(tau_run[0] / tau_ref[0] - 1) < 0.01 and abs(tau_run[1] / tau_ref[1] - 1) < 0.01
     return U0

@@ -181,8 +181,9 @@ def test_homogeneous_frictional_shear_relaxes_to_the_closed_form(options: dict, 
 def test_frictional_couette_keeps_the_1d_solution_within_one_percent() -> None:
     """``frictional`` (μ = 0.5, e = 0.7) with a Schaeffer stress at φ̄ = 0.5 (p_f is 98 % of the pressure),
     JJ walls, 10 d gap, 128 cells, started from the 1D steady profile: after strain 10 the 3D profiles are
-    the 1D ones within 1 % in u, φ, θ (measured 0.08, 0.08, 0.92 %; θ converges at second order with the
-    cells, docs/friction.md §7), the wall stress within 1 % (0.35 %).  ~140 s wall at load 8."""
+    the 1D ones within 1 % in u, φ, the wall stress within 1 %, θ within 2 %: with the registered sheared χ θ's error
+    is 5.24, 1.15, 0.53 % at 64, 128, 256 cells (it falls with the grid: a discretisation error, as the 2 % of
+    the δ_w = 30° cell below; with the χ(φ) registered before it was 0.92 % at 128 cells).  ~140 s wall at load 8."""
     from helpers.couette_case import couette_case as _couette
     from helpers.couette_case import parse as _parse
     from helpers.couette_case import run_from_profile_within_one_percent
@@ -196,20 +197,20 @@ def test_frictional_couette_keeps_the_1d_solution_within_one_percent() -> None:
     sim = Simulation(_parse(text.replace("solid_fraction = 0.3", f"solid_fraction = {phi0}")))
     ref = couette_reference(sim.phys, sim.grid, phi0)
     assert float(ref["p_frictional"].max()) > 0.9 * float(ref["p"].max())
-    run_from_profile_within_one_percent(sim, ref, phi0)
+    run_from_profile_within_one_percent(sim, ref, phi0, theta_tol=0.02)
 
 
 @pytest.mark.analytic
 @pytest.mark.slow(minutes=1.9)
 def test_frictional_walls_keep_the_1d_solution_of_a_dense_cell() -> None:
-    """JJ walls with δ_w = 30° (``frictional`` μ = 0.5, e = 0.7, Schaeffer, φ̄ = 0.57), 128 cells, IMEX, strain 4
+    """JJ walls with δ_w = 30° (``frictional`` μ = 0.5, e = 0.7, Schaeffer, φ̄ = 0.57), 128 cells, IMEX, strain 2
     from the 1D profile: the wall traction raises the 1D wall stress by more than 15 % over δ_w = 0; the 3D run keeps
     the 1D profile and stress.  With the registered sheared χ (docs/dense_physics.md §8) at 128 cells: u 0.25 %,
-    φ 0.27 %, θ 0.96 %, wall stress 1.2 % after strain 10, the same to 0.05 points from strain 2 on, hence strain 4;
+    φ 0.27 %, θ 0.96 %, wall stress 1.2 % after strain 10, the same to 0.05 points from strain 2 on, hence strain 2;
     with the χ(φ) registered before: θ 4.4 / 1.6 / 0.54 %, stress 1.95 / 1.29 / 0.65 % at 64 / 128 / 256 cells (θ
     second order at most, the stress first), so 2 % in θ and stress at 128 cells, 1 % in u, φ.  Without the static
     part of the sheared χ the shear gathered in a wall band thinner than a cell of the 1D reference and the run left
-    it within strain 0.1 (u 15 %, θ 66 % at strain 10).  113 s wall idle."""
+    it within strain 0.1 (u 15 %, θ 66 % at strain 10).  113 s wall idle at strain 4."""
     import dataclasses
 
     from helpers.couette_case import couette_case as _couette
@@ -221,7 +222,7 @@ def test_frictional_walls_keep_the_1d_solution_of_a_dense_cell() -> None:
     from ktgf.solver.run import Simulation
 
     n, phi0 = 128, 0.57
-    text = _couette([n], 4.0).replace('name = "ret"\nrestitution = 0.9', 'name = "frictional"\nrestitution = 0.7\n'
+    text = _couette([n], 2.0).replace('name = "ret"\nrestitution = 0.9', 'name = "frictional"\nrestitution = 0.7\n'
                                        'options = { mu = 0.5, stress = "schaeffer" }')
     text = text.replace("solid_fraction = 0.3", f"solid_fraction = {phi0}").replace(
         "restitution = 0.9 }", "restitution = 0.9, friction_angle = 30.0 }")
