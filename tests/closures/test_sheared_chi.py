@@ -137,16 +137,16 @@ def test_fitted_on_the_shared_homogeneous_files_it_predicts_the_e07_pressure() -
 @pytest.mark.analytic
 def test_with_its_static_part_a_frictional_wall_cell_converges_with_the_mesh() -> None:
     """The dense frictional-wall cell of the 3D check (μ 0.5, Schaeffer, e 0.7, φ̄ 0.57, JJ walls φ' 0.1, e_w 0.9,
-    δ_w 30°, 10 d): the wall shear stress on 64, 128, 256, 512 uniform cells changes less at every doubling
-    (measured 320.1, 317.6, 316.3, 315.7 Pa).  Without the static part (a = 0) the shear gathers in a wall band
-    one to three cells thick and the stress does not converge (266.6, 253.6, 238.5, 225.6 Pa; §8)."""
+    δ_w 30°, 10 d): the wall shear stress on 64, 128, 256 uniform cells changes less at the second doubling
+    (measured 320.1, 317.6, 316.3 Pa; 315.7 on 512).  Without the static part (a = 0) the shear gathers in a wall
+    band one to three cells thick and the stress does not converge (266.6, 253.6, 238.5, 225.6 Pa; §8)."""
     from ktgf.couette.run import Material, run
 
     model = get_model("frictional", mu=0.5, stress="schaeffer")
     wall = Wall(specularity=0.1, restitution=0.9, friction_angle=30.0)
     material = Material(1e-3, 2500.0, 0.7)
     tau = [float(run(model, PlanarCell(0.01, 1.0), wall, wall, 0.57, material, n_cells=n, stretch=1.0)
-                 ["wall_shear_stress"].values[0]) for n in (64, 128, 256, 512)]
+                 ["wall_shear_stress"].values[0]) for n in (64, 128, 256)]
     steps = np.abs(np.diff(tau))
     assert np.all(steps[1:] < steps[:-1] / 1.6), tau
     assert steps[-1] < 0.005 * tau[-1], tau
