@@ -201,7 +201,7 @@ def test_frictional_couette_keeps_the_1d_solution_within_one_percent() -> None:
 
 
 @pytest.mark.analytic
-@pytest.mark.slow(minutes=1.9)
+@pytest.mark.slow(minutes=2.3)
 def test_frictional_walls_keep_the_1d_solution_of_a_dense_cell() -> None:
     """JJ walls with δ_w = 30° (``frictional`` μ = 0.5, e = 0.7, Schaeffer, φ̄ = 0.57), 128 cells, IMEX, strain 2
     from the 1D profile: the wall traction raises the 1D wall stress by more than 15 % over δ_w = 0; the 3D run keeps
