@@ -143,3 +143,59 @@ def test_literal_jj_heat_flux_option(name):
     G = jj_friction(w, phi[0], chi[0], theta[0]) * slip**2
     dtheta = pr._wall_gradient(theta, 0)
     assert float(c.kappa[0]) * dtheta == pytest.approx(D - G, rel=1e-3)
+
+
+def _stacked_cases():
+    """Problems whose residual rows reach one node (paper models, JJ, bumpy and prescribed walls, the chute) and two
+    (the sheared χ of ``dense``), with and without a frictional stress and wall friction."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from helpers.friction_couette import frictional_wall_problem
+
+    from ktgf.couette.chute import InclinedLayer, build_chute
+    from ktgf.couette.run import Material
+
+    bumpy = Wall.of_type("bumpy", restitution=0.9)
+    hot = Wall(momentum="prescribed", energy="prescribed", slip=0.0, temperature=0.02)
+    return {
+        "ret-jj": _problem("ret", n=24),
+        "dense-sheared-chi": _problem("dense", mean_phi=0.5, n=24),
+        "dense-bumpy": _problem("dense", mean_phi=0.45, n=24, walls=(bumpy, bumpy)),
+        "enskog-prescribed": _problem("enskog", n=24, walls=(hot, Wall(specularity=0.3, restitution=0.9))),
+        "annular-proposed": _problem("proposed", geometry=AnnularCell(30.0, 50.0, 1 / 30.0), n=24),
+        "frictional-wall-friction": frictional_wall_problem(0.5, 0.55, 25.0, n=24),
+        "chute": build_chute("ret", InclinedLayer(0.03, 20.0), 0.3, Material(d=1e-3, rho_s=2500.0, e=0.9),
+                             n_cells=24),
+    }
+
+
+@pytest.mark.analytic
+@pytest.mark.parametrize("case", ["ret-jj", "dense-sheared-chi", "dense-bumpy", "enskog-prescribed", "annular-proposed",
+                                  "frictional-wall-friction", "chute"])
+def test_stacked_coloured_jacobian_is_the_column_by_column_difference(case):
+    """The Jacobian perturbs several nodes per colour and evaluates every perturbed state in one stacked residual
+    call: each entry equals the central difference of the plain (one state) residual in that unknown alone, with the
+    same step, to round-off; entries outside the colouring's stencil are zero there too (no coupling missed).  A stack
+    of states gives each state's own residual."""
+    from ktgf.couette.chute import bagnold_start
+
+    pr = _stacked_cases()[case]
+    rng = np.random.default_rng(3)
+    X = (bagnold_start(pr) if case == "chute" else naive_start(pr)) + 0.02 * rng.standard_normal(3 * pr.n)
+    J = pr.jacobian(X, pr.residual(X)).toarray()
+    ref = np.empty_like(J)
+    for c in range(X.size):
+        h = pr.fd_step * (1.0 + abs(X[c]))
+        up, down = X.copy(), X.copy()
+        up[c] += h
+        down[c] -= h
+        ref[:, c] = (pr.residual(up) - pr.residual(down)) / (2.0 * h)
+    inventory = (pr.n - 1) * 3 + 2  # the exact row: compare its pattern only
+    scale = np.abs(ref).max(axis=1, keepdims=True) + 1e-300
+    off = np.abs(np.delete(J - ref, inventory, axis=0)) / np.delete(scale, inventory, axis=0)
+    assert off.max() < 1e-6, (np.unravel_index(off.argmax(), off.shape), off.max())
+    stack = X + 1e-3 * rng.standard_normal((3, X.size))
+    each = np.stack([pr.residual(x) for x in stack])
+    np.testing.assert_allclose(pr.residual(stack), each, rtol=1e-12, atol=1e-14 * np.abs(each).max())

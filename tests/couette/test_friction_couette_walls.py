@@ -8,7 +8,6 @@ q·n = G − D with the collisional slip work G only (the frictional wall work i
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 import pytest
@@ -61,7 +60,6 @@ def test_frictional_wall_case_converges_from_the_naive_start_and_meets_its_wall_
     sheared χ with the other core busy; its δ_w = 0 start by natural continuation; 0.9 s without the tangential
     stress, whose δ_w = 0 start Newton finds; 24–46 s by the generic homotopies, same solution to 1e-12)."""
     pr = frictional_wall_problem(0.5, 0.55, 25.0)
-    t0 = time.perf_counter()
     X, info = solve(pr)
     assert info["residual"] < 1e-8
     assert info["path"].startswith("delta_w-continuation")
@@ -70,7 +68,6 @@ def test_frictional_wall_case_converges_from_the_naive_start_and_meets_its_wall_
     base = frictional_wall_problem(0.5, 0.55, 0.0)
     Xb, _ = solve(base, X)  # the frictionless-wall state, from this one (Newton, < 1 s)
     assert abs(t["slip"][0]) < abs(base.terms(Xb)["slip"][0])  # the wall friction holds the medium back
-    assert time.perf_counter() - t0 < 60.0  # generous bound for a loaded machine (measured 3 s at load 6)
 
 
 @pytest.mark.analytic

@@ -165,15 +165,17 @@ class ChuteProblem(Problem):
 
     def residual(self, X: np.ndarray, t: dict[str, np.ndarray] | None = None) -> np.ndarray:
         t = self.terms(X) if t is None else t
-        R = super().residual(X, t).reshape(self.n, N_VARS)
+        batch = t["u"].shape[:-1]
+        R = super().residual(X, t).reshape(*batch, self.n, N_VARS)
         free = np.ones(self.n, dtype=bool)
         for k, i in ((0, 0), (1, self.n - 1)):
             if self.walls[k].momentum == "prescribed":  # a Dirichlet row has no source
                 free[i] = False
-        R[free, 0] += t["body_force"][free]
+        R[..., free, 0] += t["body_force"][..., free]
         p, phi = t["p"], t["phi"]
-        R[:-1, 2] = (np.diff(p) + self.gravity[1] * self.dx * 0.5 * (phi[1:] + phi[:-1])) / (p[1:] + p[:-1])
-        return R.ravel()
+        R[..., :-1, 2] = ((np.diff(p) + self.gravity[1] * self.dx * 0.5 * (phi[..., 1:] + phi[..., :-1]))
+                          / (p[..., 1:] + p[..., :-1]))
+        return R.reshape(*batch, self.n * N_VARS)
 
     def residual_scales(self, t: dict[str, np.ndarray]) -> np.ndarray:
         S = super().residual_scales(t).reshape(self.n, N_VARS)

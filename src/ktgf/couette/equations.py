@@ -31,6 +31,7 @@ SI coefficient functions are called with d = ρ_s = 1 and θ in V²).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -131,8 +132,9 @@ class Problem:
 
     # --- fields --------------------------------------------------------------------------
     def unpack(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        X = X.reshape(self.n, N_VARS)
-        return X[:, 0], np.exp(X[:, 1]), phi_from_psi(X[:, 2], self.phi_max)
+        """(u, θ, φ) at the nodes; a stack of states (leading axes) gives stacks of profiles."""
+        X = X.reshape(*X.shape[:-1], self.n, N_VARS)
+        return X[..., 0], np.exp(X[..., 1]), phi_from_psi(X[..., 2], self.phi_max)
 
     def pack(self, u: np.ndarray, theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
         return np.stack([u, np.log(theta), psi_from_phi(phi, self.phi_max)], axis=1).ravel()
@@ -147,32 +149,37 @@ class Problem:
         x = self.x
         if k == 0:
             h1, h2 = x[1] - x[0], x[2] - x[1]
-            f0, f1, f2, s = f[0], f[1], f[2], 1.0
+            f0, f1, f2, s = f[..., 0], f[..., 1], f[..., 2], 1.0
         else:
             h1, h2 = x[-1] - x[-2], x[-2] - x[-3]
-            f0, f1, f2, s = f[-1], f[-2], f[-3], -1.0
+            f0, f1, f2, s = f[..., -1], f[..., -2], f[..., -3], -1.0
         return s * (-(2 * h1 + h2) / (h1 * (h1 + h2)) * f0 + (h1 + h2) / (h1 * h2) * f1 - h1 / (h2 * (h1 + h2)) * f2)
 
     # --- residual --------------------------------------------------------------------------
     def terms(self, X: np.ndarray) -> dict[str, np.ndarray]:
-        """Every flux and source of the discrete balances (used by the residual and the diagnostics)."""
+        """Every flux and source of the discrete balances (used by the residual and the diagnostics).
+
+        ``X`` may be a stack of states (leading axes, as :meth:`jacobian` passes its perturbed states): every term
+        then has those axes in front, node or face last.
+        """
         u, theta, phi = self.unpack(X)
         n = self.n
-        phi_f = 0.5 * (phi[1:] + phi[:-1])
-        theta_f = 0.5 * (theta[1:] + theta[:-1])
+        batch = u.shape[:-1]
+        phi_f = 0.5 * (phi[..., 1:] + phi[..., :-1])
+        theta_f = 0.5 * (theta[..., 1:] + theta[..., :-1])
         w = self.geometry.angular(u, self.x)
         dw = np.diff(w)
         shear = None
         if self.model.shear_dependent:  # EKT, tangential stress: ζ0 at the nodes sees the local dγ̇/√θ;
             # a shear-dependent χ: p, ζ0 at the nodes and η, κ at the faces see it
             rate = np.abs(self.A / self.geometry.stress_metric(self.xf) * dw / self.dx)  # face shear rates
-            node_rate = np.concatenate([rate[:1], 0.5 * (rate[1:] + rate[:-1]), rate[-1:]])
-            shear = np.concatenate([node_rate / np.sqrt(theta), rate / np.sqrt(theta_f)])
+            node_rate = np.concatenate([rate[..., :1], 0.5 * (rate[..., 1:] + rate[..., :-1]), rate[..., -1:]], axis=-1)
+            shear = np.concatenate([node_rate / np.sqrt(theta), rate / np.sqrt(theta_f)], axis=-1)
         c = self.model.coefficients(
-            np.concatenate([phi, phi_f]), self.e, np.concatenate([theta, theta_f]), d=1.0, rho_s=1.0, check=False,
-            shear=shear,
+            np.concatenate([phi, phi_f], axis=-1), self.e, np.concatenate([theta, theta_f], axis=-1), d=1.0,
+            rho_s=1.0, check=False, shear=shear,
         )
-        node, face = slice(0, n), slice(n, None)
+        node, face = (..., slice(0, n)), (..., slice(n, None))
         rate_f = self.A / self.geometry.stress_metric(self.xf) * dw / self.dx
         p_fric, mu_fric = frictional_terms(self, phi, phi_f, theta_f, rate_f)  # zeros without a frictional stress
         F_kinetic = self.A * c.eta[face] * dw / self.dx
@@ -180,31 +187,33 @@ class Problem:
         E = self.B * (c.kappa[face] * np.diff(theta) + c.omega[face] * np.diff(phi)) / self.dx
         P = F_kinetic * dw  # frictional work is dissipated at the contacts (frictional_stress.py)
         gamma = 1.5 * phi * theta * c.zeta0[node]
-        chi_w = self.model.chi(phi[[0, -1]])  # the wall's JJ conditions take χ(φ) (as the 3D wall ghosts do)
+        chi_w = self.model.chi(phi[..., [0, -1]])  # the wall's JJ conditions take χ(φ) (as the 3D wall ghosts do)
         p = c.p[node] + p_fric
-        F_wall = np.zeros(2)
-        E_wall = np.zeros(2)
-        slip = np.zeros(2)
-        wall_dissipation = np.zeros(2)
+        F_wall = np.zeros((*batch, 2))
+        E_wall = np.zeros((*batch, 2))
+        slip = np.zeros((*batch, 2))
+        wall_dissipation = np.zeros((*batch, 2))
         for k, (i, sign) in enumerate(((0, 1.0), (-1, -1.0))):
             wall = self.walls[k]
-            slip[k] = u[i] - self.u_wall[k]
-            cf = jj_friction(wall, phi[i], chi_w[k], theta[i])
-            bumpy = bumpy_wall_fluxes(wall, p[i], theta[i], slip[k]) if wall.is_bumpy else None
+            slip[..., k] = u[..., i] - self.u_wall[k]
+            sl = slip[..., k]
+            cf = jj_friction(wall, phi[..., i], chi_w[..., k], theta[..., i])
+            bumpy = bumpy_wall_fluxes(wall, p[..., i], theta[..., i], sl) if wall.is_bumpy else None
             if bumpy is not None:  # N = the flow's normal stress at the wall node (p_yy = p in these models)
-                wall_dissipation[k] = bumpy[2]
+                wall_dissipation[..., k] = bumpy[2]
             if wall.momentum == "bumpy":
-                F_wall[k] = sign * self.S_wall[k] * bumpy[0]
+                F_wall[..., k] = sign * self.S_wall[k] * bumpy[0]
             if wall.momentum == "johnson-jackson":
-                F_wall[k] = sign * self.S_wall[k] * cf * slip[k]
+                F_wall[..., k] = sign * self.S_wall[k] * cf * sl
                 if wall.friction_angle > 0.0:  # its work is dissipated at the wall contacts, not fed to θ
                     scale = wall.slip_regularisation * abs(self.u_wall[1] - self.u_wall[0])
-                    F_wall[k] += sign * self.S_wall[k] * jj_frictional_wall_stress(wall, p_fric[i], slip[k], scale)
+                    F_wall[..., k] += sign * self.S_wall[k] * jj_frictional_wall_stress(wall, p_fric[..., i], sl, scale)
             if wall.energy in ("johnson-jackson", "bumpy"):
-                loss = bumpy[1] if wall.energy == "bumpy" else jj_heat_loss(wall, phi[i], chi_w[k], theta[i], slip[k])
-                E_wall[k] = sign * self.B_wall[k] * loss
+                loss = (bumpy[1] if wall.energy == "bumpy"
+                        else jj_heat_loss(wall, phi[..., i], chi_w[..., k], theta[..., i], sl))
+                E_wall[..., k] = sign * self.B_wall[k] * loss
                 if wall.heat_flux == "conductive":  # the condition sets κ∂θ/∂n only: add the ω∂φ/∂x part
-                    E_wall[k] += self.B_wall[k] * c.omega[node][i] * self._wall_gradient(phi, k)
+                    E_wall[..., k] += self.B_wall[k] * c.omega[node][..., i] * self._wall_gradient(phi, k)
         return {
             "u": u, "theta": theta, "phi": phi, "p": p, "eta": c.eta[node],
             "F": F, "E": E, "P": P, "gamma": gamma, "F_wall": F_wall, "E_wall": E_wall, "slip": slip,
@@ -214,25 +223,28 @@ class Problem:
         }
 
     def residual(self, X: np.ndarray, t: dict[str, np.ndarray] | None = None) -> np.ndarray:
+        """The discrete balances (module docstring), flat; a stack of states gives a stack of residuals."""
         t = self.terms(X) if t is None else t
         n = self.n
-        R = np.empty((n, N_VARS))
-        Fx = np.concatenate([t["F_wall"][:1], t["F"], t["F_wall"][1:]])
-        R[:, 0] = Fx[1:] - Fx[:-1]
-        Ex = np.concatenate([t["E_wall"][:1], t["E"], t["E_wall"][1:]])
-        Px = np.concatenate([[0.0], t["P"], [0.0]])
-        R[:, 1] = Ex[1:] - Ex[:-1] + 0.5 * (Px[1:] + Px[:-1]) - self.V * t["gamma"]
+        batch = t["u"].shape[:-1]
+        R = np.empty((*batch, n, N_VARS))
+        Fx = np.concatenate([t["F_wall"][..., :1], t["F"], t["F_wall"][..., 1:]], axis=-1)
+        R[..., 0] = Fx[..., 1:] - Fx[..., :-1]
+        Ex = np.concatenate([t["E_wall"][..., :1], t["E"], t["E_wall"][..., 1:]], axis=-1)
+        zero = np.zeros((*batch, 1))
+        Px = np.concatenate([zero, t["P"], zero], axis=-1)
+        R[..., 1] = Ex[..., 1:] - Ex[..., :-1] + 0.5 * (Px[..., 1:] + Px[..., :-1]) - self.V * t["gamma"]
         lnp = np.log(t["p"])
         K = t["K"]
-        R[:-1, 2] = np.diff(lnp) - self.dx * 0.5 * (K[1:] + K[:-1])
-        R[-1, 2] = self.V @ t["phi"] / self.V.sum() - self.mean_phi
+        R[..., :-1, 2] = np.diff(lnp) - self.dx * 0.5 * (K[..., 1:] + K[..., :-1])
+        R[..., -1, 2] = t["phi"] @ self.V / self.V.sum() - self.mean_phi
         for k, i in ((0, 0), (1, n - 1)):
             wall = self.walls[k]
             if wall.momentum == "prescribed":
-                R[i, 0] = t["u"][i] - self.prescribed_velocity(k)
+                R[..., i, 0] = t["u"][..., i] - self.prescribed_velocity(k)
             if wall.energy == "prescribed":
-                R[i, 1] = np.log(t["theta"][i]) - np.log(wall.temperature / self.v_scale**2)
-        return R.ravel()
+                R[..., i, 1] = np.log(t["theta"][..., i]) - np.log(wall.temperature / self.v_scale**2)
+        return R.reshape(*batch, n * N_VARS)
 
     def residual_scales(self, t: dict[str, np.ndarray]) -> np.ndarray:
         """Magnitude of the terms of each equation, to report a relative residual."""
@@ -246,46 +258,52 @@ class Problem:
         return S.ravel()
 
     # --- Jacobian ----------------------------------------------------------------------------
-    def jacobian(self, X: np.ndarray, R0: np.ndarray):
-        """Sparse Jacobian: coloured forward differences for the banded part, exact inventory row."""
-        import scipy.sparse as sp
-
+    @cached_property
+    def _difference_pattern(self) -> tuple[list[tuple[int, np.ndarray]], tuple[np.ndarray, ...]]:
+        """The colour groups (unknown k, nodes j perturbed together) and, for every Jacobian entry they give, its
+        (group, row node i, equation q, column node j, unknown k); the inventory row is left out (exact)."""
         n = self.n
-        rows, cols, vals = [], [], []
-        R0m = R0.reshape(n, N_VARS)
-        Xm = X.reshape(n, N_VARS)
-        inv_row = (n - 1) * N_VARS + 2
         # a residual row sees the nodes within `reach` of its own: 1, but 2 with a shear-dependent χ (p at a node
         # then depends on the velocities of its neighbours, and the rows next to it see that p)
         reach = 2 if self.sheared_chi else 1
         offsets = (*range(-reach, reach + 1), "walls") if reach == 1 else tuple(range(-reach, reach + 1))
-        for k in range(N_VARS):
-            for colour in range(2 * reach + 1):
-                j = np.arange(colour, n, 2 * reach + 1)
-                h = self.fd_step * (1.0 + np.abs(Xm[j, k]))
-                Xp = Xm.copy()
-                Xp[j, k] += h
-                if self.central_differences:
-                    Xn = Xm.copy()
-                    Xn[j, k] -= h
-                    dR = 0.5 * (self.residual(Xp.ravel()) - self.residual(Xn.ravel())).reshape(n, N_VARS)
+        groups = [(k, np.arange(colour, n, 2 * reach + 1)) for k in range(N_VARS) for colour in range(2 * reach + 1)]
+        entries = []
+        for g, (k, j) in enumerate(groups):
+            for off in offsets:
+                if off == "walls":  # wall rows also see the third node (one-sided wall gradients)
+                    i = np.where(j == 2, 0, np.where(j == n - 3, n - 1, -1))
                 else:
-                    dR = self.residual(Xp.ravel()).reshape(n, N_VARS) - R0m
-                for off in offsets:
-                    if off == "walls":  # wall rows also see the third node (one-sided wall gradients)
-                        i = np.where(j == 2, 0, np.where(j == n - 3, n - 1, -1))
-                    else:
-                        i = j + off
-                    ok = (i >= 0) & (i < n)
-                    for q in range(N_VARS):
-                        r = i[ok] * N_VARS + q
-                        keep = r != inv_row
-                        rows.append(r[keep])
-                        cols.append((j[ok] * N_VARS + k)[keep])
-                        vals.append((dR[i[ok], q] / h[ok])[keep])
+                    i = j + off
+                ok = (i >= 0) & (i < n)
+                for q in range(N_VARS):
+                    keep = ok & ~((i == n - 1) & (q == 2))
+                    entries.append(np.stack(np.broadcast_arrays(g, i[keep], q, j[keep], k)))
+        return groups, tuple(np.concatenate(entries, axis=1))
+
+    def jacobian(self, X: np.ndarray, R0: np.ndarray):
+        """Sparse Jacobian: coloured differences for the banded part, exact inventory row.
+
+        Every perturbed state of every colour goes through one call of :meth:`residual` (a stack of states), so
+        the closures run once per Jacobian on (colours × unknowns × 2) profiles instead of once per profile.
+        """
+        import scipy.sparse as sp
+
+        n = self.n
+        Xm = X.reshape(n, N_VARS)
+        groups, (g, i, q, j, k) = self._difference_pattern
+        h = self.fd_step * (1.0 + np.abs(Xm))  # the step of each unknown
+        signs = (1.0, -1.0) if self.central_differences else (1.0,)
+        stack = np.repeat(Xm[None], len(groups) * len(signs), axis=0)
+        for c, (kc, jc) in enumerate(groups):
+            for s, sign in enumerate(signs):
+                stack[c * len(signs) + s, jc, kc] += sign * h[jc, kc]
+        Rs = self.residual(stack.reshape(len(stack), n * N_VARS)).reshape(len(groups), len(signs), n, N_VARS)
+        dR = 0.5 * (Rs[:, 0] - Rs[:, 1]) if self.central_differences else Rs[:, 0] - R0.reshape(n, N_VARS)
+        inv_row = (n - 1) * N_VARS + 2
         phi = phi_from_psi(Xm[:, 2], self.phi_max)
-        rows.append(np.full(n, inv_row))
-        cols.append(np.arange(n) * N_VARS + 2)
-        vals.append(self.V * phi * (1.0 - phi / self.phi_max) / self.V.sum())
+        rows = np.concatenate([i * N_VARS + q, np.full(n, inv_row)])
+        cols = np.concatenate([j * N_VARS + k, np.arange(n) * N_VARS + 2])
+        vals = np.concatenate([dR[g, i, q] / h[j, k], self.V * phi * (1.0 - phi / self.phi_max) / self.V.sum()])
         m = n * N_VARS
-        return sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(m, m))
+        return sp.csc_matrix((vals, (rows, cols)), shape=(m, m))

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import lru_cache, wraps
 from typing import Any, ClassVar
 
 from ..._array import namespace
@@ -45,6 +45,18 @@ def modified_cooling_rate(zeta0: Any, e: Any, inelasticity: Any) -> Any:
     CFDEM-PRINCETON implementation; not checked against the printed paper).  Needs e < 1.
     """
     return zeta0 * inelasticity / (1.0 - e**2)
+
+
+def _memoised(method: Any) -> Any:
+    """Cache a scalar method of a frozen law on (law, e, μ): a root find over quadratures whose value the solvers
+    ask for at every residual evaluation with the same material constants (the same float, so bit for bit)."""
+    cached = lru_cache(maxsize=1024)(method)
+
+    @wraps(method)
+    def call(self: Any, e: Any, mu: Any, *rest: Any) -> Any:
+        return cached(self, float(e), float(mu), *rest)
+
+    return call
 
 
 @dataclass(frozen=True)
@@ -299,6 +311,7 @@ class WaltonRestitution(FrictionPart):
         m1, m2 = _walton_moments(float(e), float(mu), self.beta0, self.q, float(r))
         return m2 / self.q - r / (self.q + r) * m1
 
+    @_memoised
     def rotational_ratio(self, e: Any, mu: Any) -> float:
         """T_rot/T with the rotational energy balance of steady homogeneous shear (0 at μ = 0)."""
         from scipy.optimize import brentq
@@ -366,6 +379,7 @@ class WaltonRestitution(FrictionPart):
                 "tr0": -(1.0 - f) * mom[0, 0] + mom[1, 0], "tr2": -(1.0 - f) * shifted[0] + shifted[1] + (1.0 - f) * work,
                 "work2": work}
 
+    @_memoised
     def _shear_expansion(self, e: float, mu: float, dr: float = 1e-4) -> tuple[float, float]:
         """(c_r, f): the steady ratio's shift Δr = c_r s² and the tangential work fraction, both to O(s²)."""
         r = self.rotational_ratio(e, mu)
@@ -405,6 +419,7 @@ class WaltonRestitution(FrictionPart):
             return 0.0
         return self._shear_expansion(float(e), float(mu))[0]
 
+    @_memoised
     def hcs_rotational_ratio(self, e: Any, mu: Any) -> float:
         """T_rot/T of the homogeneous cooling state: both temperatures decay at the same relative rate.
 

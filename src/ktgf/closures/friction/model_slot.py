@@ -28,7 +28,7 @@ MFiX/OpenFOAM, a continuum law): it is off (``stress = "none"``) unless chosen.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Any, ClassVar
 
 import numpy as np
@@ -194,8 +194,8 @@ class Friction:
         (An RDF without a divergence below φ = 1, Carnahan–Starling, gives random close packing 0.64 instead.)
         """
         top = self.jj_phi_max if self.jj_phi_max > 0.0 else (float(phi_max) if phi_max < 1.0 else RANDOM_CLOSE_PACKING)
-        return JohnsonJacksonPressure(Fr=self.jj_Fr, n=self.jj_n, p=self.jj_p, phi_min=self.jj_phi_min,
-                                      phi_max=top, delta_min=self.jj_delta_min)
+        return _johnson_jackson_pressure(Fr=self.jj_Fr, n=self.jj_n, p=self.jj_p, phi_min=self.jj_phi_min,
+                                         phi_max=top, delta_min=self.jj_delta_min)
 
     @cached_property
     def viscosity_part(self) -> Any:
@@ -372,6 +372,11 @@ class Friction:
         return "coulomb(" + ", ".join(parts) + ")"
 
 
+#: The pressure part, built (and its options validated) once per set of constants: the solvers ask for it at every
+#: residual evaluation.  A refused set raises each time (lru_cache keeps no exception).
+_johnson_jackson_pressure = lru_cache(maxsize=64)(JohnsonJacksonPressure)
+
+
 def _per_restitution(fn: Any, e: Any) -> Any:
     """fn(e) of a scalar-only quadrature (SciPy) at every distinct value of e, in e's shape and dtype; under
     ``jax.jit`` (a traced e) through a host callback, so e cannot be differentiated."""
@@ -382,6 +387,9 @@ def _per_restitution(fn: Any, e: Any) -> Any:
         return jax.pure_callback(lambda v: _per_restitution(fn, np.asarray(v)), jax.ShapeDtypeStruct(e.shape, e.dtype),
                                  e, vmap_method="expand_dims")
     values = np.asarray(e, dtype=float)
+    if values.ndim == 0:  # the solvers' one restitution: no np.unique round trip (the same float)
+        out = np.array(fn(float(values)), dtype=float)
+        return float(out) if not isinstance(e, np.ndarray) else out.astype(values.dtype)
     uniq, inverse = np.unique(values, return_inverse=True)
     out = np.array([fn(float(v)) for v in uniq])[inverse].reshape(values.shape)
     return float(out) if out.ndim == 0 and not isinstance(e, np.ndarray) else out.astype(values.dtype)
