@@ -389,9 +389,9 @@ def _per_restitution(fn: Any, e: Any) -> Any:
     values = np.asarray(e, dtype=float)
     if values.ndim == 0:  # the solvers' one restitution: no np.unique round trip (the same float)
         out = np.array(fn(float(values)), dtype=float)
-        return float(out) if not isinstance(e, np.ndarray) else out.astype(values.dtype)
-    uniq, inverse = np.unique(values, return_inverse=True)
-    out = np.array([fn(float(v)) for v in uniq])[inverse].reshape(values.shape)
+    else:
+        uniq, inverse = np.unique(values, return_inverse=True)
+        out = np.array([fn(float(v)) for v in uniq])[inverse].reshape(values.shape)
     return float(out) if out.ndim == 0 and not isinstance(e, np.ndarray) else out.astype(values.dtype)
 
 
